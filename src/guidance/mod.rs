@@ -1,0 +1,1 @@
+//! Job state machine. (in progress)

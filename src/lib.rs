@@ -1,0 +1,18 @@
+//! agsteer: automatic steering for tractors.
+//!
+//! Data flows one way through the control cycle:
+//! [`can`] (bus + DBC codec) → [`estimate`] (lat/lon → ENU, antenna offset, latency
+//! compensation) → [`guidance`] (job state machine, progress) → [`plan`] (global paths) →
+//! [`track`] (local B-spline, pure pursuit) → [`safety`] (engage gating, limits, timeouts) →
+//! [`can`].
+//!
+//! Planning modules are pure functions of their inputs (no I/O, clocks or globals). I/O lives
+//! only in [`can`], [`daemon`] and the binaries.
+
+pub mod config;
+pub mod estimate;
+pub mod geo;
+pub mod guidance;
+pub mod plan;
+pub mod sim;
+pub mod track;

@@ -1,0 +1,1 @@
+//! Local path and trackers. (in progress)
