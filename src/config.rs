@@ -1,1 +1,592 @@
-//! Configuration. (in progress)
+//! The one TOML configuration file a service technician edits.
+//!
+//! Every section is `deny_unknown_fields` and every key has a default, so a file only needs the
+//! keys it changes. Edge units (degrees, km/h) are converted to SI by the accessor methods, in
+//! this one place. [`Config::validate`] reports every problem at once, each naming the key, the
+//! value and the rule. `--set key.path=value` overrides are applied to the TOML tree before it
+//! is deserialised, so they go through exactly the same checks as the file.
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::path::Path;
+
+/// Everything that can go wrong loading a configuration.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("{0}")]
+    Parse(String),
+    #[error("bad override `{0}`: expected key.path=value")]
+    BadOverride(String),
+    #[error("{}", .0.iter().map(|p| p.to_string()).collect::<Vec<_>>().join("\n"))]
+    Invalid(Vec<Problem>),
+}
+
+/// One validation problem: `key = value: rule`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    pub key: String,
+    pub value: String,
+    pub rule: String,
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} = {}: {}", self.key, self.value, self.rule)
+    }
+}
+
+/// The kind of job the guidance runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum JobKind {
+    /// Parallel AB lines (SPEC §2).
+    #[default]
+    Ab,
+}
+
+/// Side of A→B on which the following lines are laid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LineSide {
+    Left,
+    #[default]
+    Right,
+}
+
+/// Which tracker steers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum TrackerChoice {
+    /// Pure pursuit on a latency-compensated, dead-reckoned pose (the default).
+    #[default]
+    Predictive,
+    /// Plain seed-000 pure pursuit on the latest fix: the reference.
+    PurePursuit,
+}
+
+/// `[job]`: what to drive.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct JobConfig {
+    /// Job kind: "ab".
+    pub kind: JobKind,
+    /// Point A of the first work line, local ENU [east, north], m.
+    pub point_a_m: [f64; 2],
+    /// Point B of the first work line, local ENU [east, north], m.
+    pub point_b_m: [f64; 2],
+    /// Spacing between adjacent work lines (implement working width), m.
+    pub line_width_m: f64,
+    /// Number of work lines; 0 = unlimited (until the operator stops).
+    pub line_num: u64,
+    /// Side of A→B on which further lines are laid: "left" or "right".
+    pub side: LineSide,
+    /// WGS-84 latitude of the local ENU origin, degrees.
+    pub origin_lat_deg: f64,
+    /// WGS-84 longitude of the local ENU origin, degrees.
+    pub origin_lon_deg: f64,
+}
+
+impl Default for JobConfig {
+    fn default() -> Self {
+        JobConfig {
+            kind: JobKind::Ab,
+            point_a_m: [0.0, 0.0],
+            point_b_m: [0.0, 150.0],
+            line_width_m: 3.0,
+            line_num: 12,
+            side: LineSide::Right,
+            origin_lat_deg: 52.0,
+            origin_lon_deg: 5.0,
+        }
+    }
+}
+
+/// `[guidance]`: how the job is broken into lines, blocks and turns.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GuidanceConfig {
+    /// The seed's `a` in N = 2·ceil(2·r_min/line_width) + a, an integer ≥ 1.
+    pub a: i64,
+    /// Spacing of global path points, m.
+    pub point_spacing_m: f64,
+    /// Angular step between turn-arc points, degrees.
+    pub turn_arc_step_deg: f64,
+    /// Two turn arcs whose ends are closer than this are merged into one, m.
+    pub turn_merge_distance_m: f64,
+    /// Cap on the number of points of a turn's straight part.
+    pub turn_max_points: usize,
+    /// The path counts as "near its end" within this distance of its last point, m.
+    pub end_distance_m: f64,
+}
+
+impl Default for GuidanceConfig {
+    fn default() -> Self {
+        GuidanceConfig {
+            a: 1,
+            point_spacing_m: 1.0,
+            turn_arc_step_deg: 5.0,
+            turn_merge_distance_m: 0.05,
+            turn_max_points: 500,
+            end_distance_m: 0.3,
+        }
+    }
+}
+
+/// `[vehicle]`: geometry of the tractor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VehicleConfig {
+    /// Wheelbase (rear axle to front axle), m.
+    pub wheelbase_m: f64,
+    /// Minimum turning radius used for turns, m.
+    pub r_min_m: f64,
+    /// Largest front-wheel angle either way, degrees.
+    pub max_wheel_angle_deg: f64,
+    /// GNSS antenna position ahead of the rear-axle centre, m.
+    pub antenna_forward_m: f64,
+    /// GNSS antenna position left of the rear-axle centre, m.
+    pub antenna_left_m: f64,
+    /// GNSS antenna height above the rear-axle centre, m.
+    pub antenna_up_m: f64,
+}
+
+impl Default for VehicleConfig {
+    fn default() -> Self {
+        VehicleConfig {
+            wheelbase_m: 3.0,
+            r_min_m: 5.0,
+            max_wheel_angle_deg: 35.0,
+            antenna_forward_m: 1.0,
+            antenna_left_m: 0.0,
+            antenna_up_m: 3.0,
+        }
+    }
+}
+
+/// `[control]`: the control loop.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ControlConfig {
+    /// Control period, s (0.005..=0.5).
+    pub dt_s: f64,
+    /// Driving speed in the simulator and demo, km/h.
+    pub speed_kmh: f64,
+}
+
+impl Default for ControlConfig {
+    fn default() -> Self {
+        ControlConfig {
+            dt_s: 0.02,
+            speed_kmh: 10.0,
+        }
+    }
+}
+
+/// `[track]`: local path and tracker.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrackConfig {
+    /// "predictive" (default) or "pure_pursuit" (plain reference).
+    pub kind: TrackerChoice,
+    /// Minimum look-ahead distance, m.
+    pub ld_min_m: f64,
+    /// Look-ahead growth with speed, s: Ld = max(ld_min_m, ld_gain_s · v).
+    pub ld_gain_s: f64,
+    /// Global points before the nearest one used as local-path nodes.
+    pub local_nodes_before: usize,
+    /// Global points after the nearest one used as local-path nodes.
+    pub local_nodes_after: usize,
+    /// B-spline tangent length at each node, m.
+    pub tangent_length_m: f64,
+    /// Local path sample spacing, m.
+    pub local_spacing_m: f64,
+    /// Known GNSS latency (fix measured this long before it arrives), s. Predictive only.
+    pub gnss_latency_s: f64,
+    /// Extra prediction horizon (about the actuator dead time), s. Predictive only.
+    pub lead_time_s: f64,
+}
+
+impl Default for TrackConfig {
+    fn default() -> Self {
+        TrackConfig {
+            kind: TrackerChoice::Predictive,
+            ld_min_m: 3.0,
+            ld_gain_s: 1.2,
+            local_nodes_before: 1,
+            local_nodes_after: 6,
+            tangent_length_m: 0.25,
+            local_spacing_m: 0.1,
+            gnss_latency_s: 0.05,
+            lead_time_s: 0.05,
+        }
+    }
+}
+
+/// `[sim]`: the vehicle simulator.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimConfig {
+    /// Random seed: the same seed gives the same run.
+    pub seed: u64,
+    /// Internal integration step, s.
+    pub step_s: f64,
+    /// GNSS update rate, Hz.
+    pub gnss_rate_hz: f64,
+    /// GNSS latency (measurement to delivery), s.
+    pub gnss_latency_s: f64,
+    /// GNSS position white noise σ per axis, m.
+    pub gnss_sigma_m: f64,
+    /// Dual-antenna heading noise σ, degrees.
+    pub heading_sigma_deg: f64,
+    /// Wheel-angle sensor rate, Hz.
+    pub was_rate_hz: f64,
+    /// Wheel-angle sensor noise σ, degrees.
+    pub was_noise_deg: f64,
+    /// Steering actuator dead time, s.
+    pub actuator_dead_time_s: f64,
+    /// Steering actuator first-order lag time constant, s.
+    pub actuator_tau_s: f64,
+    /// Steering actuator rate limit, degrees/s.
+    pub actuator_rate_deg_s: f64,
+    /// Initial lateral offset of the vehicle from line A→B (positive = left), m.
+    pub start_offset_m: f64,
+    /// Initial heading error relative to A→B, degrees.
+    pub start_heading_deg: f64,
+    /// Stop the simulation after this much simulated time even if unfinished, s (0 = auto).
+    pub max_time_s: f64,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        SimConfig {
+            seed: 1,
+            step_s: 0.001,
+            gnss_rate_hz: 10.0,
+            gnss_latency_s: 0.05,
+            gnss_sigma_m: 0.01,
+            heading_sigma_deg: 0.1,
+            was_rate_hz: 100.0,
+            was_noise_deg: 0.05,
+            actuator_dead_time_s: 0.05,
+            actuator_tau_s: 0.15,
+            actuator_rate_deg_s: 30.0,
+            start_offset_m: 0.0,
+            start_heading_deg: 0.0,
+            max_time_s: 0.0,
+        }
+    }
+}
+
+/// `[progress]`: where job progress is kept across power loss.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ProgressConfig {
+    /// Directory of the progress file (the daemon's state directory).
+    pub state_dir: String,
+}
+
+impl Default for ProgressConfig {
+    fn default() -> Self {
+        ProgressConfig {
+            state_dir: "/var/lib/agsteer".to_string(),
+        }
+    }
+}
+
+/// The whole configuration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct Config {
+    pub job: JobConfig,
+    pub guidance: GuidanceConfig,
+    pub vehicle: VehicleConfig,
+    pub control: ControlConfig,
+    pub track: TrackConfig,
+    pub sim: SimConfig,
+    pub progress: ProgressConfig,
+}
+
+/// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
+/// (`3`, `2.5`, `true`, `[1, 2]`, `"text"`); anything that does not parse is taken as a string.
+pub fn apply_overrides(root: &mut toml::Table, overrides: &[String]) -> Result<(), ConfigError> {
+    for ov in overrides {
+        let (key, raw) = ov
+            .split_once('=')
+            .ok_or_else(|| ConfigError::BadOverride(ov.clone()))?;
+        let key = key.trim();
+        if key.is_empty() || key.split('.').any(|p| p.trim().is_empty()) {
+            return Err(ConfigError::BadOverride(ov.clone()));
+        }
+        let raw = raw.trim();
+        let value = match format!("v = {raw}").parse::<toml::Table>() {
+            Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(raw.to_string())),
+            Err(_) => toml::Value::String(raw.to_string()),
+        };
+        let parts: Vec<&str> = key.split('.').map(str::trim).collect();
+        let (last, parents) = parts
+            .split_last()
+            .ok_or_else(|| ConfigError::BadOverride(ov.clone()))?;
+        let mut table = &mut *root;
+        for p in parents {
+            let entry = table
+                .entry(p.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            table = entry.as_table_mut().ok_or_else(|| {
+                ConfigError::Parse(format!("override `{ov}`: `{p}` is not a section"))
+            })?;
+        }
+        table.insert(last.to_string(), value);
+    }
+    Ok(())
+}
+
+impl Config {
+    /// Parse TOML text with overrides, without validating.
+    pub fn parse_with(text: &str, overrides: &[String]) -> Result<Config, ConfigError> {
+        let mut root: toml::Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| ConfigError::Parse(e.to_string()))?;
+        apply_overrides(&mut root, overrides)?;
+        Config::deserialize(root).map_err(|e| ConfigError::Parse(e.to_string()))
+    }
+
+    /// Read, override and validate a configuration file.
+    pub fn load(path: &Path, overrides: &[String]) -> Result<Config, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+            path: path.display().to_string(),
+            source,
+        })?;
+        let cfg = Config::parse_with(&text, overrides)?;
+        let problems = cfg.validate();
+        if problems.is_empty() {
+            Ok(cfg)
+        } else {
+            Err(ConfigError::Invalid(problems))
+        }
+    }
+
+    /// Every problem in the configuration, all at once.
+    pub fn validate(&self) -> Vec<Problem> {
+        let mut c = Checker::default();
+        let j = &self.job;
+        c.finite2("job.point_a_m", j.point_a_m);
+        c.finite2("job.point_b_m", j.point_b_m);
+        let ab = ((j.point_b_m[0] - j.point_a_m[0]).powi(2)
+            + (j.point_b_m[1] - j.point_a_m[1]).powi(2))
+        .sqrt();
+        if ab.is_finite() && ab < 1.0 {
+            c.push(
+                "job.point_b_m",
+                format!("{:?}", j.point_b_m),
+                "must be at least 1 m from job.point_a_m",
+            );
+        }
+        c.range("job.line_width_m", j.line_width_m, 0.1, 100.0);
+        c.range("job.origin_lat_deg", j.origin_lat_deg, -89.0, 89.0);
+        c.range("job.origin_lon_deg", j.origin_lon_deg, -180.0, 180.0);
+
+        let g = &self.guidance;
+        if g.a < 1 {
+            c.push("guidance.a", g.a.to_string(), "must be an integer >= 1");
+        }
+        c.range("guidance.point_spacing_m", g.point_spacing_m, 0.05, 10.0);
+        c.range("guidance.turn_arc_step_deg", g.turn_arc_step_deg, 0.1, 10.0);
+        c.range("guidance.turn_merge_distance_m", g.turn_merge_distance_m, 0.0, 5.0);
+        if g.turn_max_points < 2 {
+            c.push(
+                "guidance.turn_max_points",
+                g.turn_max_points.to_string(),
+                "must be an integer >= 2",
+            );
+        }
+        c.range("guidance.end_distance_m", g.end_distance_m, 0.0, 10.0);
+
+        let v = &self.vehicle;
+        c.range("vehicle.wheelbase_m", v.wheelbase_m, 0.5, 20.0);
+        c.range("vehicle.r_min_m", v.r_min_m, 0.5, 100.0);
+        c.range("vehicle.max_wheel_angle_deg", v.max_wheel_angle_deg, 1.0, 80.0);
+        c.range("vehicle.antenna_forward_m", v.antenna_forward_m, -20.0, 20.0);
+        c.range("vehicle.antenna_left_m", v.antenna_left_m, -10.0, 10.0);
+        c.range("vehicle.antenna_up_m", v.antenna_up_m, 0.0, 10.0);
+        if v.wheelbase_m.is_finite() && v.max_wheel_angle_deg.is_finite() && v.r_min_m.is_finite()
+        {
+            let r_steer = v.wheelbase_m / v.max_wheel_angle_deg.to_radians().tan();
+            if v.r_min_m + 1e-9 < r_steer {
+                c.push(
+                    "vehicle.r_min_m",
+                    v.r_min_m.to_string(),
+                    &format!(
+                        "must be >= wheelbase / tan(max wheel angle) = {r_steer:.2} m, the tightest radius the vehicle can steer"
+                    ),
+                );
+            }
+        }
+
+        c.range("control.dt_s", self.control.dt_s, 0.005, 0.5);
+        c.range("control.speed_kmh", self.control.speed_kmh, 0.5, 30.0);
+
+        let t = &self.track;
+        c.range("track.ld_min_m", t.ld_min_m, 0.2, 50.0);
+        c.range("track.ld_gain_s", t.ld_gain_s, 0.0, 10.0);
+        if t.local_nodes_after < 1 {
+            c.push(
+                "track.local_nodes_after",
+                t.local_nodes_after.to_string(),
+                "must be an integer >= 1",
+            );
+        }
+        if t.local_nodes_before + t.local_nodes_after > 64 {
+            c.push(
+                "track.local_nodes_after",
+                t.local_nodes_after.to_string(),
+                "local_nodes_before + local_nodes_after must be <= 64",
+            );
+        }
+        c.range("track.tangent_length_m", t.tangent_length_m, 0.01, 5.0);
+        c.range("track.local_spacing_m", t.local_spacing_m, 0.01, 1.0);
+        c.range("track.gnss_latency_s", t.gnss_latency_s, 0.0, 1.0);
+        c.range("track.lead_time_s", t.lead_time_s, 0.0, 1.0);
+
+        let s = &self.sim;
+        c.range("sim.step_s", s.step_s, 0.0001, 0.01);
+        c.range("sim.gnss_rate_hz", s.gnss_rate_hz, 0.5, 100.0);
+        c.range("sim.gnss_latency_s", s.gnss_latency_s, 0.0, 1.0);
+        c.range("sim.gnss_sigma_m", s.gnss_sigma_m, 0.0, 10.0);
+        c.range("sim.heading_sigma_deg", s.heading_sigma_deg, 0.0, 10.0);
+        c.range("sim.was_rate_hz", s.was_rate_hz, 1.0, 1000.0);
+        c.range("sim.was_noise_deg", s.was_noise_deg, 0.0, 5.0);
+        c.range("sim.actuator_dead_time_s", s.actuator_dead_time_s, 0.0, 1.0);
+        c.range("sim.actuator_tau_s", s.actuator_tau_s, 0.0, 5.0);
+        c.range("sim.actuator_rate_deg_s", s.actuator_rate_deg_s, 1.0, 500.0);
+        c.range("sim.start_offset_m", s.start_offset_m, -50.0, 50.0);
+        c.range("sim.start_heading_deg", s.start_heading_deg, -90.0, 90.0);
+        c.range("sim.max_time_s", s.max_time_s, 0.0, 1e7);
+        if self.progress.state_dir.trim().is_empty() {
+            c.push("progress.state_dir", "\"\"".into(), "must not be empty");
+        }
+        c.problems
+    }
+
+    /// The resolved configuration as TOML text.
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot print: {e}"))
+    }
+
+    /// Control period, s.
+    pub fn dt(&self) -> f64 {
+        self.control.dt_s
+    }
+    /// Driving speed, m/s.
+    pub fn speed(&self) -> f64 {
+        self.control.speed_kmh / 3.6
+    }
+    /// Largest wheel angle, rad.
+    pub fn max_wheel_angle(&self) -> f64 {
+        self.vehicle.max_wheel_angle_deg.to_radians()
+    }
+}
+
+#[derive(Default)]
+struct Checker {
+    problems: Vec<Problem>,
+}
+
+impl Checker {
+    fn push(&mut self, key: &str, value: String, rule: &str) {
+        self.problems.push(Problem {
+            key: key.to_string(),
+            value,
+            rule: rule.to_string(),
+        });
+    }
+    fn range(&mut self, key: &str, v: f64, lo: f64, hi: f64) {
+        if !(v.is_finite() && v >= lo && v <= hi) {
+            self.push(key, fmt_num(v), &format!("must be in {}..={}", fmt_num(lo), fmt_num(hi)));
+        }
+    }
+    fn finite2(&mut self, key: &str, v: [f64; 2]) {
+        if !(v[0].is_finite() && v[1].is_finite()) {
+            self.push(key, format!("{v:?}"), "must be two finite numbers [east, north]");
+        }
+    }
+}
+
+fn fmt_num(v: f64) -> String {
+    if v.is_finite() && v == v.trunc() && v.abs() < 1e15 {
+        format!("{}", v as i64)
+    } else {
+        format!("{v}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid() {
+        assert!(Config::default().validate().is_empty());
+    }
+
+    #[test]
+    fn messages_name_key_value_and_rule() {
+        let cfg = Config::parse_with(
+            "[guidance]\na = 0\n[control]\ndt_s = 2\n",
+            &["vehicle.wheelbase_m=-1".to_string()],
+        )
+        .unwrap();
+        let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
+        assert!(msgs.contains(&"guidance.a = 0: must be an integer >= 1".to_string()));
+        assert!(msgs.contains(&"control.dt_s = 2: must be in 0.005..=0.5".to_string()));
+        assert!(msgs
+            .iter()
+            .any(|m| m.starts_with("vehicle.wheelbase_m = -1: must be in")));
+        assert!(msgs.len() >= 3, "all problems at once: {msgs:?}");
+    }
+
+    #[test]
+    fn unknown_keys_are_rejected() {
+        let err = Config::parse_with("[control]\ndt = 0.1\n", &[]).unwrap_err();
+        assert!(err.to_string().contains("unknown field `dt`"), "{err}");
+        let err = Config::parse_with("", &["track.nope=1".into()]).unwrap_err();
+        assert!(err.to_string().contains("nope"), "{err}");
+    }
+
+    #[test]
+    fn overrides_parse_values_and_strings() {
+        let cfg = Config::parse_with(
+            "",
+            &[
+                "track.kind = pure_pursuit".into(),
+                "job.line_num=100".into(),
+                "job.point_b_m=[10.0, 20.5]".into(),
+            ],
+        )
+        .unwrap();
+        assert_eq!(cfg.track.kind, TrackerChoice::PurePursuit);
+        assert_eq!(cfg.job.line_num, 100);
+        assert_eq!(cfg.job.point_b_m, [10.0, 20.5]);
+        assert!(matches!(
+            Config::parse_with("", &["noequals".into()]),
+            Err(ConfigError::BadOverride(_))
+        ));
+    }
+
+    #[test]
+    fn nan_is_a_problem_not_a_panic() {
+        let cfg = Config::parse_with("[control]\nspeed_kmh = nan\n", &[]).unwrap();
+        let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
+        assert!(msgs.iter().any(|m| m.starts_with("control.speed_kmh = NaN")));
+    }
+
+    #[test]
+    fn r_min_must_be_steerable() {
+        let cfg = Config::parse_with("[vehicle]\nr_min_m = 1.0\n", &[]).unwrap();
+        assert!(cfg.validate().iter().any(|p| p.key == "vehicle.r_min_m"));
+    }
+}
