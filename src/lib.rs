@@ -10,6 +10,7 @@
 //! only in [`can`], [`daemon`] and the binaries.
 
 pub mod config;
+pub mod daemon;
 pub mod estimate;
 pub mod geo;
 pub mod guidance;

@@ -1,1 +1,3 @@
-//! Job state machine. (in progress)
+//! Guidance: the job state machine and its progress.
+
+pub mod progress;
