@@ -1,1 +1,215 @@
-fn main() {}
+//! `agsteer`: the technician's and developer's tool.
+
+use agsteer::config::Config;
+use agsteer::daemon::progress_file;
+use agsteer::demo::{self, DemoOptions};
+use agsteer::guidance::Event;
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "agsteer", version, about = "agsteer: automatic steering for tractors")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Options shared by every subcommand that reads a configuration.
+#[derive(Args, Clone)]
+struct ConfigArgs {
+    /// Override a configuration key without editing the file, e.g. `--set track.kind=pure_pursuit`.
+    #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
+    set: Vec<String>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a whole job closed-loop against the simulator, faster than real time.
+    Demo {
+        /// Configuration file.
+        #[arg(long, default_value = "config/demo.toml")]
+        config: PathBuf,
+        /// Output directory for trace.svg, report.json and progress.json.
+        #[arg(long, default_value = "out/demo")]
+        out: PathBuf,
+        /// Print the report JSON on stdout.
+        #[arg(long)]
+        json: bool,
+        /// Continue from OUT/progress.json instead of starting afresh.
+        #[arg(long)]
+        resume: bool,
+        /// Stop after this many lines, as a power loss would (for trying --resume).
+        #[arg(long, value_name = "LINES")]
+        stop_after: Option<u64>,
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    },
+    /// Validate a configuration: print it resolved, or every problem (exit status 2).
+    CheckConfig {
+        /// Configuration file.
+        file: PathBuf,
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    },
+}
+
+fn init_logging() {
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_target(false)
+        .try_init();
+}
+
+fn main() -> ExitCode {
+    init_logging();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Demo {
+            config,
+            out,
+            json,
+            resume,
+            stop_after,
+            cfg,
+        } => run_demo(&config, &out, json, resume, stop_after, &cfg.set),
+        Command::CheckConfig { file, cfg } => check_config(&file, &cfg.set),
+    };
+    match result {
+        Ok(code) => ExitCode::from(code),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn load_config(path: &Path, set: &[String]) -> Result<Config> {
+    Config::load(path, set).with_context(|| format!("configuration {}", path.display()))
+}
+
+fn check_config(path: &Path, set: &[String]) -> Result<u8> {
+    match Config::load(path, set) {
+        Ok(cfg) => {
+            print!("{}", cfg.to_toml());
+            Ok(0)
+        }
+        Err(agsteer::config::ConfigError::Invalid(problems)) => {
+            eprintln!("{}: {} problem(s)", path.display(), problems.len());
+            for p in problems {
+                eprintln!("  {p}");
+            }
+            Ok(2)
+        }
+        Err(e) => {
+            eprintln!("{}: {e}", path.display());
+            Ok(2)
+        }
+    }
+}
+
+fn log_event(t: f64, ev: &Event) {
+    match ev {
+        Event::LineStarted { block, rank, line } => {
+            tracing::info!(t_s = format_args!("{t:.2}"), block, rank, line, "line started")
+        }
+        Event::LineFinished { block, rank, line } => {
+            tracing::info!(t_s = format_args!("{t:.2}"), block, rank, line, "line finished")
+        }
+        Event::TurnStarted { from_line, to_line } => tracing::info!(
+            t_s = format_args!("{t:.2}"),
+            from_line,
+            to_line,
+            "turn started"
+        ),
+        Event::BlockChanged { block } => {
+            tracing::info!(t_s = format_args!("{t:.2}"), block, "block changed")
+        }
+        Event::JobFinished { lines_done } => {
+            tracing::info!(t_s = format_args!("{t:.2}"), lines_done, "job finished")
+        }
+    }
+}
+
+fn run_demo(
+    config: &Path,
+    out: &Path,
+    json: bool,
+    resume: bool,
+    stop_after: Option<u64>,
+    set: &[String],
+) -> Result<u8> {
+    let cfg = load_config(config, set)?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let progress_path = out.join(progress_file::PROGRESS_FILE_NAME);
+    let resume_from = if resume {
+        match progress_file::load(&progress_path) {
+            Ok(Some(p)) => {
+                tracing::info!(
+                    lines_done = p.lines_done,
+                    block = p.index_block,
+                    rank = p.index_rank,
+                    "resuming from {}",
+                    progress_path.display()
+                );
+                Some(p)
+            }
+            Ok(None) => anyhow::bail!("--resume: no progress file at {}", progress_path.display()),
+            Err(e) => return Err(e).context("--resume"),
+        }
+    } else {
+        None
+    };
+    let opts = DemoOptions {
+        resume: resume_from,
+        stop_after_lines: stop_after,
+        record_trace: true,
+    };
+    let mut save_error = None;
+    let mut on_progress = |p: &agsteer::guidance::progress::Progress| {
+        if let Err(e) = progress_file::save(&progress_path, p) {
+            save_error.get_or_insert(e);
+        }
+    };
+    let run = demo::run(&cfg, &opts, &mut on_progress, &mut log_event)
+        .context("running the demo job")?;
+    if let Some(e) = save_error {
+        tracing::error!("could not save progress: {e}");
+    }
+    let report_json = serde_json::to_string_pretty(&run.report)?;
+    std::fs::write(out.join("report.json"), format!("{report_json}\n"))
+        .with_context(|| format!("writing {}/report.json", out.display()))?;
+    std::fs::write(out.join("trace.svg"), demo::svg::demo_svg(&run.trace, &run.report))
+        .with_context(|| format!("writing {}/trace.svg", out.display()))?;
+    if json {
+        println!("{report_json}");
+    } else {
+        let r = &run.report;
+        println!(
+            "{}: {}/{} lines, {} turns, {:.0} m in {:.0} s simulated ({:.2} s wall)",
+            if r.finished { "finished" } else { "NOT finished" },
+            r.lines_completed,
+            r.lines_planned
+                .map(|n| n.to_string())
+                .unwrap_or_else(|| "unlimited".into()),
+            r.turns,
+            r.distance_m,
+            r.sim_time_s,
+            r.wall_time_s
+        );
+        println!(
+            "true XTE on work lines: RMS {:.1} cm, p95 {:.1} cm, max {:.1} cm; acquisition max {:.1} cm (tracker {})",
+            r.xte_rms_m * 100.0,
+            r.xte_p95_m * 100.0,
+            r.xte_max_m * 100.0,
+            r.acquisition_xte_max_m * 100.0,
+            r.tracker
+        );
+        println!("wrote {}/trace.svg and report.json", out.display());
+    }
+    Ok(0)
+}

@@ -1,0 +1,192 @@
+//! One control cycle, glued in the data-flow order: [`estimate`](crate::estimate) →
+//! [`guidance`](crate::guidance) → [`plan`](crate::plan) → [`track`](crate::track).
+//!
+//! The same [`Controller`] runs in the in-process demo, the tests and the daemon. It is
+//! allocation-free per cycle and never does I/O: callers feed it inputs and persist the
+//! progress snapshots it hands out.
+
+use crate::config::{Config, LineSide, TrackerChoice};
+use crate::estimate::{AntennaOffset, Estimator, EstimatorParams, GnssFix, VehicleEstimate};
+use crate::geo::{v2, Pose};
+use crate::guidance::progress::{JobDefinition, Progress};
+use crate::guidance::{Guidance, GuidanceError, GuidanceParams};
+use crate::plan::abline::{AbParams, AbPlan, Side};
+use crate::plan::turns::TurnParams;
+use crate::track::local_path::LocalPathParams;
+use crate::track::{pure_pursuit, TrackOutput, TrackerParams};
+
+/// The AB planner's parameters from the configuration.
+pub fn ab_params(cfg: &Config) -> AbParams {
+    AbParams {
+        point_a: v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]),
+        point_b: v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]),
+        line_width: cfg.job.line_width_m,
+        line_num: cfg.job.line_num,
+        r_min: cfg.vehicle.r_min_m,
+        side: match cfg.job.side {
+            LineSide::Left => Side::Left,
+            LineSide::Right => Side::Right,
+        },
+        block_extra: cfg.guidance.a.max(1) as u32,
+        point_spacing: cfg.guidance.point_spacing_m,
+        turn: TurnParams {
+            r_min: cfg.vehicle.r_min_m,
+            arc_step: cfg.guidance.turn_arc_step_deg.to_radians(),
+            merge_distance: cfg.guidance.turn_merge_distance_m,
+            point_spacing: cfg.guidance.point_spacing_m,
+            max_points: cfg.guidance.turn_max_points,
+        },
+    }
+}
+
+/// The state machine's parameters from the configuration.
+pub fn guidance_params(cfg: &Config) -> GuidanceParams {
+    GuidanceParams {
+        end_distance: cfg.guidance.end_distance_m,
+        local: LocalPathParams {
+            nodes_before: cfg.track.local_nodes_before,
+            nodes_after: cfg.track.local_nodes_after,
+            tangent_length: cfg.track.tangent_length_m,
+            spacing: cfg.track.local_spacing_m,
+        },
+        search_window: 8,
+    }
+}
+
+/// The tracker's parameters from the configuration.
+pub fn tracker_params(cfg: &Config) -> TrackerParams {
+    TrackerParams {
+        wheelbase: cfg.vehicle.wheelbase_m,
+        ld_min: cfg.track.ld_min_m,
+        ld_gain: cfg.track.ld_gain_s,
+        max_wheel_angle: cfg.max_wheel_angle(),
+    }
+}
+
+/// The estimator's parameters: the predictive tracker compensates latency and dead-reckons,
+/// plain pure pursuit uses the latest fix as it is.
+pub fn estimator_params(cfg: &Config) -> EstimatorParams {
+    let predictive = cfg.track.kind == TrackerChoice::Predictive;
+    EstimatorParams {
+        wheelbase: cfg.vehicle.wheelbase_m,
+        antenna: AntennaOffset {
+            forward: cfg.vehicle.antenna_forward_m,
+            left: cfg.vehicle.antenna_left_m,
+            up: cfg.vehicle.antenna_up_m,
+        },
+        gnss_latency: if predictive {
+            cfg.track.gnss_latency_s
+        } else {
+            0.0
+        },
+        predict: predictive,
+        lead_time: if predictive {
+            cfg.track.lead_time_s
+        } else {
+            0.0
+        },
+    }
+}
+
+/// The result of one cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlOutput {
+    /// Commanded front-wheel angle, rad (positive left). `None` when there is nothing to
+    /// steer by (no fix yet, job finished).
+    pub wheel_angle: Option<f64>,
+    /// The estimate the command was computed from.
+    pub estimate: Option<VehicleEstimate>,
+    /// Cross-track error (positive = left of the path), m.
+    pub xte: Option<f64>,
+    /// Heading error, rad.
+    pub heading_error: Option<f64>,
+    /// The tracker's detail.
+    pub track: Option<TrackOutput>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ControlError {
+    #[error(transparent)]
+    Guidance(#[from] GuidanceError),
+    #[error("cannot plan the job: {0}")]
+    Plan(#[from] crate::plan::PlanError),
+}
+
+/// Estimation, guidance and tracking for one job.
+pub struct Controller {
+    estimator: Estimator,
+    guidance: Guidance,
+    tracker: TrackerParams,
+}
+
+impl Controller {
+    /// A new job, or the continuation of `resume`.
+    pub fn from_config(cfg: &Config, resume: Option<&Progress>) -> Result<Self, ControlError> {
+        let plan = AbPlan::new(ab_params(cfg))?;
+        let job = JobDefinition::from_config(cfg);
+        let guidance = match resume {
+            Some(p) => Guidance::resume(plan, job, guidance_params(cfg), p)?,
+            None => Guidance::new(plan, job, guidance_params(cfg))?,
+        };
+        Ok(Controller {
+            estimator: Estimator::new(estimator_params(cfg)),
+            guidance,
+            tracker: tracker_params(cfg),
+        })
+    }
+
+    pub fn on_fix(&mut self, fix: &GnssFix) {
+        self.estimator.on_fix(fix);
+    }
+
+    pub fn on_wheel_angle(&mut self, t: f64, angle: f64) {
+        self.estimator.on_wheel_angle(t, angle);
+    }
+
+    /// One control period at time `t` (s, controller clock).
+    pub fn tick(&mut self, t: f64) -> Result<ControlOutput, ControlError> {
+        let mut out = ControlOutput {
+            wheel_angle: None,
+            estimate: None,
+            xte: None,
+            heading_error: None,
+            track: None,
+        };
+        let Some(est) = self.estimator.estimate(t) else {
+            return Ok(out);
+        };
+        out.estimate = Some(est);
+        self.guidance.update(&est.pose)?;
+        if self.guidance.is_finished() {
+            return Ok(out);
+        }
+        if let Some((xte, he)) = self.guidance.errors(&est.pose) {
+            out.xte = Some(xte);
+            out.heading_error = Some(he);
+        }
+        let tr = pure_pursuit(self.guidance.local_path(), &est.pose, est.speed, &self.tracker);
+        if tr.wheel_angle.is_finite() {
+            out.wheel_angle = Some(tr.wheel_angle);
+        }
+        out.track = Some(tr);
+        Ok(out)
+    }
+
+    pub fn guidance(&self) -> &Guidance {
+        &self.guidance
+    }
+    pub fn guidance_mut(&mut self) -> &mut Guidance {
+        &mut self.guidance
+    }
+
+    /// Where a vehicle would begin the current path: its first point, on its first segment's
+    /// heading. Used to place the simulated vehicle on a resumed job.
+    pub fn path_start_pose(&self) -> Option<Pose> {
+        let p = self.guidance.global_path();
+        if p.len() < 2 {
+            return None;
+        }
+        let d = p[1].pos - p[0].pos;
+        Some(Pose::new(p[0].pos.x, p[0].pos.y, d.y.atan2(d.x)))
+    }
+}

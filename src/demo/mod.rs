@@ -1,0 +1,372 @@
+//! The closed-loop demo: the controller and the simulator in one process, faster than real
+//! time, scored against the simulator's ground truth (never the estimate).
+//!
+//! Memory does not grow with the job: XTE statistics use a fixed histogram, and the trace for
+//! the SVG is recorded only on request.
+
+pub mod svg;
+
+use crate::config::{Config, TrackerChoice};
+use crate::control::{ControlError, Controller};
+use crate::estimate::GnssFix;
+use crate::geo::{left_normal, signed_offset, v2, Pose, Vec2};
+use crate::guidance::progress::{Phase, Progress};
+use crate::guidance::Event;
+use crate::sim::{SimOutput, SimParams, Simulator};
+use serde::Serialize;
+
+/// Work-line samples closer than this to the line start are excluded from the XTE figures, m.
+pub const ACQUISITION_SKIP_M: f64 = 10.0;
+/// Acquisition is judged between [`ACQUISITION_SKIP_M`] and this distance along the line, m.
+pub const ACQUISITION_END_M: f64 = 20.0;
+/// Trace points for the SVG are recorded every this many metres driven.
+const TRACE_SPACING_M: f64 = 0.5;
+
+/// The simulator's parameters from the configuration.
+pub fn sim_params(cfg: &Config) -> SimParams {
+    let s = &cfg.sim;
+    SimParams {
+        wheelbase: cfg.vehicle.wheelbase_m,
+        max_wheel_angle: cfg.max_wheel_angle(),
+        antenna_forward: cfg.vehicle.antenna_forward_m,
+        antenna_left: cfg.vehicle.antenna_left_m,
+        antenna_up: cfg.vehicle.antenna_up_m,
+        dead_time: s.actuator_dead_time_s,
+        tau: s.actuator_tau_s,
+        max_rate: s.actuator_rate_deg_s.to_radians(),
+        gnss_rate_hz: s.gnss_rate_hz,
+        gnss_latency: s.gnss_latency_s,
+        gnss_sigma: s.gnss_sigma_m,
+        heading_sigma: s.heading_sigma_deg.to_radians(),
+        was_rate_hz: s.was_rate_hz,
+        was_noise: s.was_noise_deg.to_radians(),
+        step: s.step_s,
+        seed: s.seed,
+        ..SimParams::default()
+    }
+}
+
+/// |XTE| statistics in constant memory: a histogram of 0.1 mm bins up to 2 m.
+#[derive(Debug, Clone)]
+pub struct XteStats {
+    bins: Vec<u32>,
+    overflow: u64,
+    count: u64,
+    sum_sq: f64,
+    max: f64,
+}
+
+const BIN_M: f64 = 1e-4;
+const BINS: usize = 20_000;
+
+impl Default for XteStats {
+    fn default() -> Self {
+        XteStats {
+            bins: vec![0; BINS],
+            overflow: 0,
+            count: 0,
+            sum_sq: 0.0,
+            max: 0.0,
+        }
+    }
+}
+
+impl XteStats {
+    pub fn add(&mut self, xte: f64) {
+        let a = xte.abs();
+        if !a.is_finite() {
+            return;
+        }
+        let i = (a / BIN_M) as usize;
+        match self.bins.get_mut(i) {
+            Some(b) => *b += 1,
+            None => self.overflow += 1,
+        }
+        self.count += 1;
+        self.sum_sq += a * a;
+        self.max = self.max.max(a);
+    }
+    pub fn count(&self) -> u64 {
+        self.count
+    }
+    pub fn rms(&self) -> f64 {
+        if self.count == 0 {
+            0.0
+        } else {
+            (self.sum_sq / self.count as f64).sqrt()
+        }
+    }
+    pub fn max(&self) -> f64 {
+        self.max
+    }
+    /// The `q` quantile (0..1), to the bin resolution (upper bin edge).
+    pub fn quantile(&self, q: f64) -> f64 {
+        if self.count == 0 {
+            return 0.0;
+        }
+        let target = (q * self.count as f64).ceil().max(1.0) as u64;
+        let mut seen = 0u64;
+        for (i, &b) in self.bins.iter().enumerate() {
+            seen += b as u64;
+            if seen >= target {
+                return ((i + 1) as f64 * BIN_M).min(self.max);
+            }
+        }
+        self.max
+    }
+}
+
+/// The demo report (`report.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    pub finished: bool,
+    /// Lines in the job; `null` when unlimited.
+    pub lines_planned: Option<u64>,
+    pub lines_completed: u64,
+    /// RMS |XTE| on work lines, excluding the first 10 m of each line, m.
+    pub xte_rms_m: f64,
+    pub xte_p95_m: f64,
+    pub xte_max_m: f64,
+    /// Largest |XTE| between 10 m and 20 m of each line after a turn, m.
+    pub acquisition_xte_max_m: f64,
+    pub turns: u64,
+    pub distance_m: f64,
+    pub max_wheel_angle_deg: f64,
+    pub max_wheel_rate_deg_s: f64,
+    pub sim_time_s: f64,
+    pub wall_time_s: f64,
+    pub tracker: String,
+}
+
+/// What to record and where to start.
+#[derive(Debug, Clone, Default)]
+pub struct DemoOptions {
+    /// Continue this saved progress instead of starting the job afresh.
+    pub resume: Option<Progress>,
+    /// Stop (as at a power loss) once this many lines have been finished in this run.
+    pub stop_after_lines: Option<u64>,
+    /// Record the trace and the turns for the SVG.
+    pub record_trace: bool,
+}
+
+/// A recorded point of the true trajectory.
+#[derive(Debug, Clone, Copy)]
+pub struct TracePoint {
+    pub pos: Vec2,
+    /// |XTE| at this point when on a work line, m; `None` in turns.
+    pub xte_abs: Option<f64>,
+}
+
+/// What the SVG draws.
+#[derive(Debug, Clone, Default)]
+pub struct Trace {
+    pub points: Vec<TracePoint>,
+    pub turns: Vec<Vec<Vec2>>,
+    /// (start, end) of every work line driven.
+    pub lines: Vec<(Vec2, Vec2)>,
+}
+
+/// A finished run.
+#[derive(Debug, Clone)]
+pub struct DemoRun {
+    pub report: Report,
+    pub trace: Trace,
+    /// Lines finished in this run, in order.
+    pub finished_lines: Vec<u64>,
+    /// Progress at the end of the run.
+    pub progress: Progress,
+}
+
+fn tracker_name(kind: TrackerChoice) -> &'static str {
+    match kind {
+        TrackerChoice::Predictive => "predictive",
+        TrackerChoice::PurePursuit => "pure_pursuit",
+    }
+}
+
+/// A default time budget: three times the time to drive every line and turn.
+fn default_max_time(cfg: &Config) -> f64 {
+    let ab = v2(
+        cfg.job.point_b_m[0] - cfg.job.point_a_m[0],
+        cfg.job.point_b_m[1] - cfg.job.point_a_m[1],
+    )
+    .norm();
+    let lines = if cfg.job.line_num == 0 {
+        100
+    } else {
+        cfg.job.line_num
+    } as f64;
+    let per_line = ab + 4.0 * cfg.vehicle.r_min_m + 20.0 * cfg.job.line_width_m;
+    60.0 + 3.0 * lines * per_line / cfg.speed().max(0.1)
+}
+
+/// Run the job closed-loop. `on_progress` is called at every line change with the snapshot to
+/// persist; `on_event` with every guidance event.
+pub fn run(
+    cfg: &Config,
+    opts: &DemoOptions,
+    on_progress: &mut dyn FnMut(&Progress),
+    on_event: &mut dyn FnMut(f64, &Event),
+) -> Result<DemoRun, ControlError> {
+    let wall = std::time::Instant::now();
+    let mut ctrl = Controller::from_config(cfg, opts.resume.as_ref())?;
+    let speed = cfg.speed();
+    let start = match &opts.resume {
+        Some(_) => ctrl.path_start_pose(),
+        None => None,
+    }
+    .unwrap_or_else(|| {
+        let a = v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]);
+        let b = v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]);
+        let dir = (b - a).normalize();
+        let p = a + left_normal(&dir) * cfg.sim.start_offset_m;
+        Pose::new(
+            p.x,
+            p.y,
+            dir.y.atan2(dir.x) + cfg.sim.start_heading_deg.to_radians(),
+        )
+    });
+    let mut sim = Simulator::new(sim_params(cfg), start, speed);
+    let dt = cfg.dt();
+    let max_time = if cfg.sim.max_time_s > 0.0 {
+        cfg.sim.max_time_s
+    } else {
+        default_max_time(cfg)
+    };
+
+    let mut stats = XteStats::default();
+    let mut acquisition_max: f64 = 0.0;
+    let mut turns = 0u64;
+    let mut finished_lines = Vec::new();
+    let mut lines_this_run = 0u64;
+    let mut after_turn = opts.resume.is_some();
+    let mut outs: Vec<SimOutput> = Vec::with_capacity(64);
+    let mut trace = Trace::default();
+    let mut distance = 0.0;
+    let mut next_trace_at = 0.0;
+    let mut max_wheel: f64 = 0.0;
+    let mut max_rate: f64 = 0.0;
+    let mut last_wheel = sim.true_state().wheel_angle;
+    let mut command = 0.0;
+    let mut t = 0.0;
+    let mut k: u64 = 0;
+    let mut stopped = false;
+
+    while t <= max_time {
+        t = k as f64 * dt;
+        k += 1;
+        sim.advance_to(t, &mut outs);
+        for o in outs.drain(..) {
+            match o {
+                SimOutput::Gnss(m) => ctrl.on_fix(&GnssFix {
+                    t_received: m.t_delivered,
+                    antenna: m.antenna,
+                    heading: Some(m.heading),
+                    speed: m.speed,
+                    roll: None,
+                }),
+                SimOutput::WheelAngle { t, angle } => ctrl.on_wheel_angle(t, angle),
+            }
+        }
+        let out = ctrl.tick(t)?;
+        if ctrl.guidance().has_events() {
+            on_progress(&ctrl.guidance().progress());
+            let g = ctrl.guidance_mut();
+            let mut turn_started = false;
+            for ev in g.drain_events() {
+                match ev {
+                    Event::TurnStarted { .. } => {
+                        turns += 1;
+                        turn_started = true;
+                    }
+                    Event::LineFinished { line, .. } => {
+                        finished_lines.push(line);
+                        lines_this_run += 1;
+                    }
+                    _ => {}
+                }
+                on_event(t, &ev);
+            }
+            if turn_started {
+                after_turn = true;
+                if opts.record_trace {
+                    trace
+                        .turns
+                        .push(ctrl.guidance().global_path().iter().map(|p| p.pos).collect());
+                }
+            }
+            if opts.stop_after_lines.is_some_and(|n| lines_this_run >= n) {
+                stopped = true;
+                break;
+            }
+        }
+        if ctrl.guidance().is_finished() {
+            break;
+        }
+        if let Some(w) = out.wheel_angle {
+            command = w;
+        }
+        sim.set_command(command);
+
+        // Ground truth scoring.
+        let truth = sim.true_state();
+        distance += truth.speed.abs() * dt;
+        max_wheel = max_wheel.max(truth.wheel_angle.abs());
+        if k > 1 {
+            max_rate = max_rate.max((truth.wheel_angle - last_wheel).abs() / dt);
+        }
+        last_wheel = truth.wheel_angle;
+        let g = ctrl.guidance();
+        let mut xte_abs = None;
+        if g.phase() == Phase::Work {
+            let (block, rank) = (g.index_block(), g.index_rank());
+            let plan = g.plan();
+            let (s, e) = plan.line_endpoints(plan.line_of(block, rank), plan.line_reversed(block, rank));
+            let len = (e - s).norm();
+            let dir = (e - s) / len;
+            let along = (truth.pose.pos - s).dot(&dir);
+            let xte = signed_offset(&truth.pose.pos, &s, &dir);
+            if (ACQUISITION_SKIP_M..=len).contains(&along) {
+                stats.add(xte);
+                if after_turn && along <= ACQUISITION_END_M {
+                    acquisition_max = acquisition_max.max(xte.abs());
+                }
+            }
+            xte_abs = Some(xte.abs());
+            if opts.record_trace && trace.lines.last() != Some(&(s, e)) {
+                trace.lines.push((s, e));
+            }
+        }
+        if opts.record_trace && distance >= next_trace_at {
+            trace.points.push(TracePoint {
+                pos: truth.pose.pos,
+                xte_abs,
+            });
+            next_trace_at = distance + TRACE_SPACING_M;
+        }
+    }
+
+    let finished = ctrl.guidance().is_finished() && !stopped;
+    let report = Report {
+        finished,
+        lines_planned: (cfg.job.line_num > 0).then_some(cfg.job.line_num),
+        lines_completed: ctrl.guidance().lines_done(),
+        xte_rms_m: stats.rms(),
+        xte_p95_m: stats.quantile(0.95),
+        xte_max_m: stats.max(),
+        acquisition_xte_max_m: acquisition_max,
+        turns,
+        distance_m: distance,
+        max_wheel_angle_deg: max_wheel.to_degrees(),
+        max_wheel_rate_deg_s: max_rate.to_degrees(),
+        sim_time_s: t,
+        wall_time_s: wall.elapsed().as_secs_f64(),
+        tracker: tracker_name(cfg.track.kind).to_string(),
+    };
+    Ok(DemoRun {
+        report,
+        trace,
+        finished_lines,
+        progress: ctrl.guidance().progress(),
+    })
+}

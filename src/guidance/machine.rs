@@ -1,0 +1,311 @@
+//! The seed-000 job state machine (SPEC §2, steps 1–4), run every control period.
+//!
+//! It owns the current global path (one work line or one turn, regenerated lazily at each
+//! change) and the local B-spline path, and keeps `index_block`, `index_rank`,
+//! `index_global` and `index_local`. It never allocates per cycle: the path buffers are reused
+//! and events are pushed only when something changes.
+
+use super::progress::{JobDefinition, Phase, Progress, PROGRESS_VERSION};
+use crate::geo::{signed_offset, wrap_angle, PathPoint, Pose, Tag, Vec2};
+use crate::plan::abline::AbPlan;
+use crate::plan::PlanError;
+use crate::track::local_path::{nearest_global, LocalPath, LocalPathParams};
+
+/// Something the binaries log.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Event {
+    LineStarted { block: u64, rank: u64, line: u64 },
+    LineFinished { block: u64, rank: u64, line: u64 },
+    TurnStarted { from_line: u64, to_line: u64 },
+    BlockChanged { block: u64 },
+    JobFinished { lines_done: u64 },
+}
+
+/// Tuning of the state machine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GuidanceParams {
+    /// The path is "near its end" within this distance of its last point, m.
+    pub end_distance: f64,
+    /// Local B-spline path parameters.
+    pub local: LocalPathParams,
+    /// Global points searched either side of the previous nearest point each cycle.
+    pub search_window: usize,
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum GuidanceError {
+    #[error("saved progress belongs to a different job (job parameters differ); refusing to resume")]
+    DifferentJob,
+    #[error("saved progress points at block {block}, rank {rank}, which this job does not have")]
+    OutOfRange { block: u64, rank: u64 },
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+}
+
+/// The job state machine.
+pub struct Guidance {
+    plan: AbPlan,
+    job: JobDefinition,
+    params: GuidanceParams,
+    index_block: u64,
+    index_rank: usize,
+    phase: Phase,
+    lines_done: u64,
+    path: Vec<PathPoint>,
+    index_global: usize,
+    local: LocalPath,
+    events: Vec<Event>,
+}
+
+impl Guidance {
+    /// Start a job on its first line (step 1).
+    pub fn new(
+        plan: AbPlan,
+        job: JobDefinition,
+        params: GuidanceParams,
+    ) -> Result<Self, GuidanceError> {
+        let local = LocalPath::new(&params.local);
+        let mut g = Guidance {
+            plan,
+            job,
+            params,
+            index_block: 0,
+            index_rank: 0,
+            phase: Phase::Work,
+            lines_done: 0,
+            path: Vec::with_capacity(1024),
+            index_global: 0,
+            local,
+            events: Vec::with_capacity(16),
+        };
+        g.start_work_line()?;
+        Ok(g)
+    }
+
+    /// Continue a job from saved progress. A turn in progress is regenerated and driven again;
+    /// finished lines are never driven again.
+    pub fn resume(
+        plan: AbPlan,
+        job: JobDefinition,
+        params: GuidanceParams,
+        saved: &Progress,
+    ) -> Result<Self, GuidanceError> {
+        if saved.job != job {
+            return Err(GuidanceError::DifferentJob);
+        }
+        let mut g = Guidance::new(plan, job, params)?;
+        g.events.clear();
+        let (block, rank) = (saved.index_block, saved.index_rank);
+        let in_range = g.plan.block_count().is_none_or(|n| block < n)
+            && (rank as usize) < g.plan.block_len(block);
+        if !in_range {
+            return Err(GuidanceError::OutOfRange { block, rank });
+        }
+        g.index_block = block;
+        g.index_rank = rank as usize;
+        g.lines_done = saved.lines_done;
+        match saved.phase {
+            Phase::Finished => {
+                g.phase = Phase::Finished;
+                g.path.clear();
+            }
+            Phase::Work => g.start_work_line()?,
+            Phase::Turn => match g.previous_position() {
+                Some(prev) => g.start_turn(prev)?,
+                None => g.start_work_line()?,
+            },
+        }
+        Ok(g)
+    }
+
+    /// One control period (steps 2–4): update the indices for `pose`, switch paths at their
+    /// ends, rebuild the local path when `index_global` moved.
+    pub fn update(&mut self, pose: &Pose) -> Result<(), GuidanceError> {
+        if self.phase == Phase::Finished || self.path.len() < 2 {
+            return Ok(());
+        }
+        self.index_global = nearest_global(
+            &self.path,
+            &pose.pos,
+            self.index_global,
+            self.params.search_window,
+        );
+        if self.near_end(&pose.pos) {
+            match self.phase {
+                Phase::Turn => self.start_work_line()?,
+                Phase::Work => self.finish_line()?,
+                Phase::Finished => {}
+            }
+            if self.phase == Phase::Finished {
+                return Ok(());
+            }
+            self.index_global = nearest_global(&self.path, &pose.pos, 0, 4);
+        }
+        if self.local.built_for() != Some(self.index_global) {
+            self.local.rebuild(&self.path, self.index_global);
+        }
+        self.local.nearest(&pose.pos);
+        Ok(())
+    }
+
+    fn near_end(&self, p: &Vec2) -> bool {
+        let n = self.path.len();
+        if self.index_global + 2 < n {
+            return false;
+        }
+        let last = self.path[n - 1].pos;
+        let d = last - self.path[n - 2].pos;
+        let len = d.norm();
+        if len <= 0.0 {
+            return true;
+        }
+        (p - last).dot(&(d / len)) > -self.params.end_distance
+    }
+
+    fn finish_line(&mut self) -> Result<(), GuidanceError> {
+        let (block, rank) = (self.index_block, self.index_rank);
+        let line = self.plan.line_of(block, rank);
+        self.lines_done += 1;
+        self.events.push(Event::LineFinished {
+            block,
+            rank: rank as u64,
+            line,
+        });
+        match self.plan.next_position(block, rank) {
+            None => {
+                self.phase = Phase::Finished;
+                self.path.clear();
+                self.events.push(Event::JobFinished {
+                    lines_done: self.lines_done,
+                });
+            }
+            Some((next_block, next_rank)) => {
+                self.index_block = next_block;
+                self.index_rank = next_rank;
+                if next_block != block {
+                    self.events.push(Event::BlockChanged { block: next_block });
+                }
+                self.start_turn((block, rank))?;
+            }
+        }
+        Ok(())
+    }
+
+    fn start_turn(&mut self, from: (u64, usize)) -> Result<(), GuidanceError> {
+        let to = (self.index_block, self.index_rank);
+        self.path.clear();
+        self.plan.turn_points(from, to, &mut self.path)?;
+        self.phase = Phase::Turn;
+        self.index_global = 0;
+        self.events.push(Event::TurnStarted {
+            from_line: self.plan.line_of(from.0, from.1),
+            to_line: self.plan.line_of(to.0, to.1),
+        });
+        Ok(())
+    }
+
+    fn start_work_line(&mut self) -> Result<(), GuidanceError> {
+        self.path.clear();
+        self.plan
+            .work_line_points(self.index_block, self.index_rank, &mut self.path);
+        self.phase = Phase::Work;
+        self.index_global = 0;
+        self.events.push(Event::LineStarted {
+            block: self.index_block,
+            rank: self.index_rank as u64,
+            line: self.current_line(),
+        });
+        Ok(())
+    }
+
+    fn previous_position(&self) -> Option<(u64, usize)> {
+        if self.index_rank > 0 {
+            Some((self.index_block, self.index_rank - 1))
+        } else if self.index_block > 0 {
+            let b = self.index_block - 1;
+            Some((b, self.plan.block_len(b).checked_sub(1)?))
+        } else {
+            None
+        }
+    }
+
+    /// Events since the last call, oldest first.
+    pub fn drain_events(&mut self) -> std::vec::Drain<'_, Event> {
+        self.events.drain(..)
+    }
+
+    /// Did any event happen in the last update (a progress save point)?
+    pub fn has_events(&self) -> bool {
+        !self.events.is_empty()
+    }
+
+    /// A snapshot to persist.
+    pub fn progress(&self) -> Progress {
+        Progress {
+            version: PROGRESS_VERSION,
+            job: self.job.clone(),
+            index_block: self.index_block,
+            index_rank: self.index_rank as u64,
+            phase: self.phase,
+            lines_done: self.lines_done,
+        }
+    }
+
+    /// Signed cross-track error of `pose` from the current global path (positive = vehicle
+    /// left of the path), m, and heading error (vehicle − path), rad.
+    pub fn errors(&self, pose: &Pose) -> Option<(f64, f64)> {
+        let n = self.path.len();
+        if n < 2 {
+            return None;
+        }
+        let i = self.index_global.min(n - 2);
+        let a = self.path[i].pos;
+        let d = self.path[i + 1].pos - a;
+        let len = d.norm();
+        if len <= 0.0 {
+            return None;
+        }
+        let dir = d / len;
+        let xte = signed_offset(&pose.pos, &a, &dir);
+        Some((xte, wrap_angle(pose.heading - dir.y.atan2(dir.x))))
+    }
+
+    pub fn plan(&self) -> &AbPlan {
+        &self.plan
+    }
+    pub fn local_path(&self) -> &LocalPath {
+        &self.local
+    }
+    pub fn global_path(&self) -> &[PathPoint] {
+        &self.path
+    }
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+    pub fn is_finished(&self) -> bool {
+        self.phase == Phase::Finished
+    }
+    pub fn index_block(&self) -> u64 {
+        self.index_block
+    }
+    pub fn index_rank(&self) -> usize {
+        self.index_rank
+    }
+    pub fn index_global(&self) -> usize {
+        self.index_global
+    }
+    pub fn lines_done(&self) -> u64 {
+        self.lines_done
+    }
+    /// Absolute index of the line being driven (or turned into).
+    pub fn current_line(&self) -> u64 {
+        self.plan.line_of(self.index_block, self.index_rank)
+    }
+    /// Tag of the path being driven.
+    pub fn tag(&self) -> Tag {
+        match self.phase {
+            Phase::Turn => Tag::Turn,
+            _ => Tag::Work,
+        }
+    }
+}
