@@ -309,3 +309,89 @@ impl Guidance {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+    use crate::control::{ab_params, guidance_params};
+
+    /// Drive an ideal vehicle along whatever path the machine hands out and return the lines
+    /// in the order they were finished.
+    fn drive(cfg: &Config, resume: Option<&Progress>, stop_after: Option<usize>) -> (Vec<u64>, Progress) {
+        let plan = AbPlan::new(ab_params(cfg)).unwrap();
+        let job = JobDefinition::from_config(cfg);
+        let mut g = match resume {
+            Some(p) => Guidance::resume(plan, job, guidance_params(cfg), p).unwrap(),
+            None => Guidance::new(plan, job, guidance_params(cfg)).unwrap(),
+        };
+        let mut finished = Vec::new();
+        for _ in 0..2_000_000 {
+            if g.is_finished() || stop_after.is_some_and(|n| finished.len() >= n) {
+                break;
+            }
+            let path = g.global_path();
+            let i = (g.index_global() + 3).min(path.len() - 1);
+            let d = path[i].pos - path[i - 1].pos;
+            let pose = Pose::new(path[i].pos.x, path[i].pos.y, d.y.atan2(d.x));
+            g.update(&pose).unwrap();
+            for ev in g.drain_events() {
+                if let Event::LineFinished { line, .. } = ev {
+                    finished.push(line);
+                }
+            }
+        }
+        (finished, g.progress())
+    }
+
+    fn cfg_with_lines(n: u64) -> Config {
+        let mut cfg = Config::default();
+        cfg.job.line_num = n;
+        cfg.job.point_b_m = [0.0, 20.0];
+        cfg
+    }
+
+    #[test]
+    fn visits_every_line_exactly_once() {
+        let n_block = AbPlan::new(ab_params(&Config::default())).unwrap().block_size() as u64;
+        for count in [1, n_block - 1, n_block, n_block + 1, 2 * n_block + 3, 100] {
+            let cfg = cfg_with_lines(count);
+            let (mut lines, progress) = drive(&cfg, None, None);
+            assert_eq!(progress.phase, Phase::Finished, "{count} lines: not finished");
+            assert_eq!(lines.len() as u64, count, "{count} lines: {lines:?}");
+            lines.sort_unstable();
+            assert_eq!(lines, (0..count).collect::<Vec<_>>(), "{count} lines");
+        }
+    }
+
+    #[test]
+    fn resume_drives_no_line_twice() {
+        let cfg = cfg_with_lines(23);
+        let (full, _) = drive(&cfg, None, None);
+        for stop in [1usize, 5, 11, 22] {
+            let (first, saved) = drive(&cfg, None, Some(stop));
+            let (second, end) = drive(&cfg, Some(&saved), None);
+            assert_eq!(end.phase, Phase::Finished);
+            let mut all = first.clone();
+            all.extend(&second);
+            assert_eq!(all, full, "stop after {stop}");
+        }
+    }
+
+    #[test]
+    fn resume_refuses_another_job() {
+        let cfg = cfg_with_lines(10);
+        let (_, saved) = drive(&cfg, None, Some(3));
+        let mut other = cfg.clone();
+        other.job.line_width_m = 4.0;
+        let plan = AbPlan::new(ab_params(&other)).unwrap();
+        let err = Guidance::resume(
+            plan,
+            JobDefinition::from_config(&other),
+            guidance_params(&other),
+            &saved,
+        )
+        .err();
+        assert_eq!(err, Some(GuidanceError::DifferentJob));
+    }
+}
