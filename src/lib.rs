@@ -18,5 +18,6 @@ pub mod estimate;
 pub mod geo;
 pub mod guidance;
 pub mod plan;
+pub mod safety;
 pub mod sim;
 pub mod track;

@@ -1,0 +1,461 @@
+//! The safety supervisor: the only path from the tracker to the steering command.
+//!
+//! In the manner of openpilot's panda safety, it is a small state machine that knows nothing
+//! of planning. It watches input freshness and quality, counts bad frames, gates engagement on
+//! the operator and on the vehicle being close to the line, and limits every engaged command
+//! (angle, rate, lateral acceleration). Everything is a pure function of the inputs and the
+//! times the caller passes in: no clocks, no I/O, no allocation.
+//!
+//! States: `Disengaged` → `Ready` (all inputs fresh and good) → `Engaged` (on an operator
+//! engage) → `Fault(code)` (an engaged condition broke) → `Disengaged` once the condition has
+//! cleared. Engaging needs an operator engage received while `Ready`; nothing re-engages by
+//! itself.
+
+use serde::Serialize;
+
+/// Why the supervisor will not steer. The numeric value goes on the bus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+#[repr(u8)]
+pub enum FaultCode {
+    None = 0,
+    GnssTimeout = 1,
+    FixQuality = 2,
+    WheelAngleTimeout = 3,
+    WheelAngleInvalid = 4,
+    SpeedOutOfRange = 5,
+    OperatorOverride = 6,
+    XteTooLarge = 7,
+    HeadingErrorTooLarge = 8,
+    NoGuidance = 9,
+    BusDown = 10,
+    OperatorInvalid = 11,
+    ActuatorFault = 12,
+    /// The rate limit cannot bring the angle within the lateral-acceleration limit (the speed
+    /// rose too fast): steering is given back rather than break either limit.
+    LateralAccelLimit = 13,
+}
+
+/// Supervisor state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SafetyState {
+    Disengaged,
+    Ready,
+    Engaged,
+    Fault(FaultCode),
+}
+
+impl SafetyState {
+    /// The state's number on the bus (guidance status frame).
+    pub fn code(&self) -> u8 {
+        match self {
+            SafetyState::Disengaged => 0,
+            SafetyState::Ready => 1,
+            SafetyState::Engaged => 2,
+            SafetyState::Fault(_) => 3,
+        }
+    }
+}
+
+/// GNSS solution quality as the supervisor sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FixQuality {
+    RtkFixed,
+    RtkFloat,
+    Other,
+    None,
+}
+
+/// Inputs whose frames carry a counter and a CRC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(usize)]
+pub enum CheckedInput {
+    WheelAngle = 0,
+    Operator = 1,
+    Gnss = 2,
+    Imu = 3,
+}
+const CHECKED_INPUTS: usize = 4;
+
+/// Tuning of the supervisor, SI units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SafetyParams {
+    /// GNSS older than this is stale, s (default 0.3).
+    pub gnss_timeout: f64,
+    /// RTK float is tolerated this long, s (default 0: never).
+    pub rtk_float_tolerance: f64,
+    /// Wheel angle older than this is stale, s (default 0.1).
+    pub wheel_angle_timeout: f64,
+    /// Validity score at which an input counts as invalid (+1 per bad frame, −1 per good one).
+    pub invalid_threshold: u32,
+    /// Allowed speed range, m/s (defaults 0.5–25 km/h).
+    pub min_speed: f64,
+    pub max_speed: f64,
+    /// Measured angle this far from the command counts toward an override, rad.
+    pub override_angle: f64,
+    /// … for longer than this, s.
+    pub override_time: f64,
+    /// Engaging needs |XTE| below this, m (default 1).
+    pub max_engage_xte: f64,
+    /// Engaging needs |heading error| below this, rad (default 60°).
+    pub max_engage_heading_error: f64,
+    /// Command limits: angle, rad; rate, rad/s; lateral acceleration v²·κ, m/s².
+    pub max_wheel_angle: f64,
+    pub max_wheel_rate: f64,
+    pub a_lat_max: f64,
+    /// Wheelbase, m (curvature ↔ angle).
+    pub wheelbase: f64,
+}
+
+impl Default for SafetyParams {
+    fn default() -> Self {
+        SafetyParams {
+            gnss_timeout: 0.3,
+            rtk_float_tolerance: 0.0,
+            wheel_angle_timeout: 0.1,
+            invalid_threshold: 5,
+            min_speed: 0.5 / 3.6,
+            max_speed: 25.0 / 3.6,
+            override_angle: 8f64.to_radians(),
+            override_time: 0.5,
+            max_engage_xte: 1.0,
+            max_engage_heading_error: 60f64.to_radians(),
+            max_wheel_angle: 35f64.to_radians(),
+            max_wheel_rate: 30f64.to_radians(),
+            a_lat_max: 2.0,
+            wheelbase: 3.0,
+        }
+    }
+}
+
+/// What goes to the steering frame this period.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SteeringCommand {
+    /// Engaged (steer to `wheel_angle`) or not (the actuator must not steer).
+    pub engaged: bool,
+    /// Front-wheel angle, rad: the limited demand when engaged, the measured angle otherwise.
+    pub wheel_angle: f64,
+    /// Curvature of `wheel_angle`, 1/m.
+    pub curvature: f64,
+    pub state: SafetyState,
+    /// Why not engaged (or `None`).
+    pub fault: FaultCode,
+}
+
+/// The supervisor.
+#[derive(Debug, Clone)]
+pub struct Supervisor {
+    params: SafetyParams,
+    state: SafetyState,
+    gnss_t: Option<f64>,
+    fix: FixQuality,
+    float_since: Option<f64>,
+    wheel_t: Option<f64>,
+    wheel_angle: f64,
+    override_bit: bool,
+    actuator_fault: bool,
+    speed_t: Option<f64>,
+    speed: f64,
+    scores: [u32; CHECKED_INPUTS],
+    diverged_since: Option<f64>,
+    last_command: f64,
+    last_t: Option<f64>,
+    engage_requested: bool,
+    bus_down: bool,
+    last_refusal: FaultCode,
+}
+
+impl Supervisor {
+    pub fn new(params: SafetyParams) -> Self {
+        Supervisor {
+            params,
+            state: SafetyState::Disengaged,
+            gnss_t: None,
+            fix: FixQuality::None,
+            float_since: None,
+            wheel_t: None,
+            wheel_angle: 0.0,
+            override_bit: false,
+            actuator_fault: false,
+            speed_t: None,
+            speed: 0.0,
+            scores: [0; CHECKED_INPUTS],
+            diverged_since: None,
+            last_command: 0.0,
+            last_t: None,
+            engage_requested: false,
+            bus_down: false,
+            last_refusal: FaultCode::None,
+        }
+    }
+
+    pub fn params(&self) -> &SafetyParams {
+        &self.params
+    }
+
+    /// Replace the tuning (limits, timeouts) atomically, keeping the state.
+    pub fn set_params(&mut self, params: SafetyParams) {
+        self.params = params;
+    }
+
+    pub fn state(&self) -> SafetyState {
+        self.state
+    }
+
+    /// The reason the last engage request was refused.
+    pub fn last_refusal(&self) -> FaultCode {
+        self.last_refusal
+    }
+
+    /// A GNSS solution arrived at `t` (s).
+    pub fn on_gnss(&mut self, t: f64, quality: FixQuality) {
+        if !t.is_finite() {
+            return;
+        }
+        self.gnss_t = Some(t);
+        if quality == FixQuality::RtkFloat {
+            if self.fix != FixQuality::RtkFloat || self.float_since.is_none() {
+                self.float_since = Some(t);
+            }
+        } else {
+            self.float_since = None;
+        }
+        self.fix = quality;
+    }
+
+    /// A valid wheel-angle frame arrived at `t`: measured angle (rad), the operator-override
+    /// and fault bits of its status byte.
+    pub fn on_wheel_angle(&mut self, t: f64, angle: f64, override_bit: bool, fault_bit: bool) {
+        if !t.is_finite() || !angle.is_finite() {
+            return;
+        }
+        self.wheel_t = Some(t);
+        self.wheel_angle = angle;
+        self.override_bit = override_bit;
+        self.actuator_fault = fault_bit;
+    }
+
+    /// Vehicle speed (m/s, signed) measured at `t`.
+    pub fn on_speed(&mut self, t: f64, speed: f64) {
+        if t.is_finite() && speed.is_finite() {
+            self.speed_t = Some(t);
+            self.speed = speed;
+        }
+    }
+
+    /// The counter/CRC check of one frame of a checked input (opendbc's scheme).
+    pub fn on_frame_check(&mut self, input: CheckedInput, ok: bool) {
+        let s = &mut self.scores[input as usize];
+        if ok {
+            *s = s.saturating_sub(1);
+        } else {
+            *s = (*s + 1).min(self.params.invalid_threshold * 2);
+        }
+    }
+
+    /// The bus went down or came back.
+    pub fn on_bus(&mut self, up: bool) {
+        self.bus_down = !up;
+    }
+
+    /// The operator asked to engage. Acted on in the next [`Supervisor::step`].
+    pub fn request_engage(&mut self) {
+        self.engage_requested = true;
+    }
+
+    /// The operator asked to disengage (also pause): immediate.
+    pub fn request_disengage(&mut self) {
+        self.engage_requested = false;
+        if self.state == SafetyState::Engaged {
+            self.state = SafetyState::Disengaged;
+        }
+    }
+
+    /// Is `input` currently counted as invalid?
+    pub fn input_invalid(&self, input: CheckedInput) -> bool {
+        self.scores[input as usize] >= self.params.invalid_threshold
+    }
+
+    /// The first condition that forbids steering at `t`, or `FaultCode::None`.
+    fn input_fault(&self, t: f64) -> FaultCode {
+        let p = &self.params;
+        let fresh = |last: Option<f64>, timeout: f64| last.is_some_and(|l| t - l <= timeout && t >= l - 1.0);
+        if self.bus_down {
+            return FaultCode::BusDown;
+        }
+        if !fresh(self.gnss_t, p.gnss_timeout) {
+            return FaultCode::GnssTimeout;
+        }
+        match self.fix {
+            FixQuality::RtkFixed => {}
+            FixQuality::RtkFloat => {
+                let since = self.float_since.unwrap_or(t);
+                if p.rtk_float_tolerance <= 0.0 || t - since > p.rtk_float_tolerance {
+                    return FaultCode::FixQuality;
+                }
+            }
+            _ => return FaultCode::FixQuality,
+        }
+        if self.input_invalid(CheckedInput::Gnss) {
+            return FaultCode::FixQuality;
+        }
+        if !fresh(self.wheel_t, p.wheel_angle_timeout) {
+            return FaultCode::WheelAngleTimeout;
+        }
+        if self.input_invalid(CheckedInput::WheelAngle) {
+            return FaultCode::WheelAngleInvalid;
+        }
+        if self.input_invalid(CheckedInput::Operator) {
+            return FaultCode::OperatorInvalid;
+        }
+        if self.actuator_fault {
+            return FaultCode::ActuatorFault;
+        }
+        if self.override_bit {
+            return FaultCode::OperatorOverride;
+        }
+        let speed_ok = fresh(self.speed_t, p.gnss_timeout.max(p.wheel_angle_timeout))
+            && self.speed.abs() >= p.min_speed
+            && self.speed.abs() <= p.max_speed;
+        if !speed_ok {
+            return FaultCode::SpeedOutOfRange;
+        }
+        FaultCode::None
+    }
+
+    /// One control period at `t` (s). `demand` is the tracker's wheel angle (rad), with the
+    /// cross-track and heading errors it was computed from; `None` when guidance has nothing to
+    /// steer by. Returns the command to send.
+    pub fn step(
+        &mut self,
+        t: f64,
+        demand: Option<f64>,
+        xte: Option<f64>,
+        heading_error: Option<f64>,
+    ) -> SteeringCommand {
+        let dt = match self.last_t {
+            Some(l) if t.is_finite() && t > l => (t - l).min(1.0),
+            _ => 0.0,
+        };
+        if t.is_finite() {
+            self.last_t = Some(t);
+        }
+        let t = if t.is_finite() { t } else { f64::NEG_INFINITY };
+        let mut fault = self.input_fault(t);
+        let demand = demand.filter(|d| d.is_finite());
+        if fault == FaultCode::None && demand.is_none() {
+            fault = FaultCode::NoGuidance;
+        }
+        // Operator override by divergence: measured far from the command for too long.
+        if self.state == SafetyState::Engaged && fault == FaultCode::None {
+            if (self.wheel_angle - self.last_command).abs() > self.params.override_angle {
+                let since = *self.diverged_since.get_or_insert(t);
+                if t - since > self.params.override_time {
+                    fault = FaultCode::OperatorOverride;
+                }
+            } else {
+                self.diverged_since = None;
+            }
+        } else {
+            self.diverged_since = None;
+        }
+
+        match self.state {
+            SafetyState::Engaged if fault != FaultCode::None => {
+                self.state = SafetyState::Fault(fault);
+            }
+            SafetyState::Fault(_) if fault == FaultCode::None => {
+                self.state = SafetyState::Ready;
+            }
+            SafetyState::Fault(_) => self.state = SafetyState::Fault(fault),
+            SafetyState::Disengaged | SafetyState::Ready => {
+                self.state = if fault == FaultCode::None {
+                    SafetyState::Ready
+                } else {
+                    SafetyState::Disengaged
+                };
+            }
+            SafetyState::Engaged => {}
+        }
+
+        if std::mem::take(&mut self.engage_requested) {
+            let p = &self.params;
+            let refusal = if self.state != SafetyState::Ready {
+                if fault == FaultCode::None {
+                    FaultCode::None
+                } else {
+                    fault
+                }
+            } else if !xte.is_some_and(|x| x.abs() < p.max_engage_xte) {
+                FaultCode::XteTooLarge
+            } else if !heading_error.is_some_and(|h| h.abs() < p.max_engage_heading_error) {
+                FaultCode::HeadingErrorTooLarge
+            } else {
+                FaultCode::None
+            };
+            if self.state == SafetyState::Ready && refusal == FaultCode::None {
+                self.state = SafetyState::Engaged;
+                // The rate limit starts from where the wheels are.
+                self.last_command = self.wheel_angle;
+                self.diverged_since = None;
+            }
+            self.last_refusal = refusal;
+        }
+
+        if self.state == SafetyState::Engaged {
+            match self.limit(demand.unwrap_or(self.wheel_angle), dt) {
+                Some(limited) => {
+                    self.last_command = limited;
+                    return SteeringCommand {
+                        engaged: true,
+                        wheel_angle: limited,
+                        curvature: limited.tan() / self.params.wheelbase,
+                        state: self.state,
+                        fault: FaultCode::None,
+                    };
+                }
+                None => self.state = SafetyState::Fault(FaultCode::LateralAccelLimit),
+            }
+        }
+        let measured = self.wheel_angle;
+        self.last_command = measured;
+        SteeringCommand {
+            engaged: false,
+            wheel_angle: measured,
+            curvature: measured.tan() / self.params.wheelbase,
+            state: self.state,
+            fault: match self.state {
+                SafetyState::Fault(c) => c,
+                _ => fault,
+            },
+        }
+    }
+
+    /// The largest wheel angle allowed at the current speed (angle and lateral acceleration).
+    pub fn angle_limit(&self) -> f64 {
+        let p = &self.params;
+        let v2 = self.speed * self.speed;
+        let by_alat = if v2 > 1e-9 {
+            (p.a_lat_max * p.wheelbase / v2).atan()
+        } else {
+            p.max_wheel_angle
+        };
+        p.max_wheel_angle.min(by_alat)
+    }
+
+    /// The next engaged command: toward `demand` by at most the rate allowance, within the
+    /// angle and lateral-acceleration limits. `None` when both cannot hold at once.
+    fn limit(&self, demand: f64, dt: f64) -> Option<f64> {
+        let lim = self.angle_limit();
+        let target = demand.clamp(-lim, lim);
+        let step = self.params.max_wheel_rate * dt;
+        let prev = self.last_command;
+        let next = prev + (target - prev).clamp(-step, step);
+        (next.abs() <= lim + 1e-12).then_some(next)
+    }
+}
+
+#[cfg(test)]
+mod tests;

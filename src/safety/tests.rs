@@ -1,0 +1,187 @@
+use super::*;
+
+const DT: f64 = 0.02;
+
+/// A supervisor fed good inputs up to `t`.
+fn feed_good(s: &mut Supervisor, t: f64) {
+    s.on_gnss(t, FixQuality::RtkFixed);
+    s.on_wheel_angle(t, 0.0, false, false);
+    s.on_speed(t, 10.0 / 3.6);
+}
+
+fn engaged_supervisor() -> (Supervisor, f64) {
+    let mut s = Supervisor::new(SafetyParams::default());
+    let mut t = 0.0;
+    feed_good(&mut s, t);
+    assert_eq!(s.step(t, Some(0.0), Some(0.1), Some(0.0)).state, SafetyState::Ready);
+    s.request_engage();
+    t += DT;
+    feed_good(&mut s, t);
+    let c = s.step(t, Some(0.0), Some(0.1), Some(0.0));
+    assert!(c.engaged, "{c:?}");
+    (s, t)
+}
+
+#[test]
+fn engages_only_on_operator_request_when_ready() {
+    let mut s = Supervisor::new(SafetyParams::default());
+    // Nothing received yet: not ready, an engage is refused.
+    s.request_engage();
+    let c = s.step(0.0, Some(0.0), Some(0.0), Some(0.0));
+    assert!(!c.engaged);
+    assert_eq!(s.last_refusal(), FaultCode::GnssTimeout);
+    feed_good(&mut s, 0.1);
+    let c = s.step(0.1, Some(0.0), Some(0.0), Some(0.0));
+    assert_eq!(c.state, SafetyState::Ready);
+    assert!(!c.engaged, "ready is not engaged");
+}
+
+#[test]
+fn refuses_far_from_the_line() {
+    let mut s = Supervisor::new(SafetyParams::default());
+    feed_good(&mut s, 0.0);
+    s.request_engage();
+    assert!(!s.step(0.0, Some(0.0), Some(1.5), Some(0.0)).engaged);
+    assert_eq!(s.last_refusal(), FaultCode::XteTooLarge);
+    s.request_engage();
+    assert!(!s.step(0.02, Some(0.0), Some(0.1), Some(1.2)).engaged);
+    assert_eq!(s.last_refusal(), FaultCode::HeadingErrorTooLarge);
+}
+
+#[test]
+fn gnss_timeout_disengages_within_one_period_and_never_reengages() {
+    let (mut s, mut t) = engaged_supervisor();
+    let last_gnss = t;
+    let mut disengaged_at = None;
+    while t < last_gnss + 2.0 {
+        t += DT;
+        s.on_wheel_angle(t, 0.0, false, false);
+        s.on_speed(t, 2.0);
+        let c = s.step(t, Some(0.0), Some(0.0), Some(0.0));
+        if !c.engaged && disengaged_at.is_none() {
+            disengaged_at = Some(t);
+            assert_eq!(c.fault, FaultCode::GnssTimeout);
+        }
+    }
+    let at = disengaged_at.expect("disengaged");
+    assert!(at - last_gnss <= 0.3 + DT + 1e-9, "{}", at - last_gnss);
+    // GNSS returns: Ready, but not engaged without a fresh engage.
+    for _ in 0..50 {
+        t += DT;
+        feed_good(&mut s, t);
+        let c = s.step(t, Some(0.0), Some(0.0), Some(0.0));
+        assert!(!c.engaged);
+    }
+    assert_eq!(s.state(), SafetyState::Ready);
+}
+
+#[test]
+fn bad_frame_score_is_opendbc_style() {
+    let (mut s, t) = engaged_supervisor();
+    for _ in 0..4 {
+        s.on_frame_check(CheckedInput::WheelAngle, false);
+    }
+    assert!(!s.input_invalid(CheckedInput::WheelAngle));
+    assert!(s.step(t + DT, Some(0.0), Some(0.0), Some(0.0)).engaged);
+    s.on_frame_check(CheckedInput::WheelAngle, false);
+    assert!(s.input_invalid(CheckedInput::WheelAngle));
+    let c = s.step(t + 2.0 * DT, Some(0.0), Some(0.0), Some(0.0));
+    assert!(!c.engaged);
+    assert_eq!(c.fault, FaultCode::WheelAngleInvalid);
+    s.on_frame_check(CheckedInput::WheelAngle, true);
+    assert!(!s.input_invalid(CheckedInput::WheelAngle), "−1 per good frame");
+}
+
+#[test]
+fn rate_limit_starts_from_measured_angle() {
+    let mut s = Supervisor::new(SafetyParams::default());
+    s.on_gnss(0.0, FixQuality::RtkFixed);
+    s.on_speed(0.0, 2.0);
+    s.on_wheel_angle(0.0, 0.1, false, false);
+    s.step(0.0, Some(0.0), Some(0.0), Some(0.0));
+    s.request_engage();
+    let c = s.step(DT, Some(-0.5), Some(0.0), Some(0.0));
+    assert!(c.engaged);
+    let max_step = 30f64.to_radians() * DT;
+    assert!((c.wheel_angle - (0.1 - max_step)).abs() < 1e-12, "{}", c.wheel_angle);
+}
+
+#[test]
+fn lateral_acceleration_limits_the_angle() {
+    let p = SafetyParams::default();
+    let mut s = Supervisor::new(p.clone());
+    let v = 20.0 / 3.6;
+    let mut t = 0.0;
+    s.on_gnss(t, FixQuality::RtkFixed);
+    s.on_wheel_angle(t, 0.0, false, false);
+    s.on_speed(t, v);
+    s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    s.request_engage();
+    let mut last = 0.0;
+    for _ in 0..200 {
+        t += DT;
+        s.on_gnss(t, FixQuality::RtkFixed);
+        s.on_wheel_angle(t, last, false, false);
+        s.on_speed(t, v);
+        let c = s.step(t, Some(0.6), Some(0.0), Some(0.0));
+        assert!(c.engaged);
+        assert!(v * v * c.curvature.abs() <= p.a_lat_max + 1e-9);
+        last = c.wheel_angle;
+    }
+    assert!(last > 0.1, "still steers up to the limit: {last}");
+}
+
+#[test]
+fn override_bit_and_divergence_disengage() {
+    let (mut s, t) = engaged_supervisor();
+    s.on_wheel_angle(t + DT, 0.0, true, false);
+    s.on_gnss(t + DT, FixQuality::RtkFixed);
+    s.on_speed(t + DT, 2.0);
+    let c = s.step(t + DT, Some(0.0), Some(0.0), Some(0.0));
+    assert_eq!(c.fault, FaultCode::OperatorOverride);
+
+    let (mut s, mut t) = engaged_supervisor();
+    let mut fault_at = None;
+    for _ in 0..100 {
+        t += DT;
+        s.on_gnss(t, FixQuality::RtkFixed);
+        s.on_speed(t, 2.0);
+        // The driver holds the wheels hard left while the command is straight.
+        s.on_wheel_angle(t, 0.4, false, false);
+        let c = s.step(t, Some(0.0), Some(0.0), Some(0.0));
+        if !c.engaged {
+            fault_at.get_or_insert((t, c.fault));
+        }
+    }
+    let (_, code) = fault_at.expect("override detected");
+    assert_eq!(code, FaultCode::OperatorOverride);
+}
+
+#[test]
+fn rtk_float_tolerance() {
+    let p = SafetyParams {
+        rtk_float_tolerance: 1.0,
+        ..SafetyParams::default()
+    };
+    let mut s = Supervisor::new(p);
+    let mut t = 0.0;
+    feed_good(&mut s, t);
+    s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    s.request_engage();
+    t += DT;
+    feed_good(&mut s, t);
+    assert!(s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
+    let float_start = t + DT;
+    let mut out_at = None;
+    while t < float_start + 3.0 {
+        t += DT;
+        s.on_gnss(t, FixQuality::RtkFloat);
+        s.on_wheel_angle(t, 0.0, false, false);
+        s.on_speed(t, 2.0);
+        if !s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged {
+            out_at.get_or_insert(t);
+        }
+    }
+    let dur = out_at.expect("float disengages after the tolerance") - float_start;
+    assert!(dur > 1.0 - 1e-9 && dur <= 1.0 + 2.0 * DT, "{dur}");
+}
