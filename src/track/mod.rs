@@ -1,1 +1,205 @@
-//! Local path and trackers. (in progress)
+//! Tracking: the local path and the steering laws that follow it.
+//!
+//! [`pure_pursuit`] is the seed-000 law. Which pose it is fed makes the difference between the
+//! plain reference (the latest fix) and the default predictive tracker (a latency-compensated,
+//! dead-reckoned pose from [`crate::estimate`]).
+
+pub mod local_path;
+
+use crate::geo::{cross, heading_vec, Pose, Vec2};
+use local_path::LocalPath;
+
+/// Tracker parameters, SI units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackerParams {
+    /// Wheelbase L, m.
+    pub wheelbase: f64,
+    /// Minimum look-ahead distance, m.
+    pub ld_min: f64,
+    /// Look-ahead growth with speed, s: Ld = max(ld_min, ld_gain·|v|).
+    pub ld_gain: f64,
+    /// Largest front-wheel angle, rad.
+    pub max_wheel_angle: f64,
+}
+
+/// The tracker's result for one period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackOutput {
+    /// Front-wheel angle, rad (positive left), within ±max_wheel_angle. 0 when the inputs were
+    /// not finite (then `valid` is false).
+    pub wheel_angle: f64,
+    /// Path curvature demanded, 1/m.
+    pub curvature: f64,
+    /// Look-ahead distance used, m.
+    pub lookahead: f64,
+    /// The preview point.
+    pub target: Vec2,
+    /// Angle from the heading to the preview point, rad.
+    pub alpha: f64,
+    pub valid: bool,
+}
+
+/// The look-ahead distance at speed `v`, m.
+#[inline]
+pub fn lookahead(params: &TrackerParams, speed: f64) -> f64 {
+    params.ld_min.max(params.ld_gain * speed.abs())
+}
+
+/// The point `distance` along the local path from sample `start` (extrapolated along the
+/// last segment when the path is shorter).
+pub fn point_along(points: &[Vec2], start: usize, distance: f64) -> Vec2 {
+    let mut left = distance;
+    let mut i = start.min(points.len().saturating_sub(1));
+    while i + 1 < points.len() {
+        let seg = (points[i + 1] - points[i]).norm();
+        if seg >= left && seg > 0.0 {
+            return points[i] + (points[i + 1] - points[i]) * (left / seg);
+        }
+        left -= seg;
+        i += 1;
+    }
+    let n = points.len();
+    if n >= 2 {
+        let d = points[n - 1] - points[n - 2];
+        let len = d.norm();
+        if len > 0.0 {
+            return points[n - 1] + d * (left / len);
+        }
+    }
+    points.last().copied().unwrap_or_else(Vec2::zeros)
+}
+
+/// Seed-000 pure pursuit: from the nearest local point integrate the look-ahead along the
+/// local path to the preview point; α is the angle from the heading to it;
+/// κ = 2·sin α / Ld and δ = atan(L·κ).
+pub fn pure_pursuit(
+    local: &LocalPath,
+    pose: &Pose,
+    speed: f64,
+    params: &TrackerParams,
+) -> TrackOutput {
+    let ld = lookahead(params, speed);
+    let points = local.points();
+    let invalid = TrackOutput {
+        wheel_angle: 0.0,
+        curvature: 0.0,
+        lookahead: ld,
+        target: pose.pos,
+        alpha: 0.0,
+        valid: false,
+    };
+    if points.is_empty()
+        || !pose.pos.x.is_finite()
+        || !pose.pos.y.is_finite()
+        || !pose.heading.is_finite()
+        || !ld.is_finite()
+        || ld <= 0.0
+    {
+        return invalid;
+    }
+    let target = point_along(points, local.index_local(), ld);
+    let to = target - pose.pos;
+    let h = heading_vec(pose.heading);
+    let alpha = cross(&h, &to).atan2(h.dot(&to));
+    let curvature = 2.0 * alpha.sin() / ld;
+    let max = params.max_wheel_angle;
+    let wheel_angle = (params.wheelbase * curvature).atan().clamp(-max, max);
+    TrackOutput {
+        wheel_angle,
+        curvature,
+        lookahead: ld,
+        target,
+        alpha,
+        valid: true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::local_path::LocalPathParams;
+    use super::*;
+    use crate::geo::{v2, PathPoint};
+
+    fn params() -> TrackerParams {
+        TrackerParams {
+            wheelbase: 3.0,
+            ld_min: 3.0,
+            ld_gain: 1.0,
+            max_wheel_angle: 35f64.to_radians(),
+        }
+    }
+
+    fn straight_local(at: &Vec2) -> LocalPath {
+        let g: Vec<PathPoint> = (0..50).map(|i| PathPoint::work(v2(i as f64, 0.0))).collect();
+        let mut lp = LocalPath::new(&LocalPathParams {
+            nodes_before: 1,
+            nodes_after: 8,
+            ..Default::default()
+        });
+        lp.rebuild(&g, at.x.round() as usize);
+        lp.nearest(at);
+        lp
+    }
+
+    #[test]
+    fn steers_back_toward_a_straight_line() {
+        let left = Pose::new(10.0, 0.5, 0.0);
+        let out = pure_pursuit(&straight_local(&left.pos), &left, 2.0, &params());
+        assert!(out.valid && out.wheel_angle < 0.0, "left of line steers right: {out:?}");
+        let right = Pose::new(10.0, -0.5, 0.0);
+        let out = pure_pursuit(&straight_local(&right.pos), &right, 2.0, &params());
+        assert!(out.wheel_angle > 0.0, "right of line steers left");
+        let on = Pose::new(10.0, 0.0, 0.0);
+        let out = pure_pursuit(&straight_local(&on.pos), &on, 2.0, &params());
+        assert!(out.wheel_angle.abs() < 1e-9);
+    }
+
+    #[test]
+    fn curvature_on_a_circle_matches_its_radius() {
+        let r = 20.0;
+        let g: Vec<PathPoint> = (0..60)
+            .map(|i| {
+                let a = i as f64 * 0.05;
+                PathPoint::turn(v2(r * a.sin(), r - r * a.cos()))
+            })
+            .collect();
+        let mut lp = LocalPath::new(&LocalPathParams {
+            nodes_before: 1,
+            nodes_after: 10,
+            ..Default::default()
+        });
+        lp.rebuild(&g, 10);
+        let a = 0.5f64;
+        let pose = Pose::new(r * a.sin(), r - r * a.cos(), a);
+        lp.nearest(&pose.pos);
+        let out = pure_pursuit(&lp, &pose, 2.0, &params());
+        assert!((out.curvature - 1.0 / r).abs() < 0.03 / r, "κ {} vs {}", out.curvature, 1.0 / r);
+    }
+
+    #[test]
+    fn lookahead_grows_with_speed() {
+        assert_eq!(lookahead(&params(), 1.0), 3.0);
+        assert_eq!(lookahead(&params(), 5.0), 5.0);
+        assert_eq!(lookahead(&params(), -5.0), 5.0);
+    }
+
+    #[test]
+    fn nan_inputs_give_an_invalid_zero_command() {
+        let p = Pose {
+            pos: v2(f64::NAN, 0.0),
+            heading: 0.0,
+        };
+        let out = pure_pursuit(&straight_local(&v2(1.0, 0.0)), &p, 2.0, &params());
+        assert!(!out.valid);
+        assert_eq!(out.wheel_angle, 0.0);
+        let empty = LocalPath::new(&LocalPathParams::default());
+        assert!(!pure_pursuit(&empty, &Pose::new(0.0, 0.0, 0.0), 1.0, &params()).valid);
+    }
+
+    #[test]
+    fn wheel_angle_is_clamped() {
+        let p = Pose::new(10.0, 0.0, std::f64::consts::PI * 0.9);
+        let out = pure_pursuit(&straight_local(&p.pos), &p, 1.0, &params());
+        assert!(out.wheel_angle.abs() <= 35f64.to_radians() + 1e-12);
+    }
+}
