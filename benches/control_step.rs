@@ -26,8 +26,18 @@ impl Rig {
         let cfg = Config::parse_with("", &[format!("track.kind={kind}"), "job.line_num=0".into()])
             .expect("config");
         let ctrl = Controller::from_config(&cfg, None).expect("controller");
-        let sim = Simulator::new(sim_params(&cfg), Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2), cfg.speed());
-        Rig { ctrl, sim, outs: Vec::with_capacity(64), k: 0, dt: cfg.dt() }
+        let sim = Simulator::new(
+            sim_params(&cfg),
+            Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+            cfg.speed(),
+        );
+        Rig {
+            ctrl,
+            sim,
+            outs: Vec::with_capacity(64),
+            k: 0,
+            dt: cfg.dt(),
+        }
     }
 
     /// Feed the sensors for the next period (not timed).
@@ -72,7 +82,9 @@ fn percentiles(kind: &str) {
         samples.push(start.elapsed().as_nanos() as u64);
     }
     samples.sort_unstable();
-    let q = |p: f64| samples[((samples.len() as f64 * p) as usize).min(samples.len() - 1)] as f64 / 1000.0;
+    let q = |p: f64| {
+        samples[((samples.len() as f64 * p) as usize).min(samples.len() - 1)] as f64 / 1000.0
+    };
     println!(
         "control_step/{kind}: median {:.2} µs, p99 {:.2} µs, max {:.1} µs over {} steps",
         q(0.5),

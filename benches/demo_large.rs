@@ -65,8 +65,8 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("whole_job_100x300m", |b| {
         b.iter(|| {
-            let r = run(&cfg, &DemoOptions::default(), &mut |_| {}, &mut |_, _| {})
-                .expect("demo runs");
+            let r =
+                run(&cfg, &DemoOptions::default(), &mut |_| {}, &mut |_, _| {}).expect("demo runs");
             assert!(r.report.finished);
             r.report.sim_time_s
         })

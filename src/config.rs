@@ -324,7 +324,9 @@ pub fn apply_overrides(root: &mut toml::Table, overrides: &[String]) -> Result<(
         }
         let raw = raw.trim();
         let value = match format!("v = {raw}").parse::<toml::Table>() {
-            Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(raw.to_string())),
+            Ok(mut t) => t
+                .remove("v")
+                .unwrap_or(toml::Value::String(raw.to_string())),
             Err(_) => toml::Value::String(raw.to_string()),
         };
         let parts: Vec<&str> = key.split('.').map(str::trim).collect();
@@ -396,7 +398,12 @@ impl Config {
         }
         c.range("guidance.point_spacing_m", g.point_spacing_m, 0.05, 10.0);
         c.range("guidance.turn_arc_step_deg", g.turn_arc_step_deg, 0.1, 10.0);
-        c.range("guidance.turn_merge_distance_m", g.turn_merge_distance_m, 0.0, 5.0);
+        c.range(
+            "guidance.turn_merge_distance_m",
+            g.turn_merge_distance_m,
+            0.0,
+            5.0,
+        );
         if g.turn_max_points < 2 {
             c.push(
                 "guidance.turn_max_points",
@@ -409,12 +416,21 @@ impl Config {
         let v = &self.vehicle;
         c.range("vehicle.wheelbase_m", v.wheelbase_m, 0.5, 20.0);
         c.range("vehicle.r_min_m", v.r_min_m, 0.5, 100.0);
-        c.range("vehicle.max_wheel_angle_deg", v.max_wheel_angle_deg, 1.0, 80.0);
-        c.range("vehicle.antenna_forward_m", v.antenna_forward_m, -20.0, 20.0);
+        c.range(
+            "vehicle.max_wheel_angle_deg",
+            v.max_wheel_angle_deg,
+            1.0,
+            80.0,
+        );
+        c.range(
+            "vehicle.antenna_forward_m",
+            v.antenna_forward_m,
+            -20.0,
+            20.0,
+        );
         c.range("vehicle.antenna_left_m", v.antenna_left_m, -10.0, 10.0);
         c.range("vehicle.antenna_up_m", v.antenna_up_m, 0.0, 10.0);
-        if v.wheelbase_m.is_finite() && v.max_wheel_angle_deg.is_finite() && v.r_min_m.is_finite()
-        {
+        if v.wheelbase_m.is_finite() && v.max_wheel_angle_deg.is_finite() && v.r_min_m.is_finite() {
             let r_steer = v.wheelbase_m / v.max_wheel_angle_deg.to_radians().tan();
             if v.r_min_m + 1e-9 < r_steer {
                 c.push(
@@ -506,12 +522,20 @@ impl Checker {
     }
     fn range(&mut self, key: &str, v: f64, lo: f64, hi: f64) {
         if !(v.is_finite() && v >= lo && v <= hi) {
-            self.push(key, fmt_num(v), &format!("must be in {}..={}", fmt_num(lo), fmt_num(hi)));
+            self.push(
+                key,
+                fmt_num(v),
+                &format!("must be in {}..={}", fmt_num(lo), fmt_num(hi)),
+            );
         }
     }
     fn finite2(&mut self, key: &str, v: [f64; 2]) {
         if !(v[0].is_finite() && v[1].is_finite()) {
-            self.push(key, format!("{v:?}"), "must be two finite numbers [east, north]");
+            self.push(
+                key,
+                format!("{v:?}"),
+                "must be two finite numbers [east, north]",
+            );
         }
     }
 }
@@ -581,7 +605,9 @@ mod tests {
     fn nan_is_a_problem_not_a_panic() {
         let cfg = Config::parse_with("[control]\nspeed_kmh = nan\n", &[]).unwrap();
         let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
-        assert!(msgs.iter().any(|m| m.starts_with("control.speed_kmh = NaN")));
+        assert!(msgs
+            .iter()
+            .any(|m| m.starts_with("control.speed_kmh = NaN")));
     }
 
     #[test]

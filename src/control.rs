@@ -164,7 +164,12 @@ impl Controller {
             out.xte = Some(xte);
             out.heading_error = Some(he);
         }
-        let tr = pure_pursuit(self.guidance.local_path(), &est.pose, est.speed, &self.tracker);
+        let tr = pure_pursuit(
+            self.guidance.local_path(),
+            &est.pose,
+            est.speed,
+            &self.tracker,
+        );
         if tr.wheel_angle.is_finite() {
             out.wheel_angle = Some(tr.wheel_angle);
         }

@@ -44,7 +44,8 @@ pub fn save(path: &Path, progress: &Progress) -> Result<(), ProgressFileError> {
     let tmp = path.with_extension("json.tmp");
     {
         let mut f = File::create(&tmp).map_err(io(&tmp))?;
-        f.write_all(progress.encode().as_bytes()).map_err(io(&tmp))?;
+        f.write_all(progress.encode().as_bytes())
+            .map_err(io(&tmp))?;
         f.sync_all().map_err(io(&tmp))?;
     }
     fs::rename(&tmp, path).map_err(io(path))?;

@@ -290,9 +290,13 @@ pub fn run(
             if turn_started {
                 after_turn = true;
                 if opts.record_trace {
-                    trace
-                        .turns
-                        .push(ctrl.guidance().global_path().iter().map(|p| p.pos).collect());
+                    trace.turns.push(
+                        ctrl.guidance()
+                            .global_path()
+                            .iter()
+                            .map(|p| p.pos)
+                            .collect(),
+                    );
                 }
             }
             if opts.stop_after_lines.is_some_and(|n| lines_this_run >= n) {
@@ -321,7 +325,8 @@ pub fn run(
         if g.phase() == Phase::Work {
             let (block, rank) = (g.index_block(), g.index_rank());
             let plan = g.plan();
-            let (s, e) = plan.line_endpoints(plan.line_of(block, rank), plan.line_reversed(block, rank));
+            let (s, e) =
+                plan.line_endpoints(plan.line_of(block, rank), plan.line_reversed(block, rank));
             let len = (e - s).norm();
             let dir = (e - s) / len;
             let along = (truth.pose.pos - s).dot(&dir);

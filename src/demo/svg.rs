@@ -216,10 +216,16 @@ pub fn demo_svg(trace: &Trace, report: &Report) -> String {
         .chain(trace.points.iter().map(|p| &p.pos));
     let mut c = SvgCanvas::fit(extent, 900.0);
     for (a, b) in &trace.lines {
-        c.polyline([a, b], r##"stroke="#bbbbbb" stroke-width="5" stroke-linecap="round""##);
+        c.polyline(
+            [a, b],
+            r##"stroke="#bbbbbb" stroke-width="5" stroke-linecap="round""##,
+        );
     }
     for t in &trace.turns {
-        c.polyline(t, r##"stroke="#4575b4" stroke-width="1.5" stroke-dasharray="4 3""##);
+        c.polyline(
+            t,
+            r##"stroke="#4575b4" stroke-width="1.5" stroke-dasharray="4 3""##,
+        );
     }
     // Driven trace: consecutive points of one colour form one polyline.
     let mut run: Vec<Vec2> = Vec::new();
@@ -228,7 +234,10 @@ pub fn demo_svg(trace: &Trace, report: &Report) -> String {
     for w in trace.points.windows(2) {
         let col = colour_of(w[1].xte_abs);
         if col != run_colour && !run.is_empty() {
-            c.polyline(&run, &format!(r#"stroke="{run_colour}" stroke-width="1.5""#));
+            c.polyline(
+                &run,
+                &format!(r#"stroke="{run_colour}" stroke-width="1.5""#),
+            );
             run.clear();
         }
         if run.is_empty() {
@@ -238,12 +247,19 @@ pub fn demo_svg(trace: &Trace, report: &Report) -> String {
         run_colour = col;
     }
     if !run.is_empty() {
-        c.polyline(&run, &format!(r#"stroke="{run_colour}" stroke-width="1.5""#));
+        c.polyline(
+            &run,
+            &format!(r#"stroke="{run_colour}" stroke-width="1.5""#),
+        );
     }
     if let Some(p) = trace.points.first() {
         c.dot(&p.pos, 4.0, "#000");
     }
-    let status = if report.finished { "finished" } else { "NOT finished" };
+    let status = if report.finished {
+        "finished"
+    } else {
+        "NOT finished"
+    };
     c.footer_text(
         10.0,
         20.0,

@@ -136,7 +136,8 @@ impl Estimator {
         let Some(heading) = heading else {
             return;
         };
-        let pos = self.antenna_to_rear_axle(&fix.antenna, heading, fix.roll.filter(|r| r.is_finite()));
+        let pos =
+            self.antenna_to_rear_axle(&fix.antenna, heading, fix.roll.filter(|r| r.is_finite()));
         self.fix_pose = Some(Pose::new(pos.x, pos.y, heading));
         self.fix_time = fix.t_received;
         self.fix_speed = fix.speed;

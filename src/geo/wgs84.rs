@@ -32,7 +32,11 @@ fn ecef(lat: f64, lon: f64, h: f64) -> [f64; 3] {
     let (sl, cl) = lat.sin_cos();
     let (so, co) = lon.sin_cos();
     let n = A / (1.0 - E2 * sl * sl).sqrt();
-    [(n + h) * cl * co, (n + h) * cl * so, (n * (1.0 - E2) + h) * sl]
+    [
+        (n + h) * cl * co,
+        (n + h) * cl * so,
+        (n * (1.0 - E2) + h) * sl,
+    ]
 }
 
 impl EnuFrame {
@@ -107,7 +111,12 @@ mod tests {
             lat_deg: 52.2,
             lon_deg: 5.1,
         });
-        for &(x, y) in &[(0.0, 0.0), (100.0, -50.0), (2500.0, 3100.0), (-4000.0, 10.0)] {
+        for &(x, y) in &[
+            (0.0, 0.0),
+            (100.0, -50.0),
+            (2500.0, 3100.0),
+            (-4000.0, 10.0),
+        ] {
             let ll = f.to_latlon(v2(x, y));
             let back = f.to_enu(ll);
             assert!((back - v2(x, y)).norm() < 1e-3, "{x},{y} -> {back:?}");

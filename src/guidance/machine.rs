@@ -34,7 +34,9 @@ pub struct GuidanceParams {
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum GuidanceError {
-    #[error("saved progress belongs to a different job (job parameters differ); refusing to resume")]
+    #[error(
+        "saved progress belongs to a different job (job parameters differ); refusing to resume"
+    )]
     DifferentJob,
     #[error("saved progress points at block {block}, rank {rank}, which this job does not have")]
     OutOfRange { block: u64, rank: u64 },
@@ -318,7 +320,11 @@ mod tests {
 
     /// Drive an ideal vehicle along whatever path the machine hands out and return the lines
     /// in the order they were finished.
-    fn drive(cfg: &Config, resume: Option<&Progress>, stop_after: Option<usize>) -> (Vec<u64>, Progress) {
+    fn drive(
+        cfg: &Config,
+        resume: Option<&Progress>,
+        stop_after: Option<usize>,
+    ) -> (Vec<u64>, Progress) {
         let plan = AbPlan::new(ab_params(cfg)).unwrap();
         let job = JobDefinition::from_config(cfg);
         let mut g = match resume {
@@ -353,11 +359,17 @@ mod tests {
 
     #[test]
     fn visits_every_line_exactly_once() {
-        let n_block = AbPlan::new(ab_params(&Config::default())).unwrap().block_size() as u64;
+        let n_block = AbPlan::new(ab_params(&Config::default()))
+            .unwrap()
+            .block_size() as u64;
         for count in [1, n_block - 1, n_block, n_block + 1, 2 * n_block + 3, 100] {
             let cfg = cfg_with_lines(count);
             let (mut lines, progress) = drive(&cfg, None, None);
-            assert_eq!(progress.phase, Phase::Finished, "{count} lines: not finished");
+            assert_eq!(
+                progress.phase,
+                Phase::Finished,
+                "{count} lines: not finished"
+            );
             assert_eq!(lines.len() as u64, count, "{count} lines: {lines:?}");
             lines.sort_unstable();
             assert_eq!(lines, (0..count).collect::<Vec<_>>(), "{count} lines");

@@ -1,6 +1,6 @@
 //! Guidance: the job state machine and its progress.
 
-pub mod progress;
 pub mod machine;
+pub mod progress;
 
 pub use machine::{Event, Guidance, GuidanceError, GuidanceParams};

@@ -100,8 +100,8 @@ impl Progress {
 
     /// Decode and verify. Never trusts content whose checksum does not match.
     pub fn decode(bytes: &[u8]) -> Result<Progress, ProgressError> {
-        let text = std::str::from_utf8(bytes)
-            .map_err(|_| ProgressError::Content("not UTF-8".into()))?;
+        let text =
+            std::str::from_utf8(bytes).map_err(|_| ProgressError::Content("not UTF-8".into()))?;
         let text = text.strip_suffix('\n').ok_or(ProgressError::Truncated)?;
         let (body, check) = text.rsplit_once('\n').ok_or(ProgressError::Truncated)?;
         let mut words = check.split(' ');

@@ -217,7 +217,14 @@ fn heuristic(n: usize, min_gap: usize, next_block: bool) -> Vec<usize> {
     visited[0] = true;
     order.push(0usize);
     let mut budget = SEARCH_BUDGET;
-    if dfs(n, min_gap, next_block, &mut visited, &mut order, &mut budget) {
+    if dfs(
+        n,
+        min_gap,
+        next_block,
+        &mut visited,
+        &mut order,
+        &mut budget,
+    ) {
         return order;
     }
     let h = n.div_ceil(2);
@@ -250,7 +257,10 @@ fn dfs(
     // Candidates by distance, nearest first (lower line first on ties).
     let mut dist = min_gap.max(1);
     while dist < n {
-        for cand in [cur.checked_sub(dist), Some(cur + dist)].into_iter().flatten() {
+        for cand in [cur.checked_sub(dist), Some(cur + dist)]
+            .into_iter()
+            .flatten()
+        {
             if cand < n && !visited[cand] {
                 visited[cand] = true;
                 order.push(cand);
@@ -308,7 +318,9 @@ impl AbPlan {
             Side::Left => left_normal(&dir),
             Side::Right => -left_normal(&dir),
         } * params.line_width;
-        let min_gap = ((2.0 * params.r_min / params.line_width) - 1e-9).ceil().max(0.0) as usize;
+        let min_gap = ((2.0 * params.r_min / params.line_width) - 1e-9)
+            .ceil()
+            .max(0.0) as usize;
         let block_size = 2 * min_gap + params.block_extra as usize;
         let (blocks, first_order, last_order) = if params.line_num == 0 {
             (None, solve_block_order(block_size, min_gap, true), None)
@@ -424,7 +436,8 @@ impl AbPlan {
     /// Append the global points of the work line at (block, rank): about `point_spacing`
     /// apart, exact ends, tag work.
     pub fn work_line_points(&self, block: u64, rank: usize, out: &mut Vec<PathPoint>) {
-        let (s, e) = self.line_endpoints(self.line_of(block, rank), self.line_reversed(block, rank));
+        let (s, e) =
+            self.line_endpoints(self.line_of(block, rank), self.line_reversed(block, rank));
         let n = ((self.length / self.params.point_spacing).ceil() as usize).max(1);
         for i in 0..=n {
             out.push(PathPoint::work(s + (e - s) * (i as f64 / n as f64)));
@@ -480,11 +493,26 @@ mod tests {
     #[test]
     fn block_size_formula() {
         // N = 2·ceil(2r/w) + a
-        assert_eq!(AbPlan::new(params(3.0, 5.0, 1, 12)).unwrap().block_size(), 9);
-        assert_eq!(AbPlan::new(params(3.0, 3.0, 1, 12)).unwrap().block_size(), 5);
-        assert_eq!(AbPlan::new(params(2.0, 5.0, 1, 12)).unwrap().block_size(), 11);
-        assert_eq!(AbPlan::new(params(2.0, 5.0, 3, 12)).unwrap().block_size(), 13);
-        assert_eq!(AbPlan::new(params(12.0, 5.0, 1, 12)).unwrap().block_size(), 3);
+        assert_eq!(
+            AbPlan::new(params(3.0, 5.0, 1, 12)).unwrap().block_size(),
+            9
+        );
+        assert_eq!(
+            AbPlan::new(params(3.0, 3.0, 1, 12)).unwrap().block_size(),
+            5
+        );
+        assert_eq!(
+            AbPlan::new(params(2.0, 5.0, 1, 12)).unwrap().block_size(),
+            11
+        );
+        assert_eq!(
+            AbPlan::new(params(2.0, 5.0, 3, 12)).unwrap().block_size(),
+            13
+        );
+        assert_eq!(
+            AbPlan::new(params(12.0, 5.0, 1, 12)).unwrap().block_size(),
+            3
+        );
     }
 
     #[test]
@@ -568,11 +596,20 @@ mod tests {
                 let exact = solve_block_order(n, min_gap, true);
                 let lines = heuristic(n, min_gap, true);
                 let h = BlockOrder {
-                    diffs: lines.windows(2).map(|w| w[1] as i32 - w[0] as i32).collect(),
+                    diffs: lines
+                        .windows(2)
+                        .map(|w| w[1] as i32 - w[0] as i32)
+                        .collect(),
                     short_moves: 0,
                 };
-                let (ce, ch) = (order_cost(&exact, n, min_gap, true), order_cost(&h, n, min_gap, true));
-                assert!(ch < SHORT_MOVE_COST, "n={n} gap={min_gap}: heuristic made a short move");
+                let (ce, ch) = (
+                    order_cost(&exact, n, min_gap, true),
+                    order_cost(&h, n, min_gap, true),
+                );
+                assert!(
+                    ch < SHORT_MOVE_COST,
+                    "n={n} gap={min_gap}: heuristic made a short move"
+                );
                 worst = worst.max(ch as f64 / ce as f64);
             }
         }
@@ -581,15 +618,26 @@ mod tests {
 
     #[test]
     fn consecutive_lines_are_2_rmin_apart_when_feasible() {
-        for (w, r, a) in [(3.0, 5.0, 1), (2.0, 5.0, 1), (3.0, 3.0, 2), (1.0, 4.0, 1), (4.0, 6.0, 3)] {
+        for (w, r, a) in [
+            (3.0, 5.0, 1),
+            (2.0, 5.0, 1),
+            (3.0, 3.0, 2),
+            (1.0, 4.0, 1),
+            (4.0, 6.0, 3),
+        ] {
             let plan = AbPlan::new(params(w, r, a, 1000)).unwrap();
             let n = plan.block_size();
             for block in [0u64, 1, plan.block_count().unwrap() - 1] {
                 let o = plan.block_order(block);
                 assert_eq!(o.short_moves, 0, "w={w} r={r} a={a}");
-                let lines: Vec<u64> = (0..plan.block_len(block)).map(|k| plan.line_of(block, k)).collect();
+                let lines: Vec<u64> = (0..plan.block_len(block))
+                    .map(|k| plan.line_of(block, k))
+                    .collect();
                 for p in lines.windows(2) {
-                    assert!(p[0].abs_diff(p[1]) as f64 * w >= 2.0 * r - 1e-9, "{lines:?}");
+                    assert!(
+                        p[0].abs_diff(p[1]) as f64 * w >= 2.0 * r - 1e-9,
+                        "{lines:?}"
+                    );
                 }
                 if block + 1 < plan.block_count().unwrap() {
                     let next_first = plan.line_of(block + 1, 0);
@@ -650,11 +698,16 @@ mod tests {
         let mut pos = (0u64, 0usize);
         let mut buf = Vec::new();
         while let Some(next) = plan.next_position(pos.0, pos.1) {
-            assert_ne!(plan.line_reversed(pos.0, pos.1), plan.line_reversed(next.0, next.1));
+            assert_ne!(
+                plan.line_reversed(pos.0, pos.1),
+                plan.line_reversed(next.0, next.1)
+            );
             buf.clear();
             plan.work_line_points(pos.0, pos.1, &mut buf);
             let line_end = buf.last().unwrap().pos;
-            assert!(buf.windows(2).all(|w| (w[1].pos - w[0].pos).norm() <= 1.0 + 1e-9));
+            assert!(buf
+                .windows(2)
+                .all(|w| (w[1].pos - w[0].pos).norm() <= 1.0 + 1e-9));
             buf.clear();
             plan.turn_points(pos, next, &mut buf).unwrap();
             assert!((buf[0].pos - line_end).norm() < 1e-9);

@@ -14,10 +14,7 @@ pub enum PlanError {
         rule: &'static str,
     },
     #[error("turn impossible ({reason}); lateral distance {distance:.3} m")]
-    Turn {
-        reason: &'static str,
-        distance: f64,
-    },
+    Turn { reason: &'static str, distance: f64 },
 }
 
 impl PlanError {

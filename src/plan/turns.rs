@@ -42,7 +42,11 @@ impl TurnParams {
             self.merge_distance,
             self.merge_distance >= 0.0,
         )?;
-        PlanError::check("point_spacing", self.point_spacing, self.point_spacing > 0.0)?;
+        PlanError::check(
+            "point_spacing",
+            self.point_spacing,
+            self.point_spacing > 0.0,
+        )?;
         if self.max_points < 1 {
             return Err(PlanError::Invalid {
                 name: "max_points",
@@ -233,7 +237,10 @@ mod tests {
         assert!((pts[0] - p1).norm() < 1e-3, "start {:?}", pts[0]);
         assert!((pts[pts.len() - 1] - p2).norm() < 1e-3, "end");
         let t0 = tangent_at_start(pts);
-        assert!(angle_between(&t0, &dir1).to_degrees() < 1.0, "start heading");
+        assert!(
+            angle_between(&t0, &dir1).to_degrees() < 1.0,
+            "start heading"
+        );
         let rev: Vec<Vec2> = pts.iter().rev().copied().collect();
         let t1 = -tangent_at_start(&rev);
         assert!(angle_between(&t1, &dir2).to_degrees() < 1.0, "end heading");
@@ -259,7 +266,11 @@ mod tests {
             for &left in &[true, false] {
                 for &h in &[0.0, 0.7, -2.0] {
                     let dir1 = heading_vec(h);
-                    let n = if left { left_normal(&dir1) } else { -left_normal(&dir1) };
+                    let n = if left {
+                        left_normal(&dir1)
+                    } else {
+                        -left_normal(&dir1)
+                    };
                     let p1 = v2(10.0, -3.0);
                     let p2 = p1 + n * d;
                     let mut out = Vec::new();
@@ -296,7 +307,11 @@ mod tests {
         for &d in &[0.5, 3.0, 6.0, 9.99] {
             for &left in &[true, false] {
                 let dir1 = heading_vec(1.1);
-                let n = if left { left_normal(&dir1) } else { -left_normal(&dir1) };
+                let n = if left {
+                    left_normal(&dir1)
+                } else {
+                    -left_normal(&dir1)
+                };
                 let p1 = v2(-4.0, 7.0);
                 let p2 = p1 + n * d;
                 let mut out = Vec::new();
@@ -310,8 +325,22 @@ mod tests {
     #[test]
     fn wrong_turn_kind_is_an_error() {
         let mut out = Vec::new();
-        assert!(pi_turn(v2(0.0, 0.0), v2(1.0, 0.0), v2(0.0, 3.0), &params(5.0), &mut out).is_err());
-        assert!(bulb_turn(v2(0.0, 0.0), v2(1.0, 0.0), v2(0.0, 30.0), &params(5.0), &mut out).is_err());
+        assert!(pi_turn(
+            v2(0.0, 0.0),
+            v2(1.0, 0.0),
+            v2(0.0, 3.0),
+            &params(5.0),
+            &mut out
+        )
+        .is_err());
+        assert!(bulb_turn(
+            v2(0.0, 0.0),
+            v2(1.0, 0.0),
+            v2(0.0, 30.0),
+            &params(5.0),
+            &mut out
+        )
+        .is_err());
         let mut bad = params(5.0);
         bad.r_min = f64::NAN;
         assert!(pi_turn(v2(0.0, 0.0), v2(1.0, 0.0), v2(0.0, 30.0), &bad, &mut out).is_err());

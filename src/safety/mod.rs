@@ -281,7 +281,9 @@ impl Supervisor {
     /// The first condition that forbids steering at `t`, or `FaultCode::None`.
     fn input_fault(&self, t: f64) -> FaultCode {
         let p = &self.params;
-        let fresh = |last: Option<f64>, timeout: f64| last.is_some_and(|l| t - l <= timeout && t >= l - 1.0);
+        let fresh = |last: Option<f64>, timeout: f64| {
+            last.is_some_and(|l| t - l <= timeout && t >= l - 1.0)
+        };
         if self.bus_down {
             return FaultCode::BusDown;
         }

@@ -13,7 +13,10 @@ fn engaged_supervisor() -> (Supervisor, f64) {
     let mut s = Supervisor::new(SafetyParams::default());
     let mut t = 0.0;
     feed_good(&mut s, t);
-    assert_eq!(s.step(t, Some(0.0), Some(0.1), Some(0.0)).state, SafetyState::Ready);
+    assert_eq!(
+        s.step(t, Some(0.0), Some(0.1), Some(0.0)).state,
+        SafetyState::Ready
+    );
     s.request_engage();
     t += DT;
     feed_good(&mut s, t);
@@ -89,7 +92,10 @@ fn bad_frame_score_is_opendbc_style() {
     assert!(!c.engaged);
     assert_eq!(c.fault, FaultCode::WheelAngleInvalid);
     s.on_frame_check(CheckedInput::WheelAngle, true);
-    assert!(!s.input_invalid(CheckedInput::WheelAngle), "−1 per good frame");
+    assert!(
+        !s.input_invalid(CheckedInput::WheelAngle),
+        "−1 per good frame"
+    );
 }
 
 #[test]
@@ -103,7 +109,11 @@ fn rate_limit_starts_from_measured_angle() {
     let c = s.step(DT, Some(-0.5), Some(0.0), Some(0.0));
     assert!(c.engaged);
     let max_step = 30f64.to_radians() * DT;
-    assert!((c.wheel_angle - (0.1 - max_step)).abs() < 1e-12, "{}", c.wheel_angle);
+    assert!(
+        (c.wheel_angle - (0.1 - max_step)).abs() < 1e-12,
+        "{}",
+        c.wheel_angle
+    );
 }
 
 #[test]

@@ -105,7 +105,10 @@ pub struct GnssMeasurement {
 pub enum SimOutput {
     Gnss(GnssMeasurement),
     /// Measured front-wheel angle (rad) at `t` (s).
-    WheelAngle { t: f64, angle: f64 },
+    WheelAngle {
+        t: f64,
+        angle: f64,
+    },
 }
 
 /// The simulator's true state.
@@ -166,14 +169,34 @@ impl Simulator {
                 })
             }
         };
-        check("step", p.step, p.step > 0.0 && p.step <= 0.1, "must be in (0, 0.1] s")?;
+        check(
+            "step",
+            p.step,
+            p.step > 0.0 && p.step <= 0.1,
+            "must be in (0, 0.1] s",
+        )?;
         check("wheelbase", p.wheelbase, p.wheelbase > 0.0, "must be > 0")?;
-        check("gnss_rate_hz", p.gnss_rate_hz, p.gnss_rate_hz > 0.0, "must be > 0")?;
-        check("was_rate_hz", p.was_rate_hz, p.was_rate_hz > 0.0, "must be > 0")?;
+        check(
+            "gnss_rate_hz",
+            p.gnss_rate_hz,
+            p.gnss_rate_hz > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "was_rate_hz",
+            p.was_rate_hz,
+            p.was_rate_hz > 0.0,
+            "must be > 0",
+        )?;
         check("dead_time", p.dead_time, p.dead_time >= 0.0, "must be >= 0")?;
         check("tau", p.tau, p.tau >= 0.0, "must be >= 0")?;
         check("max_rate", p.max_rate, p.max_rate > 0.0, "must be > 0")?;
-        check("gnss_latency", p.gnss_latency, p.gnss_latency >= 0.0, "must be >= 0")?;
+        check(
+            "gnss_latency",
+            p.gnss_latency,
+            p.gnss_latency >= 0.0,
+            "must be >= 0",
+        )?;
         for (n, v) in [
             ("gnss_sigma", p.gnss_sigma),
             ("heading_sigma", p.heading_sigma),
@@ -260,7 +283,9 @@ impl Simulator {
 
     fn antenna(&self) -> Vec2 {
         let h = heading_vec(self.heading);
-        Vec2::new(self.x, self.y) + h * self.p.antenna_forward + left_normal(&h) * self.p.antenna_left
+        Vec2::new(self.x, self.y)
+            + h * self.p.antenna_forward
+            + left_normal(&h) * self.p.antenna_left
     }
 
     /// The true state now.
@@ -405,7 +430,10 @@ mod tests {
             let t = k as f64 * 0.001;
             s.advance_to(t, &mut out);
             let w = s.true_state().wheel_angle;
-            assert!((w - prev).abs() <= p.max_rate * p.step + 1e-12, "rate limit");
+            assert!(
+                (w - prev).abs() <= p.max_rate * p.step + 1e-12,
+                "rate limit"
+            );
             if w != 0.0 && first_move.is_none() {
                 first_move = Some(t);
             }
@@ -432,11 +460,16 @@ mod tests {
         for w in fixes.windows(2) {
             assert!((w[1].t_measured - w[0].t_measured - 0.1).abs() < 1e-9);
         }
-        assert!(fixes.iter().all(|m| (m.t_delivered - m.t_measured - 0.05).abs() < 1e-12));
+        assert!(fixes
+            .iter()
+            .all(|m| (m.t_delivered - m.t_measured - 0.05).abs() < 1e-12));
         let n = fixes.len() as f64;
         let var = fixes.iter().map(|m| m.antenna.x.powi(2)).sum::<f64>() / n;
         assert!((var.sqrt() - 0.01).abs() < 0.0005, "σ {}", var.sqrt());
-        let was = out.iter().filter(|o| matches!(o, SimOutput::WheelAngle { .. })).count();
+        let was = out
+            .iter()
+            .filter(|o| matches!(o, SimOutput::WheelAngle { .. }))
+            .count();
         assert!((was as i64 - 100_000).abs() <= 1);
     }
 

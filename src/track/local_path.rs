@@ -151,7 +151,8 @@ impl LocalPath {
             let steps = EVALS_PER_SEGMENT;
             for j in 0..steps {
                 let u = j as f64 / steps as f64;
-                self.dense.push(bspline(&c[s], &c[s + 1], &c[s + 2], &c[s + 3], u));
+                self.dense
+                    .push(bspline(&c[s], &c[s + 1], &c[s + 2], &c[s + 3], u));
             }
         }
         self.dense.push(nodes[k - 1].pos);
@@ -159,14 +160,22 @@ impl LocalPath {
         let spacing = self.params.spacing;
         let mut node_cursor = 0usize;
         let mut carry = 0.0; // distance from the last emitted sample
-        let push = |pts: &mut Vec<Vec2>, tags: &mut Vec<(Tag, Direction)>, p: Vec2, cur: &mut usize| {
+        let push = |pts: &mut Vec<Vec2>,
+                    tags: &mut Vec<(Tag, Direction)>,
+                    p: Vec2,
+                    cur: &mut usize| {
             while *cur + 1 < k && (nodes[*cur + 1].pos - p).norm() < (nodes[*cur].pos - p).norm() {
                 *cur += 1;
             }
             pts.push(p);
             tags.push((nodes[*cur].tag, nodes[*cur].direction));
         };
-        push(&mut self.points, &mut self.tags, self.dense[0], &mut node_cursor);
+        push(
+            &mut self.points,
+            &mut self.tags,
+            self.dense[0],
+            &mut node_cursor,
+        );
         for w in 1..self.dense.len() {
             let a = self.dense[w - 1];
             let b = self.dense[w];
@@ -284,14 +293,20 @@ mod tests {
                 let chord = (b - a).normalize();
                 let t = raw.normalize();
                 let ang = cross(&chord, &t).atan2(chord.dot(&t)).abs();
-                assert!(ang.to_degrees() < 1.0, "tangent off by {} deg", ang.to_degrees());
+                assert!(
+                    ang.to_degrees() < 1.0,
+                    "tangent off by {} deg",
+                    ang.to_degrees()
+                );
             }
         }
     }
 
     #[test]
     fn samples_are_evenly_spaced() {
-        let g: Vec<PathPoint> = (0..10).map(|i| PathPoint::work(v2(i as f64, 0.0))).collect();
+        let g: Vec<PathPoint> = (0..10)
+            .map(|i| PathPoint::work(v2(i as f64, 0.0)))
+            .collect();
         let mut lp = LocalPath::new(&LocalPathParams {
             nodes_before: 1,
             nodes_after: 6,
@@ -325,12 +340,21 @@ mod tests {
 
     #[test]
     fn nearest_global_finds_the_true_nearest() {
-        let g: Vec<PathPoint> = (0..200).map(|i| PathPoint::work(v2(i as f64, 0.0))).collect();
-        for (p, hint) in [(v2(50.2, 1.0), 45usize), (v2(10.7, -2.0), 14), (v2(120.0, 0.0), 100)] {
+        let g: Vec<PathPoint> = (0..200)
+            .map(|i| PathPoint::work(v2(i as f64, 0.0)))
+            .collect();
+        for (p, hint) in [
+            (v2(50.2, 1.0), 45usize),
+            (v2(10.7, -2.0), 14),
+            (v2(120.0, 0.0), 100),
+        ] {
             let got = nearest_global(&g, &p, hint, 8);
             let truth = (0..200)
                 .min_by(|&a, &b| {
-                    (g[a].pos - p).norm().partial_cmp(&(g[b].pos - p).norm()).unwrap()
+                    (g[a].pos - p)
+                        .norm()
+                        .partial_cmp(&(g[b].pos - p).norm())
+                        .unwrap()
                 })
                 .unwrap();
             assert_eq!(got, truth);

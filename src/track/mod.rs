@@ -130,7 +130,9 @@ mod tests {
     }
 
     fn straight_local(at: &Vec2) -> LocalPath {
-        let g: Vec<PathPoint> = (0..50).map(|i| PathPoint::work(v2(i as f64, 0.0))).collect();
+        let g: Vec<PathPoint> = (0..50)
+            .map(|i| PathPoint::work(v2(i as f64, 0.0)))
+            .collect();
         let mut lp = LocalPath::new(&LocalPathParams {
             nodes_before: 1,
             nodes_after: 8,
@@ -145,7 +147,10 @@ mod tests {
     fn steers_back_toward_a_straight_line() {
         let left = Pose::new(10.0, 0.5, 0.0);
         let out = pure_pursuit(&straight_local(&left.pos), &left, 2.0, &params());
-        assert!(out.valid && out.wheel_angle < 0.0, "left of line steers right: {out:?}");
+        assert!(
+            out.valid && out.wheel_angle < 0.0,
+            "left of line steers right: {out:?}"
+        );
         let right = Pose::new(10.0, -0.5, 0.0);
         let out = pure_pursuit(&straight_local(&right.pos), &right, 2.0, &params());
         assert!(out.wheel_angle > 0.0, "right of line steers left");
@@ -173,7 +178,12 @@ mod tests {
         let pose = Pose::new(r * a.sin(), r - r * a.cos(), a);
         lp.nearest(&pose.pos);
         let out = pure_pursuit(&lp, &pose, 2.0, &params());
-        assert!((out.curvature - 1.0 / r).abs() < 0.03 / r, "κ {} vs {}", out.curvature, 1.0 / r);
+        assert!(
+            (out.curvature - 1.0 / r).abs() < 0.03 / r,
+            "κ {} vs {}",
+            out.curvature,
+            1.0 / r
+        );
     }
 
     #[test]

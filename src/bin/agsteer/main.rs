@@ -10,7 +10,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "agsteer", version, about = "agsteer: automatic steering for tractors")]
+#[command(
+    name = "agsteer",
+    version,
+    about = "agsteer: automatic steering for tractors"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -115,10 +119,22 @@ fn check_config(path: &Path, set: &[String]) -> Result<u8> {
 fn log_event(t: f64, ev: &Event) {
     match ev {
         Event::LineStarted { block, rank, line } => {
-            tracing::info!(t_s = format_args!("{t:.2}"), block, rank, line, "line started")
+            tracing::info!(
+                t_s = format_args!("{t:.2}"),
+                block,
+                rank,
+                line,
+                "line started"
+            )
         }
         Event::LineFinished { block, rank, line } => {
-            tracing::info!(t_s = format_args!("{t:.2}"), block, rank, line, "line finished")
+            tracing::info!(
+                t_s = format_args!("{t:.2}"),
+                block,
+                rank,
+                line,
+                "line finished"
+            )
         }
         Event::TurnStarted { from_line, to_line } => tracing::info!(
             t_s = format_args!("{t:.2}"),
@@ -175,23 +191,30 @@ fn run_demo(
             save_error.get_or_insert(e);
         }
     };
-    let run = demo::run(&cfg, &opts, &mut on_progress, &mut log_event)
-        .context("running the demo job")?;
+    let run =
+        demo::run(&cfg, &opts, &mut on_progress, &mut log_event).context("running the demo job")?;
     if let Some(e) = save_error {
         tracing::error!("could not save progress: {e}");
     }
     let report_json = serde_json::to_string_pretty(&run.report)?;
     std::fs::write(out.join("report.json"), format!("{report_json}\n"))
         .with_context(|| format!("writing {}/report.json", out.display()))?;
-    std::fs::write(out.join("trace.svg"), demo::svg::demo_svg(&run.trace, &run.report))
-        .with_context(|| format!("writing {}/trace.svg", out.display()))?;
+    std::fs::write(
+        out.join("trace.svg"),
+        demo::svg::demo_svg(&run.trace, &run.report),
+    )
+    .with_context(|| format!("writing {}/trace.svg", out.display()))?;
     if json {
         println!("{report_json}");
     } else {
         let r = &run.report;
         println!(
             "{}: {}/{} lines, {} turns, {:.0} m in {:.0} s simulated ({:.2} s wall)",
-            if r.finished { "finished" } else { "NOT finished" },
+            if r.finished {
+                "finished"
+            } else {
+                "NOT finished"
+            },
             r.lines_completed,
             r.lines_planned
                 .map(|n| n.to_string())
