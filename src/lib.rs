@@ -10,6 +10,7 @@
 //! Planning modules are pure functions of their inputs (no I/O, clocks or globals). I/O lives
 //! only in `can`, [`daemon`] and the binaries.
 
+pub mod can;
 pub mod config;
 pub mod control;
 pub mod daemon;

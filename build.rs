@@ -1,0 +1,179 @@
+//! Generates the CAN codec tables and typed messages from `dbc/agsteer.dbc` (the single source
+//! of truth for every frame). Editing the DBC and rebuilding is the only way to change a frame.
+
+use can_dbc::{AttributeValue, ByteOrder, Dbc, MessageId, ValueType};
+use std::fmt::Write;
+
+fn snake(name: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in name.chars().enumerate() {
+        if c.is_ascii_uppercase() {
+            if i > 0 {
+                out.push('_');
+            }
+            out.push(c.to_ascii_lowercase());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+fn attr_u64(v: &AttributeValue) -> u64 {
+    match v {
+        AttributeValue::Uint(u) => *u,
+        AttributeValue::Int(i) => *i as u64,
+        AttributeValue::Double(d) => *d as u64,
+        AttributeValue::String(_) => 0,
+    }
+}
+
+fn lit(x: f64) -> String {
+    // Debug formatting of f64 round-trips exactly and always has a '.' or an exponent.
+    format!("{x:?}_f64")
+}
+
+fn main() {
+    let path = "dbc/agsteer.dbc";
+    println!("cargo:rerun-if-changed={path}");
+    let text = std::fs::read_to_string(path).expect("read dbc/agsteer.dbc");
+    let dbc = Dbc::try_from(text.as_str()).unwrap_or_else(|e| panic!("{path}: {e:?}"));
+
+    let sig_attr = |id: MessageId, sig: &str, name: &str| -> u64 {
+        dbc.attribute_values_signal
+            .iter()
+            .find(|a| a.message_id == id && a.signal_name == sig && a.name == name)
+            .map(|a| attr_u64(&a.value))
+            .unwrap_or(0)
+    };
+    let msg_attr = |id: MessageId, name: &str| -> u64 {
+        dbc.attribute_values_message
+            .iter()
+            .find(|a| a.message_id == id && a.name == name)
+            .map(|a| attr_u64(&a.value))
+            .unwrap_or(0)
+    };
+
+    let mut table = String::new();
+    let mut types = String::new();
+    writeln!(table, "/// Every message of the DBC, in file order.").unwrap();
+    writeln!(table, "pub static MESSAGES: &[MessageDef] = &[").unwrap();
+    for (index, m) in dbc.messages.iter().enumerate() {
+        let MessageId::Extended(id) = m.id else {
+            panic!("{}: agsteer frames are J1939 29-bit", m.name);
+        };
+        let pf = (id >> 16) & 0xFF;
+        let pdu1 = pf < 0xF0;
+        let pgn = if pdu1 {
+            (id >> 8) & 0x3FF00
+        } else {
+            (id >> 8) & 0x3FFFF
+        };
+        let comment = dbc.message_comment(m.id).unwrap_or("").replace('"', "'");
+        let transmitter = match &m.transmitter {
+            can_dbc::Transmitter::NodeName(n) => n.clone(),
+            _ => String::new(),
+        };
+        assert!(m.size <= 8, "{}: classic CAN frames only", m.name);
+        writeln!(
+            table,
+            "    MessageDef {{ name: {:?}, id: 0x{id:08X}, pgn: {pgn}, pdu1: {pdu1}, size: {}, cycle_ms: {}, transmitter: {:?}, comment: {:?}, signals: &[",
+            m.name,
+            m.size,
+            msg_attr(m.id, "GenMsgCycleTime"),
+            transmitter,
+            comment
+        )
+        .unwrap();
+        let mut fields = String::new();
+        let mut from_values = String::new();
+        let mut to_values = String::new();
+        for (si, s) in m.signals.iter().enumerate() {
+            assert_eq!(
+                s.byte_order,
+                ByteOrder::LittleEndian,
+                "{}.{}: little-endian only",
+                m.name,
+                s.name
+            );
+            assert!(s.size >= 1 && s.size <= 64 && s.start_bit + s.size <= 8 * m.size);
+            let role = match sig_attr(m.id, &s.name, "AgRole") {
+                1 => "Role::Counter",
+                2 => "Role::Crc",
+                _ => "Role::Value",
+            };
+            if role == "Role::Crc" {
+                assert!(
+                    s.size == 8 && s.start_bit % 8 == 0,
+                    "{}.{}: CRC must be a whole byte",
+                    m.name,
+                    s.name
+                );
+            }
+            let na = sig_attr(m.id, &s.name, "AgNotAvailable") == 1;
+            let signed = s.value_type == ValueType::Signed;
+            let choices = dbc
+                .value_descriptions_for_signal(m.id, &s.name)
+                .map(|v| {
+                    v.iter()
+                        .map(|d| format!("({}, {:?})", d.id, d.description))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                })
+                .unwrap_or_default();
+            writeln!(
+                table,
+                "        SignalDef {{ name: {:?}, start_bit: {}, size: {}, signed: {signed}, factor: {}, offset: {}, min: {}, max: {}, unit: {:?}, role: {role}, not_available: {na}, choices: &[{choices}] }},",
+                s.name,
+                s.start_bit,
+                s.size,
+                lit(s.factor),
+                lit(s.offset),
+                lit(s.min),
+                lit(s.max),
+                s.unit,
+            )
+            .unwrap();
+            if role == "Role::Value" {
+                let field = snake(&s.name);
+                let ty = if na { "Option<f64>" } else { "f64" };
+                writeln!(
+                    fields,
+                    "    /// `{}`: {} [{} ..= {}]{}{}.\n    pub {field}: {ty},",
+                    s.name,
+                    if s.unit.is_empty() { "raw" } else { &s.unit },
+                    s.min,
+                    s.max,
+                    if na { ", None = not available" } else { "" },
+                    if choices.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; values {choices}")
+                    }
+                )
+                .unwrap();
+                if na {
+                    writeln!(from_values, "            {field}: v[{si}],").unwrap();
+                    writeln!(to_values, "        v[{si}] = self.{field};").unwrap();
+                } else {
+                    writeln!(from_values, "            {field}: v[{si}].unwrap_or(0.0),").unwrap();
+                    writeln!(to_values, "        v[{si}] = Some(self.{field});").unwrap();
+                }
+            }
+        }
+        writeln!(table, "    ] }},").unwrap();
+        writeln!(
+            types,
+            "/// {comment}\n#[derive(Debug, Clone, Copy, PartialEq, Default)]\npub struct {name} {{\n{fields}}}\n\nimpl DbcMessage for {name} {{\n    const INDEX: usize = {index};\n    fn from_values(v: &[Option<f64>]) -> Self {{\n        {name} {{\n{from_values}        }}\n    }}\n    fn to_values(&self, v: &mut [Option<f64>]) {{\n{to_values}    }}\n}}\n",
+            name = m.name,
+        )
+        .unwrap();
+    }
+    writeln!(table, "];").unwrap();
+    let out = std::path::Path::new(&std::env::var("OUT_DIR").expect("OUT_DIR")).join("dbc_gen.rs");
+    std::fs::write(
+        &out,
+        format!("// Generated by build.rs from {path}. Do not edit.\n\n{table}\n{types}"),
+    )
+    .expect("write generated codec");
+}

@@ -1,0 +1,261 @@
+//! Buses: one trait for sending and receiving timestamped frames, an in-memory bus for the
+//! in-process demo and tests, and SocketCAN (blocking and tokio) for the daemon and simulator.
+//!
+//! Receive timestamps are seconds on the receiver's monotonic clock ([`monotonic_s`]) for
+//! SocketCAN, and the caller's simulated time for [`MemBus`].
+
+use super::{Frame, TimedFrame};
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex};
+
+/// Bus errors.
+#[derive(Debug, thiserror::Error)]
+pub enum BusError {
+    /// The interface is down or gone (ENETDOWN, ENODEV, ENXIO): retry later.
+    #[error("CAN interface is down: {0}")]
+    Down(std::io::Error),
+    /// The transmit queue is full (ENOBUFS, EAGAIN).
+    #[error("CAN transmit queue full")]
+    Full,
+    #[error("CAN I/O error: {0}")]
+    Io(std::io::Error),
+}
+
+impl From<std::io::Error> for BusError {
+    fn from(e: std::io::Error) -> Self {
+        match e.raw_os_error() {
+            Some(libc::ENETDOWN) | Some(libc::ENODEV) | Some(libc::ENXIO) => BusError::Down(e),
+            Some(libc::ENOBUFS) | Some(libc::EAGAIN) => BusError::Full,
+            _ => BusError::Io(e),
+        }
+    }
+}
+
+/// Sending and receiving frames.
+pub trait CanBus {
+    /// Send one frame (non-blocking).
+    fn send(&mut self, frame: &Frame) -> Result<(), BusError>;
+    /// The next received frame, if any (non-blocking).
+    fn try_recv(&mut self) -> Result<Option<TimedFrame>, BusError>;
+}
+
+/// Seconds on the monotonic clock (CLOCK_MONOTONIC), the daemon's time base.
+pub fn monotonic_s() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes into the timespec we own.
+    unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+#[derive(Debug, Default)]
+struct Hub {
+    queues: Vec<VecDeque<(usize, TimedFrame)>>,
+    now: f64,
+}
+
+/// An in-memory bus: every node sees every frame the other nodes send, stamped with the hub's
+/// time (set by the caller), so runs are deterministic and faster than real time.
+#[derive(Debug, Clone)]
+pub struct MemBus {
+    hub: Arc<Mutex<Hub>>,
+    node: usize,
+}
+
+impl MemBus {
+    /// A new bus with its first node.
+    pub fn new() -> MemBus {
+        let hub = Arc::new(Mutex::new(Hub::default()));
+        let node = MemBus::attach(&hub);
+        MemBus { hub, node }
+    }
+    fn attach(hub: &Arc<Mutex<Hub>>) -> usize {
+        let mut h = hub.lock().unwrap_or_else(|e| e.into_inner());
+        h.queues.push(VecDeque::with_capacity(256));
+        h.queues.len() - 1
+    }
+    /// Another node on the same bus.
+    pub fn node(&self) -> MemBus {
+        MemBus {
+            hub: self.hub.clone(),
+            node: MemBus::attach(&self.hub),
+        }
+    }
+    /// Set the bus time used to stamp frames sent from now on, s.
+    pub fn set_time(&self, t: f64) {
+        self.hub.lock().unwrap_or_else(|e| e.into_inner()).now = t;
+    }
+}
+
+impl Default for MemBus {
+    fn default() -> Self {
+        MemBus::new()
+    }
+}
+
+impl CanBus for MemBus {
+    fn send(&mut self, frame: &Frame) -> Result<(), BusError> {
+        let mut h = self.hub.lock().unwrap_or_else(|e| e.into_inner());
+        let tf = TimedFrame {
+            t: h.now,
+            frame: *frame,
+        };
+        for (i, q) in h.queues.iter_mut().enumerate() {
+            if i != self.node {
+                q.push_back((self.node, tf));
+            }
+        }
+        Ok(())
+    }
+    fn try_recv(&mut self) -> Result<Option<TimedFrame>, BusError> {
+        let mut h = self.hub.lock().unwrap_or_else(|e| e.into_inner());
+        Ok(h.queues[self.node].pop_front().map(|(_, f)| f))
+    }
+}
+
+/// Receive filter: accept ids with `id & mask == wanted & mask` (29-bit ids).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Filter {
+    pub id: u32,
+    pub mask: u32,
+}
+
+fn to_socketcan(frame: &Frame) -> Result<socketcan::CanFrame, BusError> {
+    use socketcan::EmbeddedFrame;
+    let id = socketcan::ExtendedId::new(frame.id & 0x1FFF_FFFF)
+        .ok_or_else(|| BusError::Io(std::io::Error::other("id out of range")))?;
+    socketcan::CanFrame::new(id, frame.payload())
+        .ok_or_else(|| BusError::Io(std::io::Error::other("bad frame")))
+}
+
+fn from_socketcan(f: &socketcan::CanFrame) -> Option<Frame> {
+    use socketcan::{EmbeddedFrame, Id};
+    match f.id() {
+        Id::Extended(id) if f.is_data_frame() => Some(Frame::new(id.as_raw(), f.data())),
+        _ => None,
+    }
+}
+
+fn socketcan_filters(filters: &[Filter]) -> Vec<socketcan::CanFilter> {
+    const EFF: u32 = 0x8000_0000;
+    filters
+        .iter()
+        .map(|f| socketcan::CanFilter::new(f.id | EFF, f.mask | EFF))
+        .collect()
+}
+
+/// A blocking-or-not SocketCAN bus (for the simulator and tests).
+pub struct SocketCanBus {
+    sock: socketcan::CanSocket,
+}
+
+impl SocketCanBus {
+    /// Open `iface` (non-blocking), with receive filters (empty = everything).
+    pub fn open(iface: &str, filters: &[Filter]) -> Result<Self, BusError> {
+        use socketcan::{Socket, SocketOptions};
+        let sock = socketcan::CanSocket::open(iface)?;
+        sock.set_nonblocking(true)?;
+        if !filters.is_empty() {
+            sock.set_filters(&socketcan_filters(filters))?;
+        }
+        Ok(SocketCanBus { sock })
+    }
+}
+
+impl CanBus for SocketCanBus {
+    fn send(&mut self, frame: &Frame) -> Result<(), BusError> {
+        use socketcan::Socket;
+        let f = to_socketcan(frame)?;
+        self.sock.write_frame(&f).map_err(BusError::from)
+    }
+    fn try_recv(&mut self) -> Result<Option<TimedFrame>, BusError> {
+        use socketcan::Socket;
+        loop {
+            match self.sock.read_frame() {
+                Ok(f) => {
+                    if let Some(frame) = from_socketcan(&f) {
+                        return Ok(Some(TimedFrame {
+                            t: monotonic_s(),
+                            frame,
+                        }));
+                    }
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => return Ok(None),
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+}
+
+/// The daemon's tokio SocketCAN bus.
+pub struct AsyncSocketCan {
+    sock: socketcan::tokio::CanSocket,
+}
+
+impl AsyncSocketCan {
+    /// Open `iface` with receive filters (empty = everything).
+    pub fn open(iface: &str, filters: &[Filter]) -> Result<Self, BusError> {
+        use socketcan::SocketOptions;
+        let sock = socketcan::tokio::CanSocket::open(iface)?;
+        if !filters.is_empty() {
+            sock.set_filters(&socketcan_filters(filters))?;
+        }
+        Ok(AsyncSocketCan { sock })
+    }
+    /// Wait for the next extended data frame.
+    pub async fn recv(&self) -> Result<TimedFrame, BusError> {
+        loop {
+            let f = self.sock.read_frame().await?;
+            if let Some(frame) = from_socketcan(&f) {
+                return Ok(TimedFrame {
+                    t: monotonic_s(),
+                    frame,
+                });
+            }
+        }
+    }
+    /// Send without waiting: a full queue is an error, never a stall of the control loop.
+    pub fn try_send(&self, frame: &Frame) -> Result<(), BusError> {
+        let f = to_socketcan(frame)?;
+        self.sock.try_write_frame(f).map_err(BusError::from)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mem_bus_delivers_to_the_other_nodes_only() {
+        let mut a = MemBus::new();
+        let mut b = a.node();
+        let mut c = a.node();
+        a.set_time(1.5);
+        a.send(&Frame::new(0x0CFF2000, &[1, 2, 3])).unwrap();
+        assert!(a.try_recv().unwrap().is_none());
+        let fb = b.try_recv().unwrap().unwrap();
+        assert_eq!(fb.frame.payload(), &[1, 2, 3]);
+        assert_eq!(fb.t, 1.5);
+        assert!(c.try_recv().unwrap().is_some());
+        assert!(c.try_recv().unwrap().is_none());
+    }
+
+    #[test]
+    fn io_errors_map_to_down_and_full() {
+        let down = std::io::Error::from_raw_os_error(libc::ENETDOWN);
+        assert!(matches!(BusError::from(down), BusError::Down(_)));
+        let full = std::io::Error::from_raw_os_error(libc::ENOBUFS);
+        assert!(matches!(BusError::from(full), BusError::Full));
+    }
+
+    #[test]
+    fn candump_format() {
+        let f = Frame::new(
+            0x0CADFF1C,
+            &[0x80, 0x7D, 0xFD, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF],
+        );
+        assert_eq!(f.to_candump(), "0CADFF1C#807DFDFFFFFFFFFF");
+    }
+}
