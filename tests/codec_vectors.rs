@@ -90,10 +90,18 @@ fn packer_fills_counters_and_crcs_and_the_parser_checks_them() {
         assert_eq!(d.to::<SteeringCommand>(), Some(msg));
     }
     // A corrupted byte fails the CRC; a repeated frame fails the counter.
-    let f = packer.pack(&SteeringCommand { angle: 1.0, mode: 1.0 }).unwrap();
+    let f = packer
+        .pack(&SteeringCommand {
+            angle: 1.0,
+            mode: 1.0,
+        })
+        .unwrap();
     let mut bad = f.data;
     bad[1] ^= 0x10;
-    assert!(matches!(decode(f.id, &bad[..8]), Err(CodecError::BadCrc { .. })));
+    assert!(matches!(
+        decode(f.id, &bad[..8]),
+        Err(CodecError::BadCrc { .. })
+    ));
     let d = decode(f.id, f.payload()).unwrap();
     assert!(check.check(&d));
     assert!(!check.check(&d), "frozen counter is caught");
@@ -102,30 +110,79 @@ fn packer_fills_counters_and_crcs_and_the_parser_checks_them() {
 #[test]
 fn out_of_range_missing_and_not_available() {
     assert!(matches!(
-        encode(&WheelAngle { angle: Some(90.5), status: 0.0 }, 0, 0x13),
+        encode(
+            &WheelAngle {
+                angle: Some(90.5),
+                status: 0.0
+            },
+            0,
+            0x13
+        ),
         Err(CodecError::OutOfRange { .. })
     ));
     assert!(matches!(
-        encode(&SteeringCommand { angle: f64::NAN, mode: 0.0 }, 0, 0x2A),
+        encode(
+            &SteeringCommand {
+                angle: f64::NAN,
+                mode: 0.0
+            },
+            0,
+            0x2A
+        ),
         Err(CodecError::OutOfRange { .. })
     ));
-    let f = encode(&WheelAngle { angle: None, status: 0.0 }, 3, 0x13).unwrap();
+    let f = encode(
+        &WheelAngle {
+            angle: None,
+            status: 0.0,
+        },
+        3,
+        0x13,
+    )
+    .unwrap();
     let d = decode(f.id, f.payload()).unwrap();
     assert_eq!(d.to::<WheelAngle>().unwrap().angle, None);
     // Encoding rounds to the nearest raw value, ties to even (as cantools).
-    let f = encode(&WheelAngle { angle: Some(0.005), status: 0.0 }, 0, 0x13).unwrap();
+    let f = encode(
+        &WheelAngle {
+            angle: Some(0.005),
+            status: 0.0,
+        },
+        0,
+        0x13,
+    )
+    .unwrap();
     assert_eq!(i16::from_le_bytes([f.data[0], f.data[1]]), 0);
-    let f = encode(&WheelAngle { angle: Some(0.015), status: 0.0 }, 0, 0x13).unwrap();
+    let f = encode(
+        &WheelAngle {
+            angle: Some(0.015),
+            status: 0.0,
+        },
+        0,
+        0x13,
+    )
+    .unwrap();
     assert_eq!(i16::from_le_bytes([f.data[0], f.data[1]]), 2);
 }
 
 #[test]
 fn any_source_address_matches_by_pgn() {
-    let f = encode(&WheelAngle { angle: Some(1.0), status: 0.0 }, 0, 0x77).unwrap();
+    let f = encode(
+        &WheelAngle {
+            angle: Some(1.0),
+            status: 0.0,
+        },
+        0,
+        0x77,
+    )
+    .unwrap();
     assert_eq!(f.id & 0xFF, 0x77);
     let d = decode(f.id, f.payload()).unwrap();
     assert_eq!(d.source, 0x77);
-    assert!(matches!(decode(0x0CFF9913, &[0; 8]), Err(CodecError::UnknownId(_))));
+    assert!(matches!(
+        decode(0x0CFF9913, &[0; 8]),
+        Err(CodecError::UnknownId(_))
+    ));
 }
 
 #[test]

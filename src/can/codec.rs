@@ -371,3 +371,59 @@ impl CounterCheck {
         ok
     }
 }
+
+/// A Markdown table of every frame, generated from the DBC (committed as `dbc/FRAMES.md`).
+pub fn frames_markdown() -> String {
+    let mut s = String::from(
+        "# agsteer CAN frames\n\nGenerated from `dbc/agsteer.dbc` by `agsteer dbc table`. J1939 29-bit identifiers with the DBC's default source address; frames are matched by PGN, so source addresses are configurable. Little-endian. Unused bits are 1.\n\n| frame | id | PGN | period | from | signals |\n|---|---|---|---|---|---|\n",
+    );
+    for m in MESSAGES {
+        let sigs: Vec<String> = m
+            .signals
+            .iter()
+            .map(|g| {
+                let kind = match g.role {
+                    Role::Counter => " (counter)".to_string(),
+                    Role::Crc => " (CRC-8 J1850)".to_string(),
+                    Role::Value => {
+                        let unit = if g.unit.is_empty() {
+                            String::new()
+                        } else {
+                            format!(" {}", g.unit)
+                        };
+                        let na = if g.not_available { ", n/a" } else { "" };
+                        format!(
+                            " {}{} ×{} [{}, {}]{unit}{na}",
+                            if g.signed { "i" } else { "u" },
+                            g.size,
+                            g.factor,
+                            g.min,
+                            g.max
+                        )
+                    }
+                };
+                format!("`{}`{kind}", g.name)
+            })
+            .collect();
+        let period = if m.cycle_ms == 0 {
+            "event".to_string()
+        } else {
+            format!("{} ms", m.cycle_ms)
+        };
+        s.push_str(&format!(
+            "| {} | `{:08X}` | {} (0x{:X}) | {} | {} | {} |\n",
+            m.name,
+            m.id,
+            m.pgn,
+            m.pgn,
+            period,
+            m.transmitter,
+            sigs.join("; ")
+        ));
+    }
+    s.push_str("\nNotes:\n\n");
+    for m in MESSAGES {
+        s.push_str(&format!("- **{}**: {}\n", m.name, m.comment));
+    }
+    s
+}

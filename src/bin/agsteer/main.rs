@@ -1,5 +1,7 @@
 //! `agsteer`: the technician's and developer's tool.
 
+mod dbc_cmd;
+
 use agsteer::config::Config;
 use agsteer::daemon::progress_file;
 use agsteer::demo::{self, DemoOptions};
@@ -50,6 +52,11 @@ enum Command {
         #[command(flatten)]
         cfg: ConfigArgs,
     },
+    /// The DBC codec: decode candump logs, encode frames, print the frame table.
+    Dbc {
+        #[command(subcommand)]
+        cmd: dbc_cmd::DbcCommand,
+    },
     /// Validate a configuration: print it resolved, or every problem (exit status 2).
     CheckConfig {
         /// Configuration file.
@@ -82,6 +89,7 @@ fn main() -> ExitCode {
             cfg,
         } => run_demo(&config, &out, json, resume, stop_after, &cfg.set),
         Command::CheckConfig { file, cfg } => check_config(&file, &cfg.set),
+        Command::Dbc { cmd } => dbc_cmd::run(cmd),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -1,0 +1,217 @@
+//! `agsteer dbc decode|encode|table`: the DBC codec on candump logs and the command line.
+
+use agsteer::can::codec::{self, find_name, CounterCheck, Role, MAX_SIGNALS};
+use agsteer::can::fastpacket::Reassembler;
+use agsteer::can::gnss::GnssPosition;
+use anyhow::{bail, Context, Result};
+use clap::Subcommand;
+use serde_json::{json, Map, Value};
+use std::io::{BufRead, Write};
+use std::path::PathBuf;
+
+#[derive(Subcommand)]
+pub enum DbcCommand {
+    /// Decode candump log lines (`candump -L` or `iface ID#HEX`) to one JSON object per frame.
+    Decode {
+        /// Log file; standard input when absent.
+        file: Option<PathBuf>,
+    },
+    /// Encode a frame: `agsteer dbc encode SteeringCommand Angle=1.5 Mode=1`; prints ID#HEX.
+    Encode {
+        /// Message name (case-insensitive).
+        name: String,
+        /// SIGNAL=VALUE in physical units; a not-available signal may be left out.
+        signals: Vec<String>,
+        /// J1939 source address (default: the DBC's).
+        #[arg(long, value_parser = parse_u8)]
+        source: Option<u8>,
+    },
+    /// Print the Markdown table of frames (dbc/FRAMES.md).
+    Table,
+}
+
+fn parse_u8(s: &str) -> Result<u8, String> {
+    let r = if let Some(h) = s.strip_prefix("0x") {
+        u8::from_str_radix(h, 16)
+    } else {
+        s.parse()
+    };
+    r.map_err(|e| format!("{s}: {e}"))
+}
+
+pub fn run(cmd: DbcCommand) -> Result<u8> {
+    match cmd {
+        DbcCommand::Table => {
+            print!("{}", codec::frames_markdown());
+            Ok(0)
+        }
+        DbcCommand::Encode {
+            name,
+            signals,
+            source,
+        } => encode(&name, &signals, source),
+        DbcCommand::Decode { file } => {
+            let stdout = std::io::stdout();
+            let mut out = stdout.lock();
+            let mut dec = LogDecoder::default();
+            match file {
+                Some(p) => {
+                    let f = std::fs::File::open(&p)
+                        .with_context(|| format!("opening {}", p.display()))?;
+                    dec.run(std::io::BufReader::new(f), &mut out)?;
+                }
+                None => dec.run(std::io::stdin().lock(), &mut out)?,
+            }
+            Ok(0)
+        }
+    }
+}
+
+fn encode(name: &str, signals: &[String], source: Option<u8>) -> Result<u8> {
+    let Some((_, def)) = find_name(name) else {
+        bail!("no message named {name}; see `agsteer dbc table`");
+    };
+    let mut values = [None; MAX_SIGNALS];
+    let mut counter = 0u8;
+    for kv in signals {
+        let (k, v) = kv
+            .split_once('=')
+            .with_context(|| format!("`{kv}`: expected SIGNAL=VALUE"))?;
+        let Some(i) = def
+            .signals
+            .iter()
+            .position(|s| s.name.eq_ignore_ascii_case(k.trim()))
+        else {
+            let names: Vec<&str> = def.signals.iter().map(|s| s.name).collect();
+            bail!(
+                "{} has no signal {k}; it has {}",
+                def.name,
+                names.join(", ")
+            );
+        };
+        let x: f64 = v
+            .trim()
+            .parse()
+            .with_context(|| format!("`{kv}`: not a number"))?;
+        match def.signals[i].role {
+            Role::Counter => counter = x as u8,
+            Role::Crc => {}
+            Role::Value => values[i] = Some(x),
+        }
+    }
+    let sa = source.unwrap_or((def.id & 0xFF) as u8);
+    let frame = codec::encode_values(def, &values, counter, sa)?;
+    println!("{}", frame.to_candump());
+    Ok(0)
+}
+
+/// Decodes candump lines, keeping counters and fast-packet state across lines.
+#[derive(Default)]
+pub struct LogDecoder {
+    counters: CounterCheck,
+    fast: Reassembler,
+}
+
+/// `(time, id, bytes)` of a candump line.
+pub fn parse_candump_line(line: &str) -> Option<(Option<f64>, u32, Vec<u8>)> {
+    let mut words = line.split_whitespace();
+    let mut first = words.next()?;
+    let mut t = None;
+    if let Some(ts) = first.strip_prefix('(').and_then(|s| s.strip_suffix(')')) {
+        t = ts.parse().ok();
+        first = words.next()?; // interface
+    }
+    let _iface = first;
+    let frame = words.next()?;
+    let (id, hex) = frame.split_once('#')?;
+    let id = u32::from_str_radix(id, 16).ok()?;
+    if hex.len() % 2 != 0 || hex.len() > 16 {
+        return None;
+    }
+    let bytes = (0..hex.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&hex[i..i + 2], 16).ok())
+        .collect::<Option<Vec<u8>>>()?;
+    Some((t, id, bytes))
+}
+
+impl LogDecoder {
+    /// Decode one line into the JSON objects it produces (one per frame, plus a reassembled
+    /// 129029 message when a fast-packet completes).
+    pub fn line(&mut self, line: &str) -> Vec<Value> {
+        let line = line.trim();
+        if line.is_empty() {
+            return Vec::new();
+        }
+        let Some((t, id, bytes)) = parse_candump_line(line) else {
+            return vec![json!({"line": line, "error": "not a candump line"})];
+        };
+        let mut obj = Map::new();
+        obj.insert("t".into(), t.map(Value::from).unwrap_or(Value::Null));
+        obj.insert("id".into(), Value::from(format!("{id:08X}")));
+        let mut extra = Vec::new();
+        match codec::decode(id, &bytes) {
+            Err(e) => {
+                if let Some((_, def)) = codec::find(id) {
+                    obj.insert("name".into(), Value::from(def.name));
+                }
+                obj.insert("error".into(), Value::from(e.to_string()));
+            }
+            Ok(d) => {
+                obj.insert("name".into(), Value::from(d.def.name));
+                let mut sig = Map::new();
+                for (i, s) in d.def.signals.iter().enumerate() {
+                    sig.insert(
+                        s.name.into(),
+                        d.values[i].map(Value::from).unwrap_or(Value::Null),
+                    );
+                }
+                obj.insert("signals".into(), Value::Object(sig));
+                if !self.counters.check(&d) {
+                    obj.insert("error".into(), Value::from("bad counter"));
+                }
+                if d.def.name == "GnssPositionData" {
+                    match self.fast.push(d.source, &bytes) {
+                        Err(e) => {
+                            obj.insert("error".into(), Value::from(e.to_string()));
+                        }
+                        Ok(Some(payload)) => extra.push(match GnssPosition::decode(payload) {
+                            Ok(g) => json!({
+                                "t": t, "id": format!("{id:08X}"), "name": "GnssPosition129029",
+                                "signals": {
+                                    "latitude_deg": g.latitude_deg, "longitude_deg": g.longitude_deg,
+                                    "altitude_m": g.altitude_m, "method": g.method,
+                                    "satellites": g.satellites, "hdop": g.hdop,
+                                    "correction_age_s": g.correction_age_s,
+                                    "time_s": g.time_s, "date_days": g.date_days,
+                                }
+                            }),
+                            Err(e) => json!({"t": t, "id": format!("{id:08X}"),
+                                "name": "GnssPosition129029", "error": e.to_string()}),
+                        }),
+                        Ok(None) => {}
+                    }
+                }
+            }
+        }
+        let mut v = vec![Value::Object(obj)];
+        v.extend(extra);
+        v
+    }
+
+    pub fn run(&mut self, input: impl BufRead, out: &mut impl Write) -> Result<()> {
+        for line in input.lines() {
+            let line = match line {
+                Ok(l) => l,
+                Err(e) => {
+                    writeln!(out, "{}", json!({"error": format!("unreadable line: {e}")}))?;
+                    continue;
+                }
+            };
+            for v in self.line(&line) {
+                writeln!(out, "{v}")?;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,158 @@
+//! The `agsteer` binary: check-config, dbc encode/decode (with fast-packet reassembly across
+//! lines), and the committed frame table.
+
+use agsteer::can::fastpacket::split;
+use agsteer::can::gnss::{GnssPosition, METHOD_RTK_FLOAT};
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+fn agsteer(args: &[&str], stdin: &str) -> (i32, String, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_agsteer"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("agsteer runs");
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(stdin.as_bytes())
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn check_config_reports_every_problem_with_status_2() {
+    let (code, out, _) = agsteer(&["check-config", "config/demo.toml"], "");
+    assert_eq!(code, 0);
+    assert!(out.contains("line_width_m = 3.0"));
+    let (code, _, err) = agsteer(
+        &[
+            "check-config",
+            "config/demo.toml",
+            "--set",
+            "guidance.a=0",
+            "--set",
+            "control.dt_s=2",
+        ],
+        "",
+    );
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("guidance.a = 0: must be an integer >= 1"),
+        "{err}"
+    );
+    assert!(
+        err.contains("control.dt_s = 2: must be in 0.005..=0.5"),
+        "{err}"
+    );
+    let (code, _, err) = agsteer(
+        &["check-config", "config/demo.toml", "--set", "control.dtt=1"],
+        "",
+    );
+    assert_eq!(code, 2);
+    assert!(err.contains("dtt"), "{err}");
+}
+
+#[test]
+fn dbc_encode_then_decode() {
+    let (code, out, err) = agsteer(
+        &[
+            "dbc",
+            "encode",
+            "WheelAngle",
+            "Angle=-12.34",
+            "Status=2",
+            "Counter=7",
+        ],
+        "",
+    );
+    assert_eq!(code, 0, "{err}");
+    let line = format!("(12.5) vcan0 {}", out.trim());
+    let (_, out, _) = agsteer(&["dbc", "decode"], &line);
+    let v: serde_json::Value = serde_json::from_str(out.lines().next().unwrap()).unwrap();
+    assert_eq!(v["name"], "WheelAngle");
+    assert_eq!(v["t"], 12.5);
+    assert!((v["signals"]["Angle"].as_f64().unwrap() + 12.34).abs() < 1e-9);
+    assert_eq!(v["signals"]["Status"], 2.0);
+    assert!(v.get("error").is_none());
+    let (code, _, err) = agsteer(&["dbc", "encode", "WheelAngle", "Angle=123"], "");
+    assert_ne!(code, 0);
+    assert!(err.contains("out of range"), "{err}");
+}
+
+#[test]
+fn dbc_decode_reassembles_129029_and_reports_bad_frames() {
+    let g = GnssPosition {
+        sid: 1,
+        date_days: 20_000,
+        time_s: 1000.0,
+        latitude_deg: 52.000_000_123_4,
+        longitude_deg: 5.000_000_567_8,
+        altitude_m: 10.0,
+        gnss_type: 4,
+        method: METHOD_RTK_FLOAT,
+        integrity: 0,
+        satellites: 18,
+        hdop: Some(0.8),
+        pdop: Some(1.2),
+        geoidal_separation_m: 45.0,
+        reference_stations: 1,
+        reference_station_id: 7,
+        correction_age_s: Some(0.6),
+    };
+    let mut frames = Vec::new();
+    split(&g.encode(), 2, &mut frames);
+    let hex = |f: &[u8; 8]| f.iter().map(|b| format!("{b:02X}")).collect::<String>();
+    let mut log = String::new();
+    for (k, f) in frames.iter().enumerate() {
+        log.push_str(&format!("({}.0) vcan0 0DF8051C#{}\n", k, hex(f)));
+    }
+    // The same message with two frames swapped: rejected.
+    split(&g.encode(), 3, &mut frames);
+    let second: Vec<[u8; 8]> = frames[frames.len() / 2..].to_vec();
+    for (k, f) in [0usize, 1, 3, 2, 4, 5, 6]
+        .iter()
+        .map(|&i| &second[i])
+        .enumerate()
+    {
+        log.push_str(&format!("({}.5) vcan0 0DF8051C#{}\n", k, hex(f)));
+    }
+    let (code, out, _) = agsteer(&["dbc", "decode"], &log);
+    assert_eq!(code, 0);
+    let objs: Vec<serde_json::Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let whole: Vec<&serde_json::Value> = objs
+        .iter()
+        .filter(|o| o["name"] == "GnssPosition129029")
+        .collect();
+    assert_eq!(whole.len(), 1, "only the in-order message completes");
+    assert!(
+        (whole[0]["signals"]["latitude_deg"].as_f64().unwrap() - 52.000_000_123_4).abs() < 1e-12
+    );
+    assert_eq!(whole[0]["signals"]["method"], 5);
+    assert!(objs
+        .iter()
+        .any(|o| o["error"].as_str().is_some_and(|e| e.contains("expected"))));
+}
+
+#[test]
+fn frames_table_is_up_to_date() {
+    let committed =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/dbc/FRAMES.md")).unwrap();
+    assert_eq!(
+        committed,
+        agsteer::can::codec::frames_markdown(),
+        "dbc/FRAMES.md is stale: run `agsteer dbc table > dbc/FRAMES.md`"
+    );
+}
