@@ -282,6 +282,92 @@ impl Default for SimConfig {
     }
 }
 
+/// What the steering output is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum OutputKind {
+    /// The proprietary steering-angle frame.
+    #[default]
+    Angle,
+    /// ISO 11783-7 Guidance System Command (curvature).
+    Curvature,
+    /// Both.
+    Both,
+}
+
+/// `[bus]`: the CAN side.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BusConfig {
+    /// SocketCAN interface, e.g. "can0" or "vcan0".
+    pub interface: String,
+    /// agsteer's J1939 source address (0..=253).
+    pub source_address: u8,
+    /// Steering output: "angle", "curvature" (ISOBUS) or "both".
+    pub output: OutputKind,
+    /// Guidance status frame period, s.
+    pub status_period_s: f64,
+    /// Unix socket answering status JSON ("" = none).
+    pub status_socket: String,
+}
+
+impl Default for BusConfig {
+    fn default() -> Self {
+        BusConfig {
+            interface: "can0".to_string(),
+            source_address: 0x2A,
+            output: OutputKind::Angle,
+            status_period_s: 0.1,
+            status_socket: "/run/agsteer/status.sock".to_string(),
+        }
+    }
+}
+
+/// `[safety]`: engage gating, input freshness and command limits.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SafetyConfig {
+    /// GNSS older than this disengages, s.
+    pub gnss_timeout_s: f64,
+    /// RTK float is tolerated this long, s (0 = never).
+    pub rtk_float_tolerance_s: f64,
+    /// Wheel angle older than this disengages, s.
+    pub wheel_angle_timeout_s: f64,
+    /// Allowed speed range, km/h.
+    pub min_speed_kmh: f64,
+    pub max_speed_kmh: f64,
+    /// Measured wheel angle this far from the command…, degrees
+    pub override_angle_deg: f64,
+    /// …for longer than this is an operator override, s.
+    pub override_time_s: f64,
+    /// Engaging needs |XTE| below this, m.
+    pub max_engage_xte_m: f64,
+    /// Engaging needs |heading error| below this, degrees.
+    pub max_engage_heading_error_deg: f64,
+    /// Largest commanded wheel-angle rate, degrees/s.
+    pub max_wheel_rate_deg_s: f64,
+    /// Largest lateral acceleration v²·κ, m/s².
+    pub a_lat_max_m_s2: f64,
+}
+
+impl Default for SafetyConfig {
+    fn default() -> Self {
+        SafetyConfig {
+            gnss_timeout_s: 0.3,
+            rtk_float_tolerance_s: 0.0,
+            wheel_angle_timeout_s: 0.1,
+            min_speed_kmh: 0.5,
+            max_speed_kmh: 25.0,
+            override_angle_deg: 15.0,
+            override_time_s: 0.5,
+            max_engage_xte_m: 1.0,
+            max_engage_heading_error_deg: 60.0,
+            max_wheel_rate_deg_s: 45.0,
+            a_lat_max_m_s2: 2.0,
+        }
+    }
+}
+
 /// `[progress]`: where job progress is kept across power loss.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -309,6 +395,8 @@ pub struct Config {
     pub track: TrackConfig,
     pub sim: SimConfig,
     pub progress: ProgressConfig,
+    pub bus: BusConfig,
+    pub safety: SafetyConfig,
 }
 
 /// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
@@ -482,6 +570,61 @@ impl Config {
         c.range("sim.start_offset_m", s.start_offset_m, -50.0, 50.0);
         c.range("sim.start_heading_deg", s.start_heading_deg, -90.0, 90.0);
         c.range("sim.max_time_s", s.max_time_s, 0.0, 1e7);
+        let b = &self.bus;
+        if b.interface.trim().is_empty() || b.interface.len() > 15 {
+            c.push(
+                "bus.interface",
+                format!("{:?}", b.interface),
+                "must be an interface name of 1 to 15 characters",
+            );
+        }
+        if b.source_address > 253 {
+            c.push(
+                "bus.source_address",
+                b.source_address.to_string(),
+                "must be a J1939 address in 0..=253",
+            );
+        }
+        c.range("bus.status_period_s", b.status_period_s, 0.01, 10.0);
+        let f = &self.safety;
+        c.range("safety.gnss_timeout_s", f.gnss_timeout_s, 0.05, 5.0);
+        c.range(
+            "safety.rtk_float_tolerance_s",
+            f.rtk_float_tolerance_s,
+            0.0,
+            3600.0,
+        );
+        c.range(
+            "safety.wheel_angle_timeout_s",
+            f.wheel_angle_timeout_s,
+            0.02,
+            2.0,
+        );
+        c.range("safety.min_speed_kmh", f.min_speed_kmh, 0.0, 50.0);
+        c.range("safety.max_speed_kmh", f.max_speed_kmh, 0.5, 60.0);
+        if f.min_speed_kmh >= f.max_speed_kmh {
+            c.push(
+                "safety.min_speed_kmh",
+                fmt_num(f.min_speed_kmh),
+                "must be below safety.max_speed_kmh",
+            );
+        }
+        c.range("safety.override_angle_deg", f.override_angle_deg, 0.5, 90.0);
+        c.range("safety.override_time_s", f.override_time_s, 0.0, 10.0);
+        c.range("safety.max_engage_xte_m", f.max_engage_xte_m, 0.01, 50.0);
+        c.range(
+            "safety.max_engage_heading_error_deg",
+            f.max_engage_heading_error_deg,
+            1.0,
+            180.0,
+        );
+        c.range(
+            "safety.max_wheel_rate_deg_s",
+            f.max_wheel_rate_deg_s,
+            1.0,
+            500.0,
+        );
+        c.range("safety.a_lat_max_m_s2", f.a_lat_max_m_s2, 0.1, 20.0);
         if self.progress.state_dir.trim().is_empty() {
             c.push("progress.state_dir", "\"\"".into(), "must not be empty");
         }
@@ -504,6 +647,27 @@ impl Config {
     /// Largest wheel angle, rad.
     pub fn max_wheel_angle(&self) -> f64 {
         self.vehicle.max_wheel_angle_deg.to_radians()
+    }
+
+    /// The safety supervisor's parameters, SI.
+    pub fn safety_params(&self) -> crate::safety::SafetyParams {
+        let f = &self.safety;
+        crate::safety::SafetyParams {
+            gnss_timeout: f.gnss_timeout_s,
+            rtk_float_tolerance: f.rtk_float_tolerance_s,
+            wheel_angle_timeout: f.wheel_angle_timeout_s,
+            invalid_threshold: 5,
+            min_speed: f.min_speed_kmh / 3.6,
+            max_speed: f.max_speed_kmh / 3.6,
+            override_angle: f.override_angle_deg.to_radians(),
+            override_time: f.override_time_s,
+            max_engage_xte: f.max_engage_xte_m,
+            max_engage_heading_error: f.max_engage_heading_error_deg.to_radians(),
+            max_wheel_angle: self.max_wheel_angle(),
+            max_wheel_rate: f.max_wheel_rate_deg_s.to_radians(),
+            a_lat_max: f.a_lat_max_m_s2,
+            wheelbase: self.vehicle.wheelbase_m,
+        }
     }
 }
 

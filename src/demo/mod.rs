@@ -6,13 +6,18 @@
 
 pub mod svg;
 
+use crate::can::bus::{CanBus, MemBus};
+use crate::can::codec::{OperatorCommand, Packer};
+use crate::can::Frame;
 use crate::config::{Config, TrackerChoice};
-use crate::control::{ControlError, Controller};
-use crate::estimate::GnssFix;
+use crate::control::node::{operator, ControllerNode};
+use crate::control::ControlError;
 use crate::geo::{left_normal, signed_offset, v2, Pose, Vec2};
 use crate::guidance::progress::{Phase, Progress};
 use crate::guidance::Event;
-use crate::sim::{SimOutput, SimParams, Simulator};
+use crate::safety::SafetyState;
+use crate::sim::can_node::{Scenario, SimAddresses, SimNode};
+use crate::sim::{SimParams, Simulator};
 use serde::Serialize;
 
 /// Work-line samples closer than this to the line start are excluded from the XTE figures, m.
@@ -136,6 +141,10 @@ pub struct Report {
     pub sim_time_s: f64,
     pub wall_time_s: f64,
     pub tracker: String,
+    /// Fraction of control periods steered by agsteer (engaged).
+    pub engaged_fraction: f64,
+    /// Frames on the in-memory bus (both directions).
+    pub frames: u64,
 }
 
 /// What to record and where to start.
@@ -147,6 +156,11 @@ pub struct DemoOptions {
     pub stop_after_lines: Option<u64>,
     /// Record the trace and the turns for the SVG.
     pub record_trace: bool,
+    /// Faults scripted into the simulator.
+    pub scenario: Scenario,
+    /// The simulated operator never presses engage again after the first engagement ends
+    /// (fault scenarios); by default they re-engage whenever the system is ready.
+    pub no_reengage: bool,
 }
 
 /// A recorded point of the true trajectory.
@@ -209,10 +223,10 @@ pub fn run(
     on_event: &mut dyn FnMut(f64, &Event),
 ) -> Result<DemoRun, ControlError> {
     let wall = std::time::Instant::now();
-    let mut ctrl = Controller::from_config(cfg, opts.resume.as_ref())?;
+    let mut node = ControllerNode::new(cfg, opts.resume.as_ref())?;
     let speed = cfg.speed();
     let start = match &opts.resume {
-        Some(_) => ctrl.path_start_pose(),
+        Some(_) => node.controller().path_start_pose(),
         None => None,
     }
     .unwrap_or_else(|| {
@@ -226,7 +240,17 @@ pub fn run(
             dir.y.atan2(dir.x) + cfg.sim.start_heading_deg.to_radians(),
         )
     });
-    let mut sim = Simulator::new(sim_params(cfg), start, speed);
+    let mut sim = SimNode::new(
+        Simulator::new(sim_params(cfg), start, speed),
+        *node.enu(),
+        SimAddresses::default(),
+        opts.scenario.clone(),
+    );
+    // The controller and the simulator talk only through frames on an in-memory bus.
+    let mut bus_ctrl = MemBus::new();
+    let mut bus_sim = bus_ctrl.node();
+    let mut terminal_bus = bus_ctrl.node();
+    let mut terminal = Packer::new(0x26);
     let dt = cfg.dt();
     let max_time = if cfg.sim.max_time_s > 0.0 {
         cfg.sim.max_time_s
@@ -240,14 +264,18 @@ pub fn run(
     let mut finished_lines = Vec::new();
     let mut lines_this_run = 0u64;
     let mut after_turn = opts.resume.is_some();
-    let mut outs: Vec<SimOutput> = Vec::with_capacity(64);
+    let mut sim_frames: Vec<(f64, Frame)> = Vec::with_capacity(64);
+    let mut ctrl_frames: Vec<Frame> = Vec::with_capacity(8);
     let mut trace = Trace::default();
     let mut distance = 0.0;
     let mut next_trace_at = 0.0;
     let mut max_wheel: f64 = 0.0;
     let mut max_rate: f64 = 0.0;
-    let mut last_wheel = sim.true_state().wheel_angle;
-    let mut command = 0.0;
+    let mut last_wheel = sim.sim().true_state().wheel_angle;
+    let mut engaged_ticks = 0u64;
+    let mut was_engaged = false;
+    let mut engagements = 0u64;
+    let mut frames = 0u64;
     let mut t = 0.0;
     let mut k: u64 = 0;
     let mut stopped = false;
@@ -255,23 +283,51 @@ pub fn run(
     while t <= max_time {
         t = k as f64 * dt;
         k += 1;
-        sim.advance_to(t, &mut outs);
-        for o in outs.drain(..) {
-            match o {
-                SimOutput::Gnss(m) => ctrl.on_fix(&GnssFix {
-                    t_received: m.t_delivered,
-                    antenna: m.antenna,
-                    heading: Some(m.heading),
-                    speed: m.speed,
-                    roll: None,
-                }),
-                SimOutput::WheelAngle { t, angle } => ctrl.on_wheel_angle(t, angle),
+        // Simulator → bus, each frame stamped with its delivery time.
+        sim_frames.clear();
+        sim.advance_to(t, &mut sim_frames);
+        for (ts, f) in &sim_frames {
+            bus_sim.set_time(*ts);
+            let _ = bus_sim.send(f);
+        }
+        frames += sim_frames.len() as u64;
+        // The operator presses engage when the system is ready.
+        let st = node.status();
+        if st.state == SafetyState::Ready && !(opts.no_reengage && engagements > 0) {
+            if let Ok(f) = terminal.pack(&OperatorCommand {
+                command: operator::ENGAGE,
+                nudge: 0.0,
+                job: 0.0,
+            }) {
+                terminal_bus.set_time(t);
+                let _ = terminal_bus.send(&f);
             }
         }
-        let out = ctrl.tick(t)?;
-        if ctrl.guidance().has_events() {
-            on_progress(&ctrl.guidance().progress());
-            let g = ctrl.guidance_mut();
+        while let Ok(Some(tf)) = bus_ctrl.try_recv() {
+            node.on_frame(&tf);
+        }
+        ctrl_frames.clear();
+        let cmd = node.tick(t, &mut ctrl_frames);
+        bus_ctrl.set_time(t);
+        for f in &ctrl_frames {
+            let _ = bus_ctrl.send(f);
+        }
+        frames += ctrl_frames.len() as u64;
+        while let Ok(Some(tf)) = bus_sim.try_recv() {
+            sim.on_frame(&tf);
+        }
+        while let Ok(Some(_)) = terminal_bus.try_recv() {}
+        if cmd.engaged {
+            engaged_ticks += 1;
+            if !was_engaged {
+                engagements += 1;
+            }
+        }
+        was_engaged = cmd.engaged;
+
+        if node.controller().guidance().has_events() {
+            on_progress(&node.controller().guidance().progress());
+            let g = node.controller_mut().guidance_mut();
             let mut turn_started = false;
             for ev in g.drain_events() {
                 match ev {
@@ -291,7 +347,8 @@ pub fn run(
                 after_turn = true;
                 if opts.record_trace {
                     trace.turns.push(
-                        ctrl.guidance()
+                        node.controller()
+                            .guidance()
                             .global_path()
                             .iter()
                             .map(|p| p.pos)
@@ -304,23 +361,19 @@ pub fn run(
                 break;
             }
         }
-        if ctrl.guidance().is_finished() {
+        if node.controller().guidance().is_finished() {
             break;
         }
-        if let Some(w) = out.wheel_angle {
-            command = w;
-        }
-        sim.set_command(command);
 
         // Ground truth scoring.
-        let truth = sim.true_state();
+        let truth = sim.sim().true_state();
         distance += truth.speed.abs() * dt;
         max_wheel = max_wheel.max(truth.wheel_angle.abs());
         if k > 1 {
             max_rate = max_rate.max((truth.wheel_angle - last_wheel).abs() / dt);
         }
         last_wheel = truth.wheel_angle;
-        let g = ctrl.guidance();
+        let g = node.controller().guidance();
         let mut xte_abs = None;
         if g.phase() == Phase::Work {
             let (block, rank) = (g.index_block(), g.index_rank());
@@ -351,6 +404,7 @@ pub fn run(
         }
     }
 
+    let ctrl = node.controller();
     let finished = ctrl.guidance().is_finished() && !stopped;
     let report = Report {
         finished,
@@ -367,6 +421,8 @@ pub fn run(
         sim_time_s: t,
         wall_time_s: wall.elapsed().as_secs_f64(),
         tracker: tracker_name(cfg.track.kind).to_string(),
+        engaged_fraction: engaged_ticks as f64 / k.max(1) as f64,
+        frames,
     };
     Ok(DemoRun {
         report,

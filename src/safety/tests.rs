@@ -108,7 +108,7 @@ fn rate_limit_starts_from_measured_angle() {
     s.request_engage();
     let c = s.step(DT, Some(-0.5), Some(0.0), Some(0.0));
     assert!(c.engaged);
-    let max_step = 30f64.to_radians() * DT;
+    let max_step = 45f64.to_radians() * DT;
     assert!(
         (c.wheel_angle - (0.1 - max_step)).abs() < 1e-12,
         "{}",

@@ -5,6 +5,8 @@
 //! Ground truth ([`Simulator::true_state`]) is the model's own state: scoring uses it, never an
 //! estimate. The same model drives the simulator on CAN.
 
+pub mod can_node;
+
 use crate::geo::{heading_vec, left_normal, wrap_angle, Pose, Vec2};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -192,6 +192,7 @@ fn run_demo(
         resume: resume_from,
         stop_after_lines: stop_after,
         record_trace: true,
+        ..Default::default()
     };
     let mut save_error = None;
     let mut on_progress = |p: &agsteer::guidance::progress::Progress| {

@@ -15,6 +15,8 @@ use crate::plan::turns::TurnParams;
 use crate::track::local_path::LocalPathParams;
 use crate::track::{pure_pursuit, TrackOutput, TrackerParams};
 
+pub mod node;
+
 /// The AB planner's parameters from the configuration.
 pub fn ab_params(cfg: &Config) -> AbParams {
     AbParams {

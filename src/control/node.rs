@@ -1,0 +1,308 @@
+//! The controller on the bus: frames in, frames out. `can` → `estimate` → `guidance` → `plan`
+//! → `track` → `safety` → `can`, without I/O: the daemon feeds it SocketCAN frames, the demo
+//! feeds it in-memory ones, so both run exactly the same code on exactly the same frames.
+
+use super::{ControlError, Controller};
+use crate::can::codec::{
+    self, CodecError, CogSogRapid, CounterCheck, DbcMessage, GnssPositionData, GuidanceStatus,
+    GuidanceSystemCommand, OperatorCommand, Packer, PositionRapid, SteeringCommand, VesselHeading,
+    WheelAngle, WheelSpeed,
+};
+use crate::can::fastpacket::Reassembler;
+use crate::can::gnss::{yaw_from_north_cw, GnssPosition, METHOD_RTK_FIXED, METHOD_RTK_FLOAT};
+use crate::can::{Frame, TimedFrame};
+use crate::config::{Config, OutputKind};
+use crate::estimate::GnssFix;
+use crate::geo::wgs84::{EnuFrame, LatLon};
+use crate::guidance::progress::Progress;
+use crate::safety::{
+    CheckedInput, FaultCode, FixQuality, SafetyState, SteeringCommand as Cmd, Supervisor,
+};
+use serde::Serialize;
+
+/// A dual-antenna heading older than this is not used, s.
+const HEADING_MAX_AGE: f64 = 0.5;
+/// A 129029 quality older than this no longer vouches for positions, s.
+const QUALITY_MAX_AGE: f64 = 2.0;
+
+/// Operator commands (OperatorCommand.Command).
+pub mod operator {
+    pub const ENGAGE: f64 = 1.0;
+    pub const DISENGAGE: f64 = 2.0;
+    pub const PAUSE: f64 = 3.0;
+    pub const RESUME: f64 = 4.0;
+}
+
+/// What `agsteer status` and the guidance status frame report.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct NodeStatus {
+    pub state: SafetyState,
+    pub fault: FaultCode,
+    pub engaged: bool,
+    pub fix: FixQuality,
+    pub xte_m: Option<f64>,
+    pub heading_error_deg: Option<f64>,
+    pub line: u64,
+    pub block: u64,
+    pub lines_done: u64,
+    pub finished: bool,
+    pub wheel_angle_command_deg: f64,
+    pub bad_frames: u64,
+}
+
+/// The controller node.
+pub struct ControllerNode {
+    ctrl: Controller,
+    supervisor: Supervisor,
+    enu: EnuFrame,
+    packer: Packer,
+    counters: CounterCheck,
+    fast: Reassembler,
+    output: OutputKind,
+    heading: Option<(f64, f64)>,
+    speed: f64,
+    quality: Option<(f64, FixQuality)>,
+    status_every: u64,
+    ticks: u64,
+    status: NodeStatus,
+}
+
+fn quality_of(method: u8) -> FixQuality {
+    match method {
+        METHOD_RTK_FIXED => FixQuality::RtkFixed,
+        METHOD_RTK_FLOAT => FixQuality::RtkFloat,
+        0 => FixQuality::None,
+        _ => FixQuality::Other,
+    }
+}
+
+fn checked_input(name: &str) -> Option<CheckedInput> {
+    match name {
+        "WheelAngle" => Some(CheckedInput::WheelAngle),
+        "OperatorCommand" => Some(CheckedInput::Operator),
+        "ImuAttitude" => Some(CheckedInput::Imu),
+        _ => None,
+    }
+}
+
+impl ControllerNode {
+    pub fn new(cfg: &Config, resume: Option<&Progress>) -> Result<Self, ControlError> {
+        Ok(ControllerNode {
+            ctrl: Controller::from_config(cfg, resume)?,
+            supervisor: Supervisor::new(cfg.safety_params()),
+            enu: EnuFrame::new(LatLon {
+                lat_deg: cfg.job.origin_lat_deg,
+                lon_deg: cfg.job.origin_lon_deg,
+            }),
+            packer: Packer::new(cfg.bus.source_address),
+            counters: CounterCheck::default(),
+            fast: Reassembler::default(),
+            output: cfg.bus.output,
+            heading: None,
+            speed: 0.0,
+            quality: None,
+            status_every: ((cfg.bus.status_period_s / cfg.dt()).round() as u64).max(1),
+            ticks: 0,
+            status: NodeStatus {
+                state: SafetyState::Disengaged,
+                fault: FaultCode::None,
+                engaged: false,
+                fix: FixQuality::None,
+                xte_m: None,
+                heading_error_deg: None,
+                line: 0,
+                block: 0,
+                lines_done: 0,
+                finished: false,
+                wheel_angle_command_deg: 0.0,
+                bad_frames: 0,
+            },
+        })
+    }
+
+    pub fn controller(&self) -> &Controller {
+        &self.ctrl
+    }
+    pub fn controller_mut(&mut self) -> &mut Controller {
+        &mut self.ctrl
+    }
+    pub fn supervisor(&self) -> &Supervisor {
+        &self.supervisor
+    }
+    pub fn supervisor_mut(&mut self) -> &mut Supervisor {
+        &mut self.supervisor
+    }
+    pub fn status(&self) -> NodeStatus {
+        self.status
+    }
+    /// The ENU frame GNSS positions are converted into.
+    pub fn enu(&self) -> &EnuFrame {
+        &self.enu
+    }
+
+    /// One received frame.
+    pub fn on_frame(&mut self, tf: &TimedFrame) {
+        let t = tf.t;
+        let d = match codec::decode(tf.frame.id, tf.frame.payload()) {
+            Ok(d) => d,
+            Err(CodecError::UnknownId(_)) => return,
+            Err(_) => {
+                self.status.bad_frames += 1;
+                if let Some((_, def)) = codec::find(tf.frame.id) {
+                    if let Some(input) = checked_input(def.name) {
+                        self.supervisor.on_frame_check(input, false);
+                    }
+                }
+                return;
+            }
+        };
+        if let Some(input) = checked_input(d.def.name) {
+            let ok = self.counters.check(&d);
+            self.supervisor.on_frame_check(input, ok);
+            if !ok {
+                self.status.bad_frames += 1;
+                return;
+            }
+        }
+        if let Some(m) = d.to::<WheelAngle>() {
+            if let Some(deg) = m.angle {
+                let a = deg.to_radians();
+                self.supervisor
+                    .on_wheel_angle(t, a, m.status == 2.0, m.status == 1.0);
+                self.ctrl.on_wheel_angle(t, a);
+            }
+        } else if let Some(m) = d.to::<PositionRapid>() {
+            let (Some(lat), Some(lon)) = (m.latitude, m.longitude) else {
+                return;
+            };
+            let antenna = self.enu.to_enu(LatLon {
+                lat_deg: lat,
+                lon_deg: lon,
+            });
+            let heading = self
+                .heading
+                .filter(|(th, _)| t - th <= HEADING_MAX_AGE)
+                .map(|(_, h)| h);
+            self.ctrl.on_fix(&GnssFix {
+                t_received: t,
+                antenna,
+                heading,
+                speed: self.speed,
+                roll: None,
+            });
+            let q = match self.quality {
+                Some((tq, q)) if t - tq <= QUALITY_MAX_AGE => q,
+                _ => FixQuality::None,
+            };
+            self.status.fix = q;
+            self.supervisor.on_gnss(t, q);
+        } else if let Some(m) = d.to::<VesselHeading>() {
+            if let Some(h) = m.heading {
+                self.heading = Some((t, yaw_from_north_cw(h)));
+            }
+        } else if let Some(m) = d.to::<CogSogRapid>() {
+            if let Some(sog) = m.sog {
+                if self.heading.is_none() {
+                    self.speed = sog;
+                }
+            }
+        } else if let Some(m) = d.to::<WheelSpeed>() {
+            if let Some(v) = m.speed {
+                let v = if m.direction == 0.0 { -v } else { v };
+                self.speed = v;
+                self.supervisor.on_speed(t, v);
+            }
+        } else if d.index == GnssPositionData::INDEX {
+            match self.fast.push(d.source, tf.frame.payload()) {
+                Ok(Some(payload)) => match GnssPosition::decode(payload) {
+                    Ok(g) => self.quality = Some((t, quality_of(g.method))),
+                    Err(_) => self.status.bad_frames += 1,
+                },
+                Ok(None) => {}
+                Err(_) => self.status.bad_frames += 1,
+            }
+        } else if let Some(m) = d.to::<OperatorCommand>() {
+            match m.command {
+                c if c == operator::ENGAGE || c == operator::RESUME => {
+                    self.supervisor.request_engage()
+                }
+                c if c == operator::DISENGAGE || c == operator::PAUSE => {
+                    self.supervisor.request_disengage()
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// One control period at `t`: appends the frames to send.
+    pub fn tick(&mut self, t: f64, out: &mut Vec<Frame>) -> Cmd {
+        let c = match self.ctrl.tick(t) {
+            Ok(c) => c,
+            Err(e) => {
+                tracing::error!("guidance: {e}");
+                super::ControlOutput {
+                    wheel_angle: None,
+                    estimate: None,
+                    xte: None,
+                    heading_error: None,
+                    track: None,
+                }
+            }
+        };
+        let cmd = self
+            .supervisor
+            .step(t, c.wheel_angle, c.xte, c.heading_error);
+        let angle_deg = cmd.wheel_angle.to_degrees().clamp(-90.0, 90.0);
+        let engaged = if cmd.engaged { 1.0 } else { 0.0 };
+        if matches!(self.output, OutputKind::Angle | OutputKind::Both) {
+            if let Ok(f) = self.packer.pack(&SteeringCommand {
+                angle: angle_deg,
+                mode: engaged,
+            }) {
+                out.push(f);
+            }
+        }
+        if matches!(self.output, OutputKind::Curvature | OutputKind::Both) {
+            // ISO 11783-7: km⁻¹, positive = right turn; ours is 1/m, positive = left.
+            let k = (-cmd.curvature * 1000.0).clamp(-8032.0, 8031.75);
+            if let Ok(f) = self.packer.pack(&GuidanceSystemCommand {
+                curvature: k,
+                command_status: engaged,
+            }) {
+                out.push(f);
+            }
+        }
+        let g = self.ctrl.guidance();
+        self.status = NodeStatus {
+            state: cmd.state,
+            fault: cmd.fault,
+            engaged: cmd.engaged,
+            xte_m: c.xte,
+            heading_error_deg: c.heading_error.map(f64::to_degrees),
+            line: g.current_line(),
+            block: g.index_block(),
+            lines_done: g.lines_done(),
+            finished: g.is_finished(),
+            wheel_angle_command_deg: angle_deg,
+            ..self.status
+        };
+        if self.ticks % self.status_every == 0 {
+            let s = &self.status;
+            let msg = GuidanceStatus {
+                state: s.state.code() as f64,
+                fault: (s.fault as u8).min(15) as f64,
+                xte: s
+                    .xte_m
+                    .map(|x| (x * 1000.0).round().clamp(-32767.0, 32766.0)),
+                heading_error: s.heading_error_deg.map(|h| h.clamp(-180.0, 180.0)),
+                line: (s.line <= 65534).then_some(s.line as f64),
+                block: (s.block <= 254).then_some(s.block as f64),
+            };
+            if let Ok(f) = self.packer.pack(&msg) {
+                out.push(f);
+            }
+        }
+        self.ticks += 1;
+        cmd
+    }
+}

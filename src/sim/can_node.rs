@@ -1,0 +1,288 @@
+//! The simulator on the bus: the same vehicle model, speaking the DBC's frames.
+//!
+//! It sends GNSS (129025 position, 129026 COG/SOG, 127250 heading, 129029 fast-packet with
+//! RTK fixed or float) at the GNSS rate with its latency, the wheel angle at its rate with
+//! counter and CRC, and the wheel-based speed. It receives steering commands and checks their
+//! CRC and counter as a real actuator would, ignoring bad ones; while not engaged (or without
+//! valid commands) the "driver" holds the wheels where they are. A scenario scripts faults.
+
+use super::{FixQuality, SimOutput, Simulator};
+use crate::can::codec::{
+    self, CogSogRapid, CounterCheck, DbcMessage, Packer, PositionRapid, SteeringCommand,
+    VesselHeading, WheelAngle, WheelSpeed,
+};
+use crate::can::fastpacket::split;
+use crate::can::gnss::{north_cw_from_yaw, GnssPosition, METHOD_RTK_FIXED, METHOD_RTK_FLOAT};
+use crate::can::{Frame, TimedFrame};
+use crate::geo::wgs84::EnuFrame;
+use serde::Deserialize;
+
+/// A scripted fault.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FaultKind {
+    /// No GNSS frames at all.
+    GnssDropout,
+    /// The receiver reports RTK float (and a larger error).
+    RtkFloat,
+    /// Wheel-angle frames with a wrong CRC.
+    CorruptWheelAngleCrc,
+    /// Wheel-angle frames with a counter that does not advance.
+    FrozenWheelAngleCounter,
+    /// No wheel-angle frames.
+    WheelAngleSilence,
+    /// No wheel-speed frames.
+    SpeedSilence,
+    /// The operator-override bit set in the wheel-angle status.
+    OperatorOverride,
+}
+
+/// One fault window.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fault {
+    pub kind: FaultKind,
+    /// Start, s of simulated time.
+    pub at_s: f64,
+    /// Duration, s.
+    pub duration_s: f64,
+}
+
+/// A scenario file (TOML): `[[fault]] kind = "gnss_dropout", at_s = 30.0, duration_s = 2.0`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    #[serde(default)]
+    pub fault: Vec<Fault>,
+}
+
+impl Scenario {
+    fn active(&self, kind: FaultKind, t: f64) -> bool {
+        self.fault
+            .iter()
+            .any(|f| f.kind == kind && t >= f.at_s && t < f.at_s + f.duration_s)
+    }
+}
+
+/// J1939 source addresses the simulator sends from.
+#[derive(Debug, Clone, Copy)]
+pub struct SimAddresses {
+    pub gnss: u8,
+    pub wheel_angle: u8,
+    pub tractor: u8,
+}
+
+impl Default for SimAddresses {
+    fn default() -> Self {
+        SimAddresses {
+            gnss: 0x1C,
+            wheel_angle: 0x13,
+            tractor: 0xF0,
+        }
+    }
+}
+
+/// The simulator node.
+pub struct SimNode {
+    sim: Simulator,
+    enu: EnuFrame,
+    gnss: Packer,
+    was: Packer,
+    tractor: Packer,
+    checks: CounterCheck,
+    scenario: Scenario,
+    outs: Vec<SimOutput>,
+    fp: Vec<[u8; 8]>,
+    seq: u8,
+    sid: u8,
+    engaged: bool,
+    rejected: u64,
+    frozen_counter: Option<Frame>,
+    distance: f64,
+}
+
+impl SimNode {
+    pub fn new(sim: Simulator, enu: EnuFrame, addresses: SimAddresses, scenario: Scenario) -> Self {
+        SimNode {
+            sim,
+            enu,
+            gnss: Packer::new(addresses.gnss),
+            was: Packer::new(addresses.wheel_angle),
+            tractor: Packer::new(addresses.tractor),
+            checks: CounterCheck::default(),
+            scenario,
+            outs: Vec::with_capacity(64),
+            fp: Vec::with_capacity(8),
+            seq: 0,
+            sid: 0,
+            engaged: false,
+            rejected: 0,
+            frozen_counter: None,
+            distance: 0.0,
+        }
+    }
+
+    pub fn sim(&self) -> &Simulator {
+        &self.sim
+    }
+    pub fn sim_mut(&mut self) -> &mut Simulator {
+        &mut self.sim
+    }
+    /// Is the last valid command engaged?
+    pub fn engaged(&self) -> bool {
+        self.engaged
+    }
+    /// Steering frames rejected (bad CRC or counter).
+    pub fn rejected(&self) -> u64 {
+        self.rejected
+    }
+
+    /// A received frame: steering commands are checked and applied.
+    pub fn on_frame(&mut self, tf: &TimedFrame) {
+        let Ok(d) = codec::decode(tf.frame.id, tf.frame.payload()) else {
+            if codec::find(tf.frame.id).is_some_and(|(_, m)| m.name == "SteeringCommand") {
+                self.rejected += 1;
+            }
+            return;
+        };
+        let Some(cmd) = d.to::<SteeringCommand>() else {
+            return;
+        };
+        if !self.checks.check(&d) {
+            self.rejected += 1;
+            return;
+        }
+        self.engaged = cmd.mode == 1.0;
+        if self.engaged {
+            self.sim.set_command(cmd.angle.to_radians());
+        } else {
+            // The driver holds the wheels.
+            let w = self.sim.true_state().wheel_angle;
+            self.sim.set_command(w);
+        }
+    }
+
+    /// Advance to `t`, appending (send time, frame) pairs in time order.
+    pub fn advance_to(&mut self, t: f64, out: &mut Vec<(f64, Frame)>) {
+        let before = self.sim.true_state().pose.pos;
+        let float = self.scenario.active(FaultKind::RtkFloat, t);
+        self.sim.set_fix(if float {
+            FixQuality::RtkFloat
+        } else {
+            FixQuality::RtkFixed
+        });
+        self.outs.clear();
+        let mut outs = std::mem::take(&mut self.outs);
+        self.sim.advance_to(t, &mut outs);
+        self.distance += (self.sim.true_state().pose.pos - before).norm();
+        for o in outs.drain(..) {
+            match o {
+                SimOutput::WheelAngle { t: ts, angle } => self.wheel_frames(ts, angle, out),
+                SimOutput::Gnss(m) => {
+                    let ts = m.t_delivered;
+                    if self.scenario.active(FaultKind::GnssDropout, ts) {
+                        continue;
+                    }
+                    self.sid = self.sid.wrapping_add(1) % 250;
+                    let ll = self.enu.to_latlon(m.antenna);
+                    let heading = north_cw_from_yaw(m.heading);
+                    if let Ok(f) = self.gnss.pack(&VesselHeading {
+                        sid: self.sid as f64,
+                        heading: Some((heading / 1e-4).floor() * 1e-4),
+                        deviation: None,
+                        variation: None,
+                        reference: 0.0,
+                    }) {
+                        out.push((ts, f));
+                    }
+                    let speed = m.speed.abs().min(655.32);
+                    if let Ok(f) = self.gnss.pack(&CogSogRapid {
+                        sid: self.sid as f64,
+                        cog_reference: 0.0,
+                        cog: Some((heading / 1e-4).floor() * 1e-4),
+                        sog: Some(speed),
+                    }) {
+                        out.push((ts, f));
+                    }
+                    let g = GnssPosition {
+                        sid: self.sid,
+                        date_days: 20_000,
+                        time_s: m.t_measured.rem_euclid(86_400.0),
+                        latitude_deg: ll.lat_deg,
+                        longitude_deg: ll.lon_deg,
+                        altitude_m: 0.0,
+                        gnss_type: 4,
+                        method: if m.fix == FixQuality::RtkFloat {
+                            METHOD_RTK_FLOAT
+                        } else {
+                            METHOD_RTK_FIXED
+                        },
+                        integrity: 0,
+                        satellites: 20,
+                        hdop: Some(0.7),
+                        pdop: Some(1.2),
+                        geoidal_separation_m: 0.0,
+                        reference_stations: 1,
+                        reference_station_id: 1,
+                        correction_age_s: Some(1.0),
+                    };
+                    self.fp.clear();
+                    split(&g.encode(), self.seq, &mut self.fp);
+                    self.seq = (self.seq + 1) & 7;
+                    let id =
+                        (codec::GnssPositionData::def().id & !0xFF) | self.gnss.source() as u32;
+                    for d in &self.fp {
+                        out.push((ts, Frame::new(id, d)));
+                    }
+                    if let Ok(f) = self.gnss.pack(&PositionRapid {
+                        latitude: Some(ll.lat_deg),
+                        longitude: Some(ll.lon_deg),
+                    }) {
+                        out.push((ts, f));
+                    }
+                    if !self.scenario.active(FaultKind::SpeedSilence, ts) {
+                        let v = self.sim.true_state().speed;
+                        if let Ok(f) = self.tractor.pack(&WheelSpeed {
+                            speed: Some(v.abs().min(64.254)),
+                            distance: Some(self.distance.rem_euclid(4_211_081.0)),
+                            max_time_tractor_power: 255.0,
+                            key_switch: 1.0,
+                            direction: if v < 0.0 { 0.0 } else { 1.0 },
+                        }) {
+                            out.push((ts, f));
+                        }
+                    }
+                }
+            }
+        }
+        self.outs = outs;
+    }
+
+    fn wheel_frames(&mut self, ts: f64, angle: f64, out: &mut Vec<(f64, Frame)>) {
+        if self.scenario.active(FaultKind::WheelAngleSilence, ts) {
+            return;
+        }
+        let status = if self.scenario.active(FaultKind::OperatorOverride, ts) {
+            2.0
+        } else {
+            0.0
+        };
+        let Ok(mut f) = self.was.pack(&WheelAngle {
+            angle: Some(angle.to_degrees().clamp(-90.0, 90.0)),
+            status,
+        }) else {
+            return;
+        };
+        if self.scenario.active(FaultKind::FrozenWheelAngleCounter, ts) {
+            let frozen = *self.frozen_counter.get_or_insert(f);
+            // The first frozen frame repeated, counter and all: a stuck sender.
+            f = frozen;
+        } else {
+            self.frozen_counter = None;
+        }
+        if self.scenario.active(FaultKind::CorruptWheelAngleCrc, ts) {
+            f.data[7] ^= 0x5A;
+        }
+        out.push((ts, f));
+    }
+}
