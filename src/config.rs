@@ -368,6 +368,22 @@ impl Default for SafetyConfig {
     }
 }
 
+/// `[daemon]`: the agsteerd process.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DaemonConfig {
+    /// Log filter when RUST_LOG is not set: "error", "warn", "info", "debug" or "trace".
+    pub log_level: String,
+}
+
+impl Default for DaemonConfig {
+    fn default() -> Self {
+        DaemonConfig {
+            log_level: "info".to_string(),
+        }
+    }
+}
+
 /// `[progress]`: where job progress is kept across power loss.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -397,6 +413,7 @@ pub struct Config {
     pub progress: ProgressConfig,
     pub bus: BusConfig,
     pub safety: SafetyConfig,
+    pub daemon: DaemonConfig,
 }
 
 /// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
@@ -625,6 +642,13 @@ impl Config {
             500.0,
         );
         c.range("safety.a_lat_max_m_s2", f.a_lat_max_m_s2, 0.1, 20.0);
+        if !["error", "warn", "info", "debug", "trace"].contains(&self.daemon.log_level.as_str()) {
+            c.push(
+                "daemon.log_level",
+                format!("{:?}", self.daemon.log_level),
+                "must be one of error, warn, info, debug, trace",
+            );
+        }
         if self.progress.state_dir.trim().is_empty() {
             c.push("progress.state_dir", "\"\"".into(), "must not be empty");
         }

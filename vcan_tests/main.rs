@@ -74,3 +74,267 @@ fn recv_within(bus: &mut SocketCanBus, d: Duration) -> Option<agsteer::can::Time
     }
     None
 }
+
+/// (a) A whole AB job closed-loop, agsteerd and agsteer sim as separate processes; true XTE
+/// figures from the simulator's trajectory. Also the daemon's CPU and memory at dt = 10 ms.
+/// (b) is checked on the candump capture of the same run (see `capture_checks`).
+#[test]
+fn a_closed_loop_job_on_vcan() {
+    let Some(iface) = vcan() else { return };
+    let daemon = start_daemon(&[]);
+    let dump = Candump::start(&iface);
+    let traj = "/tmp/agsteer-trajectory.csv";
+    let _sim = Proc::spawn(
+        "agsteer",
+        &[
+            "sim",
+            "--config",
+            CONFIG,
+            "--iface",
+            &iface,
+            "--trajectory",
+            traj,
+        ],
+    );
+    let mut term = Terminal::new(&iface);
+    assert!(term.engage(Duration::from_secs(10)), "engaged");
+    let cpu0 = proc_cpu_s(daemon.pid());
+    let t0 = Instant::now();
+    let done = wait_status(Duration::from_secs(150), |s| s["finished"] == true);
+    let wall = t0.elapsed().as_secs_f64();
+    let cpu = proc_cpu_s(daemon.pid()) - cpu0;
+    let (rss, hwm) = proc_rss_kb(daemon.pid());
+    let last = status().unwrap_or_default();
+    let lines = dump.stop();
+    assert!(done.is_some(), "job finished: {last}");
+    println!(
+        "DAEMON-RESOURCES cpu_percent={:.1} rss_kb={rss} hwm_kb={hwm} wall_s={wall:.1} loop={}",
+        100.0 * cpu / wall,
+        last["loop"]
+    );
+    let (rms, p95, max, n) = xte_from_trajectory(traj);
+    println!("VCAN-JOB-XTE rms_m={rms:.4} p95_m={p95:.4} max_m={max:.4} samples={n}");
+    assert!(n > 100);
+    assert!(rms < 0.05, "true XTE RMS {rms}");
+    capture_checks(&lines, 0.01);
+}
+
+/// (b) The capture decodes with `agsteer dbc decode` with zero unknown or invalid frames, and
+/// command frames come every dt (gaps within 2·dt). Also the GNSS-to-command latency.
+fn capture_checks(lines: &[String], dt: f64) {
+    std::fs::write("/tmp/agsteer-capture.log", lines.join("\n") + "\n").unwrap();
+    let out = run_ok("agsteer", &["dbc", "decode", "/tmp/agsteer-capture.log"]);
+    let objs: Vec<serde_json::Value> = out
+        .lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect();
+    let bad: Vec<&serde_json::Value> = objs.iter().filter(|o| o.get("error").is_some()).collect();
+    println!(
+        "CAPTURE frames={} decoded_objects={} errors={}",
+        lines.len(),
+        objs.len(),
+        bad.len()
+    );
+    assert!(objs.len() >= lines.len());
+    assert!(
+        bad.is_empty(),
+        "invalid frames: {:?}",
+        &bad[..bad.len().min(5)]
+    );
+    let cap = parse_candump(lines);
+    let cmds = steering_frames(&cap);
+    assert!(cmds.len() > 1000, "{} command frames", cmds.len());
+    let mut gaps: Vec<f64> = cmds.windows(2).map(|w| w[1].0 - w[0].0).collect();
+    gaps.sort_by(|a, b| a.total_cmp(b));
+    let max_gap = *gaps.last().unwrap();
+    println!(
+        "COMMAND-GAPS median_ms={:.2} p99_ms={:.2} max_ms={:.2} over {}",
+        pct(&gaps, 0.5) * 1e3,
+        pct(&gaps, 0.99) * 1e3,
+        max_gap * 1e3,
+        gaps.len()
+    );
+    assert!(max_gap <= 2.0 * dt + 1e-6, "a command gap of {max_gap} s");
+    // GNSS position frame arrival → next command frame.
+    let mut lat = Vec::new();
+    let mut ci = 0;
+    for (t, id, _) in &cap {
+        if id & 0x03FF_FF00 == 0x01F8_0100 {
+            while ci < cmds.len() && cmds[ci].0 < *t {
+                ci += 1;
+            }
+            if ci < cmds.len() {
+                lat.push(cmds[ci].0 - t);
+            }
+        }
+    }
+    lat.sort_by(|a, b| a.total_cmp(b));
+    println!(
+        "GNSS-TO-COMMAND median_ms={:.2} p99_ms={:.2} over {}",
+        pct(&lat, 0.5) * 1e3,
+        pct(&lat, 0.99) * 1e3,
+        lat.len()
+    );
+}
+
+/// (c) Engage and disengage sent with cansend are obeyed.
+#[test]
+fn c_engage_and_disengage_from_cansend() {
+    let Some(iface) = vcan() else { return };
+    let _daemon = start_daemon(&[]);
+    let _sim = Proc::spawn("agsteer", &["sim", "--config", CONFIG, "--iface", &iface]);
+    let mut term = Terminal::new(&iface);
+    assert!(wait_status(Duration::from_secs(10), |s| s["state"] == "ready").is_some());
+    assert_eq!(
+        status().unwrap()["engaged"],
+        false,
+        "nothing engages by itself"
+    );
+    assert!(term.engage(Duration::from_secs(5)));
+    let dump = Candump::start(&iface);
+    std::thread::sleep(Duration::from_millis(300));
+    term.send(2);
+    assert!(
+        wait_status(Duration::from_secs(1), |s| s["engaged"] == false).is_some(),
+        "disengage obeyed"
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    let cmds = steering_frames(&parse_candump(&dump.stop()));
+    assert!(
+        cmds.iter().any(|c| c.1 == 1) && cmds.last().is_some_and(|c| c.1 == 0),
+        "modes on the bus"
+    );
+}
+
+/// (d) `ip link set down` then `up`: the daemon survives, reports the fault, and sends again
+/// within 1 s of the link coming back.
+#[test]
+fn d_link_down_and_up() {
+    let Some(iface) = vcan() else { return };
+    let mut daemon = start_daemon(&[]);
+    let _sim = Proc::spawn("agsteer", &["sim", "--config", CONFIG, "--iface", &iface]);
+    let mut term = Terminal::new(&iface);
+    assert!(term.engage(Duration::from_secs(10)));
+    let _guard = LinkGuard(iface.clone());
+    link(&iface, false);
+    let down = wait_status(Duration::from_secs(2), |s| {
+        s["loop"]["bus_up"] == false && s["engaged"] == false
+    });
+    assert!(
+        down.is_some(),
+        "the daemon reports the bus down and disengages: {:?}",
+        status()
+    );
+    println!("LINK-DOWN-STATUS {}", down.unwrap_or_default());
+    std::thread::sleep(Duration::from_secs(2));
+    assert!(daemon.alive(), "daemon survives");
+    let mut rx = SocketCanBus::open(
+        &iface,
+        &[Filter {
+            id: 0x00FF_2000,
+            mask: 0x03FF_FF00,
+        }],
+    )
+    .unwrap();
+    link(&iface, true);
+    let t_up = Instant::now();
+    let f = recv_within(&mut rx, Duration::from_secs(1));
+    let back = t_up.elapsed().as_secs_f64();
+    println!("LINK-UP-TO-COMMAND ms={:.1}", back * 1e3);
+    let f = f.expect("a command within 1 s of the link coming back");
+    assert_eq!(f.frame.data[2], 0, "disengaged after the fault");
+    assert!(wait_status(Duration::from_secs(2), |s| s["loop"]["bus_up"] == true).is_some());
+    assert_eq!(status().unwrap()["engaged"], false, "no auto re-engage");
+}
+
+/// (e) SIGTERM: the last steering frame on the bus is a disengaged one; progress is saved.
+#[test]
+fn e_sigterm_disengages_last() {
+    let Some(iface) = vcan() else { return };
+    let mut daemon = start_daemon(&[]);
+    let _sim = Proc::spawn("agsteer", &["sim", "--config", CONFIG, "--iface", &iface]);
+    let mut term = Terminal::new(&iface);
+    assert!(term.engage(Duration::from_secs(10)));
+    let dump = Candump::start(&iface);
+    std::thread::sleep(Duration::from_millis(500));
+    daemon.signal(libc::SIGTERM);
+    let st = daemon.wait_for(Duration::from_secs(5)).expect("exits");
+    assert!(st.success(), "exit 0: {st:?}");
+    std::thread::sleep(Duration::from_millis(200));
+    let cmds = steering_frames(&parse_candump(&dump.stop()));
+    assert!(cmds.iter().any(|c| c.1 == 1), "was engaged");
+    assert_eq!(
+        cmds.last().map(|c| c.1),
+        Some(0),
+        "last command is disengaged"
+    );
+    assert!(std::path::Path::new("/tmp/agsteer/state/progress.json").exists());
+}
+
+/// True |XTE| on the work lines from the simulator's trajectory (10 m at each line end
+/// excluded): (rms, p95, max, samples).
+fn xte_from_trajectory(path: &str) -> (f64, f64, f64, usize) {
+    use agsteer::config::Config;
+    use agsteer::control::ab_params;
+    use agsteer::plan::abline::AbPlan;
+    let cfg = Config::load(std::path::Path::new(CONFIG), &[]).unwrap();
+    let plan = AbPlan::new(ab_params(&cfg)).unwrap();
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut xs = Vec::new();
+    for l in text.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').filter_map(|x| x.parse().ok()).collect();
+        if v.len() < 7 || v[6] != 1.0 {
+            continue;
+        }
+        let p = agsteer::geo::v2(v[1], v[2]);
+        let (a, b) = plan.line_endpoints(0, false);
+        let dir = (b - a).normalize();
+        let along = (p - a).dot(&dir);
+        if along < 10.0 || along > plan.line_length() - 10.0 {
+            continue;
+        }
+        let line = (0..cfg.job.line_num)
+            .min_by(|&i, &j| {
+                let di =
+                    agsteer::geo::signed_offset(&p, &plan.line_endpoints(i, false).0, &dir).abs();
+                let dj =
+                    agsteer::geo::signed_offset(&p, &plan.line_endpoints(j, false).0, &dir).abs();
+                di.total_cmp(&dj)
+            })
+            .unwrap();
+        xs.push(agsteer::geo::signed_offset(&p, &plan.line_endpoints(line, false).0, &dir).abs());
+    }
+    xs.sort_by(|a, b| a.total_cmp(b));
+    let n = xs.len().max(1);
+    let rms = (xs.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
+    (
+        rms,
+        pct(&xs, 0.95),
+        xs.last().copied().unwrap_or(0.0),
+        xs.len(),
+    )
+}
+
+/// CPU seconds (user + system) of a process.
+fn proc_cpu_s(pid: u32) -> f64 {
+    let s = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
+    let after = s.rsplit_once(')').map(|x| x.1).unwrap_or("");
+    let f: Vec<&str> = after.split_whitespace().collect();
+    let tick = 100.0; // USER_HZ
+    let u: f64 = f.get(11).and_then(|x| x.parse().ok()).unwrap_or(0.0);
+    let k: f64 = f.get(12).and_then(|x| x.parse().ok()).unwrap_or(0.0);
+    (u + k) / tick
+}
+
+/// (VmRSS, VmHWM) in kB.
+fn proc_rss_kb(pid: u32) -> (u64, u64) {
+    let s = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+    let get = |k: &str| {
+        s.lines()
+            .find(|l| l.starts_with(k))
+            .and_then(|l| l.split_whitespace().nth(1))
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(0)
+    };
+    (get("VmRSS:"), get("VmHWM:"))
+}

@@ -33,6 +33,17 @@ pub fn run_ok(prog: &str, args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// Brings the interface back up when dropped, even if the test fails.
+pub struct LinkGuard(pub String);
+
+impl Drop for LinkGuard {
+    fn drop(&mut self) {
+        let _ = Command::new("ip")
+            .args(["link", "set", &self.0, "up"])
+            .status();
+    }
+}
+
 /// Bring the interface down or up.
 pub fn link(iface: &str, up: bool) {
     run_ok(
@@ -130,4 +141,179 @@ pub fn echo_latency(iface: &str, n: usize) -> (f64, f64) {
     let _ = h.join();
     lat.sort_by(|a, b| a.total_cmp(b));
     (lat[n / 2], lat[(n * 99) / 100])
+}
+
+/// A spawned program, killed when dropped.
+pub struct Proc {
+    pub child: Child,
+}
+
+impl Proc {
+    /// Spawn with stderr to /tmp/NAME.log (the VM's serial console is slow).
+    pub fn spawn(prog: &str, args: &[&str]) -> Proc {
+        let log = std::fs::File::create(format!("/tmp/{prog}.log")).expect("log file");
+        let child = Command::new(prog)
+            .args(args)
+            .stdin(Stdio::null())
+            .stderr(log)
+            .spawn()
+            .unwrap_or_else(|e| panic!("{prog}: {e}"));
+        Proc { child }
+    }
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+    /// Send a signal.
+    pub fn signal(&self, sig: i32) {
+        // SAFETY: kill(2) on our own child's pid.
+        unsafe { libc::kill(self.child.id() as i32, sig) };
+    }
+    /// Wait up to `d` for the exit status.
+    pub fn wait_for(&mut self, d: Duration) -> Option<std::process::ExitStatus> {
+        let end = Instant::now() + d;
+        while Instant::now() < end {
+            if let Ok(Some(s)) = self.child.try_wait() {
+                return Some(s);
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        None
+    }
+    pub fn alive(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(None))
+    }
+}
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+pub const CONFIG: &str = "config/vcan.toml";
+pub const STATUS_SOCKET: &str = "/tmp/agsteer/status.sock";
+
+/// A fresh state directory and a started daemon.
+pub fn start_daemon(extra: &[&str]) -> Proc {
+    let _ = std::fs::remove_dir_all("/tmp/agsteer");
+    let mut args = vec!["--config", CONFIG];
+    args.extend_from_slice(extra);
+    let p = Proc::spawn("agsteerd", &args);
+    let end = Instant::now() + Duration::from_secs(10);
+    while Instant::now() < end && status().is_none() {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(status().is_some(), "agsteerd answers on its status socket");
+    p
+}
+
+/// The daemon's status JSON.
+pub fn status() -> Option<serde_json::Value> {
+    use std::io::Read;
+    let mut s = std::os::unix::net::UnixStream::connect(STATUS_SOCKET).ok()?;
+    s.set_read_timeout(Some(Duration::from_secs(1))).ok()?;
+    let mut text = String::new();
+    s.read_to_string(&mut text).ok()?;
+    serde_json::from_str(text.trim()).ok()
+}
+
+/// Wait until `pred(status)` holds.
+pub fn wait_status(
+    d: Duration,
+    pred: impl Fn(&serde_json::Value) -> bool,
+) -> Option<serde_json::Value> {
+    let end = Instant::now() + d;
+    while Instant::now() < end {
+        if let Some(s) = status() {
+            if pred(&s) {
+                return Some(s);
+            }
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    None
+}
+
+/// The operator terminal: OperatorCommand frames with a proper counter and CRC, via cansend.
+pub struct Terminal {
+    iface: String,
+    counter: u8,
+}
+
+impl Terminal {
+    pub fn new(iface: &str) -> Terminal {
+        Terminal {
+            iface: iface.to_string(),
+            counter: 0,
+        }
+    }
+    /// 1 engage, 2 disengage, 3 pause, 4 resume.
+    pub fn send(&mut self, command: u8) {
+        let frame = run_ok(
+            "agsteer",
+            &[
+                "dbc",
+                "encode",
+                "OperatorCommand",
+                &format!("Command={command}"),
+                "Nudge=0",
+                "Job=0",
+                &format!("Counter={}", self.counter),
+            ],
+        );
+        self.counter = (self.counter + 1) & 0x0F;
+        run_ok("cansend", &[&self.iface, frame.trim()]);
+    }
+    /// Press engage until the daemon reports engaged.
+    pub fn engage(&mut self, d: Duration) -> bool {
+        let end = Instant::now() + d;
+        while Instant::now() < end {
+            if wait_status(Duration::from_millis(300), |s| s["state"] == "ready").is_some() {
+                self.send(1);
+                if wait_status(Duration::from_millis(500), |s| s["engaged"] == true).is_some() {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// (time, id, data) of candump -L lines.
+pub fn parse_candump(lines: &[String]) -> Vec<(f64, u32, Vec<u8>)> {
+    lines
+        .iter()
+        .filter_map(|l| {
+            let mut w = l.split_whitespace();
+            let t: f64 = w
+                .next()?
+                .trim_matches(|c| c == '(' || c == ')')
+                .parse()
+                .ok()?;
+            let _iface = w.next()?;
+            let (id, hex) = w.next()?.split_once('#')?;
+            let id = u32::from_str_radix(id, 16).ok()?;
+            let data = (0..hex.len() / 2)
+                .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).ok())
+                .collect::<Option<Vec<u8>>>()?;
+            Some((t, id, data))
+        })
+        .collect()
+}
+
+/// Steering command frames (PGN 0xFF20) in a capture: (time, mode).
+pub fn steering_frames(cap: &[(f64, u32, Vec<u8>)]) -> Vec<(f64, u8)> {
+    cap.iter()
+        .filter(|(_, id, _)| id & 0x03FF_FF00 == 0x00FF_2000)
+        .map(|(t, _, d)| (*t, d.get(2).copied().unwrap_or(0xFF)))
+        .collect()
+}
+
+/// Percentile of a sorted slice.
+pub fn pct(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    sorted[((sorted.len() as f64 * p) as usize).min(sorted.len() - 1)]
 }

@@ -1,3 +1,5 @@
-//! The daemon's I/O: progress files, and (with the bus) the control loop runtime.
+//! The daemon's I/O: the agsteerd runtime, progress files, systemd notifications.
 
+pub mod notify;
 pub mod progress_file;
+pub mod run;

@@ -1,6 +1,7 @@
 //! `agsteer`: the technician's and developer's tool.
 
 mod dbc_cmd;
+mod sim_cmd;
 
 use agsteer::config::Config;
 use agsteer::daemon::progress_file;
@@ -52,6 +53,35 @@ enum Command {
         #[command(flatten)]
         cfg: ConfigArgs,
     },
+    /// Run the vehicle simulator on a CAN interface in real time.
+    Sim {
+        /// CAN interface (default: the config's bus.interface).
+        #[arg(long)]
+        iface: Option<String>,
+        /// Configuration file.
+        #[arg(long, default_value = "config/demo.toml")]
+        config: PathBuf,
+        /// Fault scenario (TOML with [[fault]] kind, at_s, duration_s).
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Write the true trajectory (CSV) here, for scoring.
+        #[arg(long)]
+        trajectory: Option<PathBuf>,
+        /// Stop after this many seconds (default: run until killed).
+        #[arg(long)]
+        duration: Option<f64>,
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    },
+    /// Print the running daemon's status (state, fix, XTE, line, block, loop timing).
+    Status {
+        /// Status socket (default: the config's bus.status_socket).
+        #[arg(long)]
+        socket: Option<PathBuf>,
+        /// Configuration file naming the socket.
+        #[arg(long, default_value = "/etc/agsteer/agsteer.toml")]
+        config: PathBuf,
+    },
     /// The DBC codec: decode candump logs, encode frames, print the frame table.
     Dbc {
         #[command(subcommand)]
@@ -90,6 +120,30 @@ fn main() -> ExitCode {
         } => run_demo(&config, &out, json, resume, stop_after, &cfg.set),
         Command::CheckConfig { file, cfg } => check_config(&file, &cfg.set),
         Command::Dbc { cmd } => dbc_cmd::run(cmd),
+        Command::Sim {
+            iface,
+            config,
+            scenario,
+            trajectory,
+            duration,
+            cfg,
+        } => load_config(&config, &cfg.set).and_then(|c| {
+            let iface = iface.unwrap_or_else(|| c.bus.interface.clone());
+            sim_cmd::run(
+                &iface,
+                &c,
+                scenario.as_deref(),
+                trajectory.as_deref(),
+                duration,
+            )
+        }),
+        Command::Status { socket, config } => {
+            let path = match socket {
+                Some(p) => Ok(p),
+                None => load_config(&config, &[]).map(|c| PathBuf::from(c.bus.status_socket)),
+            };
+            path.and_then(|p| sim_cmd::status(&p))
+        }
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -1,0 +1,134 @@
+//! `agsteer sim`: the vehicle simulator on a CAN interface, in real time.
+
+use agsteer::can::bus::{monotonic_s, CanBus, SocketCanBus};
+use agsteer::can::Frame;
+use agsteer::config::Config;
+use agsteer::demo::sim_params;
+use agsteer::geo::wgs84::{EnuFrame, LatLon};
+use agsteer::geo::{left_normal, v2, Pose};
+use agsteer::sim::can_node::{Scenario, SimAddresses, SimNode};
+use agsteer::sim::Simulator;
+use anyhow::{Context, Result};
+use std::io::Write;
+use std::path::Path;
+use std::time::Duration;
+
+/// Trajectory samples are written this often, s.
+const TRAJECTORY_PERIOD_S: f64 = 0.05;
+
+pub fn run(
+    iface: &str,
+    cfg: &Config,
+    scenario: Option<&Path>,
+    trajectory: Option<&Path>,
+    duration_s: Option<f64>,
+) -> Result<u8> {
+    let scenario: Scenario = match scenario {
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("reading scenario {}", p.display()))?;
+            toml::from_str(&text).with_context(|| format!("scenario {}", p.display()))?
+        }
+        None => Scenario::default(),
+    };
+    let a = v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]);
+    let b = v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]);
+    let dir = (b - a).normalize();
+    let p = a + left_normal(&dir) * cfg.sim.start_offset_m;
+    let start = Pose::new(
+        p.x,
+        p.y,
+        dir.y.atan2(dir.x) + cfg.sim.start_heading_deg.to_radians(),
+    );
+    let enu = EnuFrame::new(LatLon {
+        lat_deg: cfg.job.origin_lat_deg,
+        lon_deg: cfg.job.origin_lon_deg,
+    });
+    let mut node = SimNode::new(
+        Simulator::new(sim_params(cfg), start, cfg.speed()),
+        enu,
+        SimAddresses::default(),
+        scenario,
+    );
+    let mut bus =
+        SocketCanBus::open(iface, &[]).with_context(|| format!("opening CAN interface {iface}"))?;
+    let mut traj = match trajectory {
+        Some(p) => {
+            let mut f = std::io::BufWriter::new(
+                std::fs::File::create(p).with_context(|| format!("creating {}", p.display()))?,
+            );
+            writeln!(
+                f,
+                "t_s,x_m,y_m,heading_rad,speed_m_s,wheel_angle_rad,engaged"
+            )?;
+            Some(f)
+        }
+        None => None,
+    };
+    let t0 = monotonic_s();
+    let mut frames: Vec<(f64, Frame)> = Vec::with_capacity(64);
+    let mut next_traj = 0.0;
+    let mut send_errors = 0u64;
+    tracing::info!(interface = iface, "simulator running");
+    loop {
+        let t = monotonic_s() - t0;
+        if duration_s.is_some_and(|d| t >= d) {
+            break;
+        }
+        frames.clear();
+        node.advance_to(t, &mut frames);
+        for (_, f) in &frames {
+            if bus.send(f).is_err() {
+                send_errors += 1;
+            }
+        }
+        loop {
+            match bus.try_recv() {
+                Ok(Some(tf)) => node.on_frame(&tf),
+                Ok(None) => break,
+                Err(_) => {
+                    std::thread::sleep(Duration::from_millis(10));
+                    break;
+                }
+            }
+        }
+        if let Some(f) = traj.as_mut() {
+            if t >= next_traj {
+                let s = node.sim().true_state();
+                writeln!(
+                    f,
+                    "{:.3},{:.4},{:.4},{:.6},{:.3},{:.5},{}",
+                    t,
+                    s.pose.pos.x,
+                    s.pose.pos.y,
+                    s.pose.heading,
+                    s.speed,
+                    s.wheel_angle,
+                    node.engaged() as u8
+                )?;
+                f.flush()?;
+                next_traj = t + TRAJECTORY_PERIOD_S;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    tracing::info!(
+        rejected_commands = node.rejected(),
+        send_errors,
+        "simulator stopped"
+    );
+    Ok(0)
+}
+
+/// `agsteer status`: ask the daemon's status socket.
+pub fn status(socket: &Path) -> Result<u8> {
+    use std::io::Read;
+    let mut s = std::os::unix::net::UnixStream::connect(socket)
+        .with_context(|| format!("connecting to {}", socket.display()))?;
+    s.set_read_timeout(Some(Duration::from_secs(2)))?;
+    let mut text = String::new();
+    s.read_to_string(&mut text)?;
+    let v: serde_json::Value = serde_json::from_str(text.trim()).context("status reply")?;
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(0)
+}

@@ -1,0 +1,342 @@
+//! The agsteerd runtime: SocketCAN in and out, the control loop on a timer, the status
+//! socket, progress saving, signals.
+//!
+//! One single-threaded tokio runtime. A reader task turns SocketCAN frames into messages on a
+//! bounded channel; the main loop selects over that channel, the control timer, status-socket
+//! connections and signals. The control step itself never waits on I/O: frames are sent with a
+//! non-blocking write, and progress is handed to a writer thread through a bounded channel
+//! (a full channel skips a save rather than stall the loop; the next line change saves again).
+
+use super::progress_file;
+use crate::can::bus::{monotonic_s, AsyncSocketCan, BusError, Filter};
+use crate::can::{Frame, TimedFrame};
+use crate::config::Config;
+use crate::control::node::{ControllerNode, NodeStatus};
+use crate::guidance::progress::Progress;
+use crate::guidance::Event;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::Duration;
+use tokio::io::AsyncWriteExt;
+use tokio::sync::mpsc as tmpsc;
+
+/// Errors that stop the daemon.
+#[derive(Debug, thiserror::Error)]
+pub enum DaemonError {
+    #[error("opening CAN interface {iface}: {source}")]
+    Open { iface: String, source: BusError },
+    #[error("status socket {path}: {source}")]
+    Status {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Control(#[from] crate::control::ControlError),
+    #[error("runtime: {0}")]
+    Runtime(std::io::Error),
+}
+
+/// Control-loop timing, for the status socket.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct LoopStats {
+    pub ticks: u64,
+    /// Ticks that started more than one period late.
+    pub deadline_misses: u64,
+    pub max_late_ms: f64,
+    pub mean_late_ms: f64,
+    /// Duration of the last control step, µs.
+    pub last_step_us: f64,
+    pub max_step_us: f64,
+    pub frames_in: u64,
+    pub send_errors: u64,
+    pub bus_up: bool,
+}
+
+#[derive(Serialize)]
+struct StatusReply<'a> {
+    #[serde(flatten)]
+    node: NodeStatus,
+    #[serde(rename = "loop")]
+    timing: &'a LoopStats,
+    interface: &'a str,
+    dt_s: f64,
+}
+
+enum BusEvent {
+    Frame(TimedFrame),
+    Down(String),
+}
+
+/// The frames agsteerd listens to (by PGN, any source address).
+pub fn receive_filters() -> Vec<Filter> {
+    crate::can::codec::MESSAGES
+        .iter()
+        .filter(|m| m.transmitter != "AGSTEER")
+        .map(|m| Filter {
+            id: m.id,
+            mask: if m.pdu1 { 0x03FF_0000 } else { 0x03FF_FF00 },
+        })
+        .collect()
+}
+
+fn spawn_progress_writer(path: PathBuf) -> mpsc::SyncSender<Progress> {
+    let (tx, rx) = mpsc::sync_channel::<Progress>(4);
+    std::thread::Builder::new()
+        .name("agsteer-progress".into())
+        .spawn(move || {
+            for p in rx {
+                if let Err(e) = progress_file::save(&path, &p) {
+                    tracing::error!("saving progress: {e}");
+                }
+            }
+        })
+        .ok();
+    tx
+}
+
+/// Load saved progress for this job: `None` when there is none, it is corrupt (moved aside)
+/// or it belongs to another job.
+pub fn load_progress(cfg: &Config, path: &Path) -> Option<Progress> {
+    match progress_file::load(path) {
+        Ok(Some(p)) => {
+            if p.job == crate::guidance::progress::JobDefinition::from_config(cfg) {
+                tracing::info!(
+                    lines_done = p.lines_done,
+                    block = p.index_block,
+                    rank = p.index_rank,
+                    "resuming the job from {}",
+                    path.display()
+                );
+                Some(p)
+            } else {
+                tracing::warn!(
+                    "{} belongs to another job (its parameters differ); starting this job from the beginning",
+                    path.display()
+                );
+                None
+            }
+        }
+        Ok(None) => None,
+        Err(e) => {
+            tracing::error!("{e}; starting the job from the beginning, disengaged");
+            None
+        }
+    }
+}
+
+fn send_all(bus: &AsyncSocketCan, frames: &[Frame], stats: &mut LoopStats) -> bool {
+    let mut ok = true;
+    for f in frames {
+        if let Err(e) = bus.try_send(f) {
+            stats.send_errors += 1;
+            if stats.send_errors.is_power_of_two() {
+                tracing::warn!("sending {:08X}: {e}", f.id);
+            }
+            ok = false;
+        }
+    }
+    ok
+}
+
+fn log_event(ev: &Event) {
+    match ev {
+        Event::LineStarted { block, rank, line } => {
+            tracing::info!(block, rank, line, "line started")
+        }
+        Event::LineFinished { block, rank, line } => {
+            tracing::info!(block, rank, line, "line finished")
+        }
+        Event::TurnStarted { from_line, to_line } => {
+            tracing::info!(from_line, to_line, "turn started")
+        }
+        Event::BlockChanged { block } => tracing::info!(block, "block changed"),
+        Event::JobFinished { lines_done } => tracing::info!(lines_done, "job finished"),
+    }
+}
+
+/// Run the daemon until SIGTERM or SIGINT.
+pub fn run(cfg: Config) -> Result<(), DaemonError> {
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .map_err(DaemonError::Runtime)?;
+    rt.block_on(run_async(cfg))
+}
+
+async fn run_async(cfg: Config) -> Result<(), DaemonError> {
+    use tokio::signal::unix::{signal, SignalKind};
+    let iface = cfg.bus.interface.clone();
+    let bus = std::rc::Rc::new(AsyncSocketCan::open(&iface, &receive_filters()).map_err(
+        |source| DaemonError::Open {
+            iface: iface.clone(),
+            source,
+        },
+    )?);
+    let state_dir = PathBuf::from(&cfg.progress.state_dir);
+    let progress_path = progress_file::progress_path(&state_dir);
+    let resume = load_progress(&cfg, &progress_path);
+    let mut node = ControllerNode::new(&cfg, resume.as_ref())?;
+    let progress_tx = spawn_progress_writer(progress_path.clone());
+
+    let listener = if cfg.bus.status_socket.is_empty() {
+        None
+    } else {
+        let path = PathBuf::from(&cfg.bus.status_socket);
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        let _ = std::fs::remove_file(&path);
+        let l = tokio::net::UnixListener::bind(&path).map_err(|source| DaemonError::Status {
+            path: cfg.bus.status_socket.clone(),
+            source,
+        })?;
+        use std::os::unix::fs::PermissionsExt;
+        let _ = std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o660));
+        Some(l)
+    };
+
+    // Reader task: frames → channel; errors → Down, with a back-off, never ending.
+    let (tx, mut rx) = tmpsc::channel::<BusEvent>(4096);
+    let reader_bus = bus.clone();
+    let local = tokio::task::LocalSet::new();
+    local.spawn_local(async move {
+        loop {
+            match reader_bus.recv().await {
+                Ok(tf) => {
+                    // A full channel drops the frame: inputs are periodic, the next one comes.
+                    let _ = tx.try_send(BusEvent::Frame(tf));
+                }
+                Err(e) => {
+                    let _ = tx.try_send(BusEvent::Down(e.to_string()));
+                    tokio::time::sleep(Duration::from_millis(50)).await;
+                }
+            }
+        }
+    });
+
+    let dt = cfg.dt();
+    let mut interval = tokio::time::interval(Duration::from_secs_f64(dt));
+    interval.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    let mut sigterm = signal(SignalKind::terminate()).map_err(DaemonError::Runtime)?;
+    let mut sigint = signal(SignalKind::interrupt()).map_err(DaemonError::Runtime)?;
+    let mut sighup = signal(SignalKind::hangup()).map_err(DaemonError::Runtime)?;
+    let mut frames: Vec<Frame> = Vec::with_capacity(8);
+    let mut stats = LoopStats {
+        bus_up: true,
+        ..Default::default()
+    };
+    let mut late_sum = 0.0;
+    let mut bus_up = true;
+    tracing::info!(interface = %iface, dt_s = dt, "agsteerd running");
+    crate::daemon::notify::ready();
+
+    local
+        .run_until(async {
+            loop {
+                tokio::select! {
+                    biased;
+                    _ = sigterm.recv() => break,
+                    _ = sigint.recv() => break,
+                    _ = sighup.recv() => {
+                        tracing::warn!("SIGHUP: configuration reload is not supported yet; keeping the running configuration");
+                    }
+                    scheduled = interval.tick() => {
+                        let late = scheduled.elapsed().as_secs_f64();
+                        let start = std::time::Instant::now();
+                        let t = monotonic_s();
+                        frames.clear();
+                        node.tick(t, &mut frames);
+                        let sent = send_all(&bus, &frames, &mut stats);
+                        if sent && !bus_up {
+                            tracing::info!("CAN interface {iface} is back");
+                            bus_up = true;
+                            node.supervisor_mut().on_bus(true);
+                        } else if !sent && bus_up {
+                            tracing::error!("CAN interface {iface} is down");
+                            bus_up = false;
+                            node.supervisor_mut().on_bus(false);
+                        }
+                        stats.bus_up = bus_up;
+                        if node.controller().guidance().has_events() {
+                            let p = node.controller().guidance().progress();
+                            if progress_tx.try_send(p).is_err() {
+                                tracing::warn!("progress writer busy; this save is skipped");
+                            }
+                            for ev in node.controller_mut().guidance_mut().drain_events() {
+                                log_event(&ev);
+                            }
+                        }
+                        stats.ticks += 1;
+                        if late > dt {
+                            stats.deadline_misses += 1;
+                        }
+                        late_sum += late;
+                        stats.max_late_ms = stats.max_late_ms.max(late * 1e3);
+                        stats.mean_late_ms = late_sum / stats.ticks as f64 * 1e3;
+                        stats.last_step_us = start.elapsed().as_secs_f64() * 1e6;
+                        stats.max_step_us = stats.max_step_us.max(stats.last_step_us);
+                        if late <= dt {
+                            crate::daemon::notify::watchdog();
+                        }
+                    }
+                    ev = rx.recv() => match ev {
+                        Some(BusEvent::Frame(tf)) => {
+                            stats.frames_in += 1;
+                            node.on_frame(&tf);
+                        }
+                        Some(BusEvent::Down(e)) => {
+                            if bus_up {
+                                tracing::error!("CAN interface {iface}: {e}");
+                                bus_up = false;
+                                node.supervisor_mut().on_bus(false);
+                            }
+                        }
+                        None => break,
+                    },
+                    conn = async {
+                        match &listener {
+                            Some(l) => l.accept().await,
+                            None => std::future::pending().await,
+                        }
+                    } => {
+                        if let Ok((mut stream, _)) = conn {
+                            let reply = StatusReply {
+                                node: node.status(),
+                                timing: &stats,
+                                interface: &iface,
+                                dt_s: dt,
+                            };
+                            let mut text = serde_json::to_string(&reply).unwrap_or_default();
+                            text.push('\n');
+                            // A slow reader gets a short deadline, never the control loop.
+                            let _ = tokio::time::timeout(
+                                Duration::from_millis(5),
+                                stream.write_all(text.as_bytes()),
+                            )
+                            .await;
+                        }
+                    }
+                }
+            }
+        })
+        .await;
+
+    // Shut down: a disengaged command goes out last, progress is saved.
+    tracing::info!("stopping: sending a disengaged command and saving progress");
+    node.supervisor_mut().request_disengage();
+    for _ in 0..2 {
+        frames.clear();
+        node.tick(monotonic_s(), &mut frames);
+        send_all(&bus, &frames, &mut stats);
+    }
+    drop(progress_tx);
+    let p = node.controller().guidance().progress();
+    if let Err(e) = progress_file::save(&progress_path, &p) {
+        tracing::error!("saving progress: {e}");
+    }
+    if !cfg.bus.status_socket.is_empty() {
+        let _ = std::fs::remove_file(&cfg.bus.status_socket);
+    }
+    Ok(())
+}
