@@ -374,12 +374,16 @@ impl Default for SafetyConfig {
 pub struct DaemonConfig {
     /// Log filter when RUST_LOG is not set: "error", "warn", "info", "debug" or "trace".
     pub log_level: String,
+    /// SCHED_FIFO priority of the control loop (1..=99); 0 = the normal scheduler. Needs root
+    /// or CAP_SYS_NICE.
+    pub realtime_priority: u8,
 }
 
 impl Default for DaemonConfig {
     fn default() -> Self {
         DaemonConfig {
             log_level: "info".to_string(),
+            realtime_priority: 0,
         }
     }
 }
@@ -647,6 +651,13 @@ impl Config {
                 "daemon.log_level",
                 format!("{:?}", self.daemon.log_level),
                 "must be one of error, warn, info, debug, trace",
+            );
+        }
+        if self.daemon.realtime_priority > 99 {
+            c.push(
+                "daemon.realtime_priority",
+                self.daemon.realtime_priority.to_string(),
+                "must be in 0..=99 (0 = normal scheduling)",
             );
         }
         if self.progress.state_dir.trim().is_empty() {

@@ -1,8 +1,6 @@
 //! Helpers for the vcan tests: the interface, spawning programs, candump captures, link
 //! up/down, and an echo latency baseline.
 
-use agsteer::can::bus::{CanBus, SocketCanBus};
-use agsteer::can::Frame;
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
@@ -91,50 +89,36 @@ impl Candump {
     }
 }
 
-/// Round-trip latency (s) of a trivial echo on the bus: a thread re-sends every frame with
-/// id + 1. Returns (median, p99).
+/// Round-trip latency (s) of a trivial echo on the bus: a thread blocked in read(2) re-sends
+/// every frame with id + 1; the measuring side blocks in read(2) too. Returns (median, p99).
 pub fn echo_latency(iface: &str, n: usize) -> (f64, f64) {
-    let mut echo = SocketCanBus::open(
-        iface,
-        &[agsteer::can::bus::Filter {
-            id: 0x0CFF5000,
-            mask: 0x1FFFFFFF,
-        }],
-    )
-    .unwrap();
+    use socketcan::{EmbeddedFrame, ExtendedId, Socket, SocketOptions};
+    let filter = |id: u32| [socketcan::CanFilter::new(id | 0x8000_0000, 0x9FFF_FFFF)];
+    let echo = socketcan::CanSocket::open(iface).unwrap();
+    echo.set_filters(&filter(0x0CFF5000)).unwrap();
+    echo.set_read_timeout(Duration::from_millis(200)).unwrap();
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
     let s2 = stop.clone();
     let h = std::thread::spawn(move || {
+        let reply = ExtendedId::new(0x0CFF5001).unwrap();
         while !s2.load(std::sync::atomic::Ordering::Relaxed) {
-            match echo.try_recv() {
-                Ok(Some(f)) => {
-                    let _ = echo.send(&Frame::new(f.frame.id + 1, f.frame.payload()));
+            if let Ok(f) = echo.read_frame() {
+                if let Some(r) = socketcan::CanFrame::new(reply, f.data()) {
+                    let _ = echo.write_frame(&r);
                 }
-                _ => std::hint::spin_loop(),
             }
         }
     });
-    let mut bus = SocketCanBus::open(
-        iface,
-        &[agsteer::can::bus::Filter {
-            id: 0x0CFF5001,
-            mask: 0x1FFFFFFF,
-        }],
-    )
-    .unwrap();
+    let sock = socketcan::CanSocket::open(iface).unwrap();
+    sock.set_filters(&filter(0x0CFF5001)).unwrap();
+    sock.set_read_timeout(Duration::from_secs(1)).unwrap();
+    let ask = ExtendedId::new(0x0CFF5000).unwrap();
     let mut lat = Vec::with_capacity(n);
     for k in 0..n {
+        let f = socketcan::CanFrame::new(ask, &(k as u64).to_le_bytes()).unwrap();
         let t0 = Instant::now();
-        bus.send(&Frame::new(0x0CFF5000, &(k as u64).to_le_bytes()))
-            .unwrap();
-        loop {
-            if let Ok(Some(_)) = bus.try_recv() {
-                break;
-            }
-            if t0.elapsed() > Duration::from_secs(1) {
-                break;
-            }
-        }
+        sock.write_frame(&f).unwrap();
+        let _ = sock.read_frame();
         lat.push(t0.elapsed().as_secs_f64());
     }
     stop.store(true, std::sync::atomic::Ordering::Relaxed);

@@ -125,6 +125,26 @@ pub fn load_progress(cfg: &Config, path: &Path) -> Option<Progress> {
     }
 }
 
+/// Run this thread under SCHED_FIFO at `priority` (0 = leave it alone).
+fn set_realtime_priority(priority: u8) {
+    if priority == 0 {
+        return;
+    }
+    let param = libc::sched_param {
+        sched_priority: priority as i32,
+    };
+    // SAFETY: sched_setscheduler on the calling thread with a valid parameter.
+    let rc = unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) };
+    if rc == 0 {
+        tracing::info!(priority, "control loop runs under SCHED_FIFO");
+    } else {
+        tracing::warn!(
+            "cannot set SCHED_FIFO priority {priority}: {} (needs root or CAP_SYS_NICE)",
+            std::io::Error::last_os_error()
+        );
+    }
+}
+
 fn send_all(bus: &AsyncSocketCan, frames: &[Frame], stats: &mut LoopStats) -> bool {
     let mut ok = true;
     for f in frames {
@@ -178,6 +198,8 @@ async fn run_async(cfg: Config) -> Result<(), DaemonError> {
     let resume = load_progress(&cfg, &progress_path);
     let mut node = ControllerNode::new(&cfg, resume.as_ref())?;
     let progress_tx = spawn_progress_writer(progress_path.clone());
+    // Helper threads exist now; only the control loop's thread gets real-time priority.
+    set_realtime_priority(cfg.daemon.realtime_priority);
 
     let listener = if cfg.bus.status_socket.is_empty() {
         None
@@ -258,7 +280,8 @@ async fn run_async(cfg: Config) -> Result<(), DaemonError> {
                             node.supervisor_mut().on_bus(false);
                         }
                         stats.bus_up = bus_up;
-                        if node.controller().guidance().has_events() {
+                        let had_events = node.controller().guidance().has_events();
+                        if had_events {
                             let p = node.controller().guidance().progress();
                             if progress_tx.try_send(p).is_err() {
                                 tracing::warn!("progress writer busy; this save is skipped");
@@ -275,6 +298,14 @@ async fn run_async(cfg: Config) -> Result<(), DaemonError> {
                         stats.max_late_ms = stats.max_late_ms.max(late * 1e3);
                         stats.mean_late_ms = late_sum / stats.ticks as f64 * 1e3;
                         stats.last_step_us = start.elapsed().as_secs_f64() * 1e6;
+                        if stats.last_step_us > dt * 0.5e6 {
+                            tracing::warn!(
+                                step_us = stats.last_step_us,
+                                tick = stats.ticks,
+                                line_change = had_events,
+                                "slow control step"
+                            );
+                        }
                         stats.max_step_us = stats.max_step_us.max(stats.last_step_us);
                         if late <= dt {
                             crate::daemon::notify::watchdog();
