@@ -348,6 +348,10 @@ pub struct SafetyConfig {
     pub max_wheel_rate_deg_s: f64,
     /// Largest lateral acceleration v²·κ, m/s².
     pub a_lat_max_m_s2: f64,
+    /// Actuator model for override detection: dead time, s; lag, s; rate, degrees/s.
+    pub actuator_dead_time_s: f64,
+    pub actuator_tau_s: f64,
+    pub actuator_rate_deg_s: f64,
 }
 
 impl Default for SafetyConfig {
@@ -358,12 +362,15 @@ impl Default for SafetyConfig {
             wheel_angle_timeout_s: 0.1,
             min_speed_kmh: 0.5,
             max_speed_kmh: 25.0,
-            override_angle_deg: 15.0,
+            override_angle_deg: 8.0,
             override_time_s: 0.5,
             max_engage_xte_m: 1.0,
             max_engage_heading_error_deg: 60.0,
             max_wheel_rate_deg_s: 45.0,
             a_lat_max_m_s2: 2.0,
+            actuator_dead_time_s: 0.05,
+            actuator_tau_s: 0.15,
+            actuator_rate_deg_s: 30.0,
         }
     }
 }
@@ -646,6 +653,19 @@ impl Config {
             500.0,
         );
         c.range("safety.a_lat_max_m_s2", f.a_lat_max_m_s2, 0.1, 20.0);
+        c.range(
+            "safety.actuator_dead_time_s",
+            f.actuator_dead_time_s,
+            0.0,
+            0.5,
+        );
+        c.range("safety.actuator_tau_s", f.actuator_tau_s, 0.0, 5.0);
+        c.range(
+            "safety.actuator_rate_deg_s",
+            f.actuator_rate_deg_s,
+            1.0,
+            500.0,
+        );
         if !["error", "warn", "info", "debug", "trace"].contains(&self.daemon.log_level.as_str()) {
             c.push(
                 "daemon.log_level",
@@ -702,6 +722,9 @@ impl Config {
             max_wheel_rate: f.max_wheel_rate_deg_s.to_radians(),
             a_lat_max: f.a_lat_max_m_s2,
             wheelbase: self.vehicle.wheelbase_m,
+            actuator_dead_time: f.actuator_dead_time_s,
+            actuator_tau: f.actuator_tau_s,
+            actuator_rate: f.actuator_rate_deg_s.to_radians(),
         }
     }
 }

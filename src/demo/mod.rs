@@ -145,6 +145,8 @@ pub struct Report {
     pub engaged_fraction: f64,
     /// Frames on the in-memory bus (both directions).
     pub frames: u64,
+    /// Why agsteer stopped steering, by fault, counted per disengagement.
+    pub disengagements: std::collections::BTreeMap<String, u64>,
 }
 
 /// What to record and where to start.
@@ -276,6 +278,7 @@ pub fn run(
     let mut was_engaged = false;
     let mut engagements = 0u64;
     let mut frames = 0u64;
+    let mut disengagements = std::collections::BTreeMap::new();
     let mut t = 0.0;
     let mut k: u64 = 0;
     let mut stopped = false;
@@ -322,6 +325,12 @@ pub fn run(
             if !was_engaged {
                 engagements += 1;
             }
+        } else if was_engaged {
+            let name = serde_json::to_value(cmd.fault)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_else(|| format!("{:?}", cmd.fault));
+            *disengagements.entry(name).or_insert(0) += 1;
         }
         was_engaged = cmd.engaged;
 
@@ -423,6 +432,7 @@ pub fn run(
         tracker: tracker_name(cfg.track.kind).to_string(),
         engaged_fraction: engaged_ticks as f64 / k.max(1) as f64,
         frames,
+        disengagements,
     };
     Ok(DemoRun {
         report,

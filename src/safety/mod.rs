@@ -107,6 +107,13 @@ pub struct SafetyParams {
     pub a_lat_max: f64,
     /// Wheelbase, m (curvature ↔ angle).
     pub wheelbase: f64,
+    /// Model of the steering actuator used to judge an override: the measured angle is
+    /// compared with where the actuator should be (the command after this dead time, s …
+    pub actuator_dead_time: f64,
+    /// … through a first-order lag of this time constant, s …
+    pub actuator_tau: f64,
+    /// … at most this fast, rad/s), not with the raw command.
+    pub actuator_rate: f64,
 }
 
 impl Default for SafetyParams {
@@ -118,7 +125,7 @@ impl Default for SafetyParams {
             invalid_threshold: 5,
             min_speed: 0.5 / 3.6,
             max_speed: 25.0 / 3.6,
-            override_angle: 15f64.to_radians(),
+            override_angle: 8f64.to_radians(),
             override_time: 0.5,
             max_engage_xte: 1.0,
             max_engage_heading_error: 60f64.to_radians(),
@@ -126,6 +133,9 @@ impl Default for SafetyParams {
             max_wheel_rate: 45f64.to_radians(),
             a_lat_max: 2.0,
             wheelbase: 3.0,
+            actuator_dead_time: 0.05,
+            actuator_tau: 0.15,
+            actuator_rate: 30f64.to_radians(),
         }
     }
 }
@@ -165,7 +175,15 @@ pub struct Supervisor {
     engage_requested: bool,
     bus_down: bool,
     last_refusal: FaultCode,
+    /// Where the actuator model says the wheels should be, rad.
+    expected: f64,
+    /// Recent engaged commands (time, angle) for the model's dead time.
+    history: [(f64, f64); HISTORY],
+    history_len: usize,
+    history_head: usize,
 }
+
+const HISTORY: usize = 64;
 
 impl Supervisor {
     pub fn new(params: SafetyParams) -> Self {
@@ -188,7 +206,46 @@ impl Supervisor {
             engage_requested: false,
             bus_down: false,
             last_refusal: FaultCode::None,
+            expected: 0.0,
+            history: [(0.0, 0.0); HISTORY],
+            history_len: 0,
+            history_head: 0,
         }
+    }
+
+    /// The command the actuator acts on at `t`: the newest one at least a dead time old.
+    fn delayed_command(&self, t: f64) -> Option<f64> {
+        let cutoff = t - self.params.actuator_dead_time;
+        (0..self.history_len)
+            .map(|i| self.history[(self.history_head + HISTORY - 1 - i) % HISTORY])
+            .find(|(tc, _)| *tc <= cutoff + 1e-9)
+            .map(|(_, c)| c)
+    }
+
+    fn remember_command(&mut self, t: f64, angle: f64) {
+        self.history[self.history_head] = (t, angle);
+        self.history_head = (self.history_head + 1) % HISTORY;
+        self.history_len = (self.history_len + 1).min(HISTORY);
+    }
+
+    /// Advance the actuator model by `dt` to time `t`.
+    fn update_expected(&mut self, t: f64, dt: f64) {
+        let Some(target) = self.delayed_command(t) else {
+            return;
+        };
+        let p = &self.params;
+        let wanted = if p.actuator_tau > 0.0 {
+            (target - self.expected) * (dt / p.actuator_tau).min(1.0)
+        } else {
+            target - self.expected
+        };
+        let step = p.actuator_rate * dt;
+        self.expected += wanted.clamp(-step, step);
+    }
+
+    /// Where the actuator model says the wheels should be, rad.
+    pub fn expected_wheel_angle(&self) -> f64 {
+        self.expected
     }
 
     pub fn params(&self) -> &SafetyParams {
@@ -350,9 +407,13 @@ impl Supervisor {
         if fault == FaultCode::None && demand.is_none() {
             fault = FaultCode::NoGuidance;
         }
-        // Operator override by divergence: measured far from the command for too long.
+        // Operator override by divergence: the measured angle far, for too long, from where
+        // the actuator should have taken the wheels.
+        if self.state == SafetyState::Engaged {
+            self.update_expected(t, dt);
+        }
         if self.state == SafetyState::Engaged && fault == FaultCode::None {
-            if (self.wheel_angle - self.last_command).abs() > self.params.override_angle {
+            if (self.wheel_angle - self.expected).abs() > self.params.override_angle {
                 let since = *self.diverged_since.get_or_insert(t);
                 if t - since > self.params.override_time {
                     fault = FaultCode::OperatorOverride;
@@ -399,8 +460,11 @@ impl Supervisor {
             };
             if self.state == SafetyState::Ready && refusal == FaultCode::None {
                 self.state = SafetyState::Engaged;
-                // The rate limit starts from where the wheels are.
+                // The rate limit and the actuator model start from where the wheels are.
                 self.last_command = self.wheel_angle;
+                self.expected = self.wheel_angle;
+                self.history_len = 0;
+                self.remember_command(t, self.wheel_angle);
                 self.diverged_since = None;
             }
             self.last_refusal = refusal;
@@ -410,6 +474,7 @@ impl Supervisor {
             match self.limit(demand.unwrap_or(self.wheel_angle), dt) {
                 Some(limited) => {
                     self.last_command = limited;
+                    self.remember_command(t, limited);
                     return SteeringCommand {
                         engaged: true,
                         wheel_angle: limited,
