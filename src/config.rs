@@ -463,6 +463,57 @@ pub fn apply_overrides(root: &mut toml::Table, overrides: &[String]) -> Result<(
     Ok(())
 }
 
+/// Edit distance between two keys (for "did you mean").
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// Add "did you mean `key`?" to serde's unknown-field messages.
+fn suggest_nearest(msg: String) -> String {
+    let Some(start) = msg.find("unknown field `") else {
+        return msg;
+    };
+    let rest = &msg[start + "unknown field `".len()..];
+    let Some(end) = rest.find('`') else {
+        return msg;
+    };
+    let unknown = &rest[..end];
+    // serde says "expected `a`", "expected `a` or `b`" or "expected one of `a`, `b`, …".
+    let Some(list) = rest.find("expected ").map(|i| &rest[i..]) else {
+        return msg;
+    };
+    let list = list.lines().next().unwrap_or("");
+    let best = list
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .min_by_key(|k| edit_distance(unknown, k));
+    match best {
+        Some(k) => {
+            // Put the hint on the first line, before serde's "in `section`" line.
+            let (first, more) = msg.split_once('\n').unwrap_or((msg.as_str(), ""));
+            let more = more.trim();
+            if more.is_empty() {
+                format!("{first}; did you mean `{k}`?")
+            } else {
+                format!("{first}; did you mean `{k}`? ({more})")
+            }
+        }
+        None => msg,
+    }
+}
+
 impl Config {
     /// Parse TOML text with overrides, without validating.
     pub fn parse_with(text: &str, overrides: &[String]) -> Result<Config, ConfigError> {
@@ -470,7 +521,7 @@ impl Config {
             .parse()
             .map_err(|e: toml::de::Error| ConfigError::Parse(e.to_string()))?;
         apply_overrides(&mut root, overrides)?;
-        Config::deserialize(root).map_err(|e| ConfigError::Parse(e.to_string()))
+        Config::deserialize(root).map_err(|e| ConfigError::Parse(suggest_nearest(e.to_string())))
     }
 
     /// Read, override and validate a configuration file.
@@ -801,6 +852,10 @@ mod tests {
         assert!(err.to_string().contains("unknown field `dt`"), "{err}");
         let err = Config::parse_with("", &["track.nope=1".into()]).unwrap_err();
         assert!(err.to_string().contains("nope"), "{err}");
+        let err = Config::parse_with("[control]\nspeed_kmn = 9\n", &[]).unwrap_err();
+        assert!(err.to_string().contains("did you mean `speed_kmh`?"), "{err}");
+        let err = Config::parse_with("[vehicel]\n", &[]).unwrap_err();
+        assert!(err.to_string().contains("did you mean `vehicle`?"), "{err}");
     }
 
     #[test]
