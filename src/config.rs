@@ -737,6 +737,38 @@ impl Config {
         c.problems
     }
 
+    /// The keys that cannot change while the daemon runs a job: those defining the job, the
+    /// bus identity and the control period. Returns the ones that differ in `new`.
+    pub fn fixed_key_changes(&self, new: &Config) -> Vec<&'static str> {
+        let mut v = Vec::new();
+        let mut check = |key: &'static str, same: bool| {
+            if !same {
+                v.push(key);
+            }
+        };
+        check("job", self.job == new.job);
+        check("guidance", self.guidance == new.guidance);
+        check(
+            "vehicle.r_min_m",
+            self.vehicle.r_min_m == new.vehicle.r_min_m,
+        );
+        check("control.dt_s", self.control.dt_s == new.control.dt_s);
+        check("bus.interface", self.bus.interface == new.bus.interface);
+        check(
+            "bus.source_address",
+            self.bus.source_address == new.bus.source_address,
+        );
+        check(
+            "bus.status_socket",
+            self.bus.status_socket == new.bus.status_socket,
+        );
+        check(
+            "progress.state_dir",
+            self.progress.state_dir == new.progress.state_dir,
+        );
+        v
+    }
+
     /// The resolved configuration as TOML text.
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot print: {e}"))
@@ -853,7 +885,10 @@ mod tests {
         let err = Config::parse_with("", &["track.nope=1".into()]).unwrap_err();
         assert!(err.to_string().contains("nope"), "{err}");
         let err = Config::parse_with("[control]\nspeed_kmn = 9\n", &[]).unwrap_err();
-        assert!(err.to_string().contains("did you mean `speed_kmh`?"), "{err}");
+        assert!(
+            err.to_string().contains("did you mean `speed_kmh`?"),
+            "{err}"
+        );
         let err = Config::parse_with("[vehicel]\n", &[]).unwrap_err();
         assert!(err.to_string().contains("did you mean `vehicle`?"), "{err}");
     }
@@ -885,6 +920,21 @@ mod tests {
         assert!(msgs
             .iter()
             .any(|m| m.starts_with("control.speed_kmh = NaN")));
+    }
+
+    #[test]
+    fn job_keys_are_fixed_tuning_keys_are_not() {
+        let a = Config::default();
+        let tuned = Config::parse_with(
+            "[track]\nld_min_m = 4.0\n[safety]\na_lat_max_m_s2 = 1.5\n",
+            &[],
+        )
+        .unwrap();
+        assert!(a.fixed_key_changes(&tuned).is_empty());
+        let moved =
+            Config::parse_with("[job]\nline_width_m = 4.0\n[vehicle]\nr_min_m = 6.0\n", &[])
+                .unwrap();
+        assert_eq!(a.fixed_key_changes(&moved), vec!["job", "vehicle.r_min_m"]);
     }
 
     #[test]
