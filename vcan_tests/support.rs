@@ -135,7 +135,18 @@ pub struct Proc {
 impl Proc {
     /// Spawn with stderr to /tmp/NAME.log (the VM's serial console is slow).
     pub fn spawn(prog: &str, args: &[&str]) -> Proc {
-        let log = std::fs::File::create(format!("/tmp/{prog}.log")).expect("log file");
+        Proc::spawn_logging(prog, args, false)
+    }
+
+    /// Spawn, appending stderr to /tmp/NAME.log when `append`.
+    pub fn spawn_logging(prog: &str, args: &[&str], append: bool) -> Proc {
+        let log = std::fs::OpenOptions::new()
+            .create(true)
+            .append(append)
+            .write(true)
+            .truncate(!append)
+            .open(format!("/tmp/{prog}.log"))
+            .expect("log file");
         let child = Command::new(prog)
             .args(args)
             .stdin(Stdio::null())

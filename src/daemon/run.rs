@@ -126,7 +126,7 @@ pub fn load_progress(cfg: &Config, path: &Path) -> Option<Progress> {
 }
 
 /// Run this thread under SCHED_FIFO at `priority` (0 = leave it alone).
-fn set_realtime_priority(priority: u8) {
+pub fn set_realtime_priority(priority: u8) {
     if priority == 0 {
         return;
     }
