@@ -181,3 +181,138 @@ fn garbage_on_every_known_id_is_counted_invalid_and_never_panics() {
     );
     assert!(!st.engaged);
 }
+
+/// Drive a controller node with healthy inputs and the operator's engage, in process.
+struct Bench {
+    node: agsteer::control::node::ControllerNode,
+    sim: agsteer::sim::can_node::SimNode,
+    terminal: agsteer::can::codec::Packer,
+    t: f64,
+    out: Vec<agsteer::can::Frame>,
+    sim_out: Vec<(f64, agsteer::can::Frame)>,
+}
+
+impl Bench {
+    fn new(cfg: &Config) -> Bench {
+        use agsteer::geo::Pose;
+        let node = agsteer::control::node::ControllerNode::new(cfg, None).unwrap();
+        let sim = agsteer::sim::can_node::SimNode::new(
+            agsteer::sim::Simulator::new(
+                agsteer::demo::sim_params(cfg),
+                Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+                cfg.speed(),
+            ),
+            *node.enu(),
+            Default::default(),
+            Scenario::default(),
+        );
+        Bench {
+            node,
+            sim,
+            terminal: agsteer::can::codec::Packer::new(0x26),
+            t: 0.0,
+            out: Vec::new(),
+            sim_out: Vec::new(),
+        }
+    }
+    /// One period; `extra` frames arrive with the sensors'.
+    fn period(
+        &mut self,
+        dt: f64,
+        extra: &[agsteer::can::Frame],
+    ) -> agsteer::safety::SteeringCommand {
+        use agsteer::can::TimedFrame;
+        self.t += dt;
+        self.sim_out.clear();
+        self.sim.advance_to(self.t, &mut self.sim_out);
+        for (ts, f) in &self.sim_out {
+            self.node.on_frame(&TimedFrame { t: *ts, frame: *f });
+        }
+        for f in extra {
+            self.node.on_frame(&TimedFrame {
+                t: self.t,
+                frame: *f,
+            });
+        }
+        self.out.clear();
+        let cmd = self.node.tick(self.t, &mut self.out);
+        for f in &self.out {
+            self.sim.on_frame(&TimedFrame {
+                t: self.t,
+                frame: *f,
+            });
+        }
+        cmd
+    }
+    fn engage(&mut self, dt: f64) {
+        for _ in 0..100 {
+            // A new frame each time: a repeated one would be a frozen counter.
+            let f = self
+                .terminal
+                .pack(&agsteer::can::codec::OperatorCommand {
+                    command: 1.0,
+                    nudge: 0.0,
+                    job: 0.0,
+                })
+                .unwrap();
+            if self.period(dt, &[f]).engaged {
+                return;
+            }
+        }
+        panic!(
+            "did not engage: {:?} refusal {:?}",
+            self.node.status(),
+            self.node.supervisor().last_refusal()
+        );
+    }
+}
+
+#[test]
+fn interface_down_disengages_and_nothing_reengages_after_it_returns() {
+    let cfg = config();
+    let dt = cfg.dt();
+    let mut b = Bench::new(&cfg);
+    b.engage(dt);
+    for _ in 0..50 {
+        assert!(b.period(dt, &[]).engaged);
+    }
+    // The daemon tells the supervisor when sends fail (bus down) and when they work again.
+    b.node.supervisor_mut().on_bus(false);
+    let cmd = b.period(dt, &[]);
+    assert!(!cmd.engaged, "disengaged within one period");
+    assert_eq!(cmd.fault, agsteer::safety::FaultCode::BusDown);
+    for _ in 0..(5.0 / dt) as usize {
+        assert!(!b.period(dt, &[]).engaged);
+    }
+    b.node.supervisor_mut().on_bus(true);
+    for _ in 0..100 {
+        let c = b.period(dt, &[]);
+        assert!(!c.engaged, "stays disengaged until an operator engage");
+    }
+    assert_eq!(
+        b.node.supervisor().state(),
+        agsteer::safety::SafetyState::Ready
+    );
+}
+
+#[test]
+fn can_flood_of_unrelated_ids_changes_nothing() {
+    let cfg = config();
+    let dt = cfg.dt();
+    let mut b = Bench::new(&cfg);
+    b.engage(dt);
+    // 10 000 frames/s of another id for 10 s: 200 per 20 ms period.
+    let flood: Vec<agsteer::can::Frame> = (0..(10_000.0 * dt) as u64)
+        .map(|k| agsteer::can::Frame::new(0x18FEF1F1, &k.to_le_bytes()))
+        .collect();
+    let periods = (10.0 / dt) as usize;
+    for _ in 0..periods {
+        let c = b.period(dt, &flood);
+        assert!(c.engaged, "keeps steering through the flood");
+    }
+    assert_eq!(
+        b.node.status().bad_frames,
+        0,
+        "unrelated ids are not our frames"
+    );
+}

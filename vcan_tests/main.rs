@@ -287,7 +287,7 @@ fn d_link_down_and_up() {
         status()
     );
     println!("LINK-DOWN-STATUS {}", down.unwrap_or_default());
-    std::thread::sleep(Duration::from_secs(2));
+    std::thread::sleep(Duration::from_secs(5));
     assert!(daemon.alive(), "daemon survives");
     let mut rx = SocketCanBus::open(
         &iface,
