@@ -8,7 +8,11 @@
 //! lines are driven in the shortest order that never turns between lines closer than
 //! `2·r_min` (so every turn is a pi turn), starting at the block's first line and ending where
 //! the next block's first line is at least `2·r_min` away. The order is solved exactly by
-//! dynamic programming over subsets for blocks of up to [`EXACT_MAX_LINES`] lines.
+//! dynamic programming over subsets for blocks of up to [`EXACT_MAX_LINES`] lines, and by a
+//! heuristic beyond (see [`solve_block_order`]). When no order avoids lines closer than
+//! `2·r_min` (a block of fewer than `2·ceil(2·r_min/line_width) + 1` lines), the plan does not
+//! fail: the order has the fewest such "short" moves, then the shortest distance, and the
+//! short moves are driven with bulb turns.
 
 use super::turns::{bulb_turn, pi_turn, TurnParams};
 use super::PlanError;
@@ -789,8 +793,8 @@ mod tests {
 
     #[test]
     fn heuristic_is_valid_for_large_blocks_and_no_worse_than_its_candidates() {
-        for n in [21usize, 22, 25, 29, 33, 40, 47, 64] {
-            let gaps = [1usize, 2, 3, 5, 7, 9, 10, 13, (n - 1) / 2];
+        for n in [21usize, 30, 64] {
+            let gaps = [1usize, 4, 9, 13, (n - 1) / 2];
             for min_gap in gaps.into_iter().filter(|&g| 2 * g < n) {
                 for next_block in [false, true] {
                     let o = solve_block_order(n, min_gap, next_block);
@@ -818,7 +822,7 @@ mod tests {
     fn heuristic_candidates_are_near_optimal_where_the_dp_can_check_them() {
         // Chained parts (forced to 6–10 lines): measured worst 1.12× the optimum.
         let mut worst_chain: f64 = 1.0;
-        for n in 7..=18 {
+        for n in 7..=16 {
             for min_gap in 1..=(n - 1) / 2 {
                 for next_block in [false, true] {
                     let exact = order_cost(
