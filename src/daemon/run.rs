@@ -13,7 +13,6 @@ use crate::can::{Frame, TimedFrame};
 use crate::config::Config;
 use crate::control::node::{ControllerNode, NodeStatus};
 use crate::guidance::progress::Progress;
-use crate::guidance::Event;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
@@ -157,22 +156,6 @@ fn send_all(bus: &AsyncSocketCan, frames: &[Frame], stats: &mut LoopStats) -> bo
         }
     }
     ok
-}
-
-fn log_event(ev: &Event) {
-    match ev {
-        Event::LineStarted { block, rank, line } => {
-            tracing::info!(block, rank, line, "line started")
-        }
-        Event::LineFinished { block, rank, line } => {
-            tracing::info!(block, rank, line, "line finished")
-        }
-        Event::TurnStarted { from_line, to_line } => {
-            tracing::info!(from_line, to_line, "turn started")
-        }
-        Event::BlockChanged { block } => tracing::info!(block, "block changed"),
-        Event::JobFinished { lines_done } => tracing::info!(lines_done, "job finished"),
-    }
 }
 
 /// Where the configuration came from, for SIGHUP.
@@ -347,7 +330,7 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                                 tracing::warn!("progress writer busy; this save is skipped");
                             }
                             for ev in node.controller_mut().guidance_mut().drain_events() {
-                                log_event(&ev);
+                                tracing::info!("{ev}");
                             }
                         }
                         stats.ticks += 1;

@@ -21,6 +21,24 @@ pub enum Event {
     JobFinished { lines_done: u64 },
 }
 
+impl std::fmt::Display for Event {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Event::LineStarted { block, rank, line } => {
+                write!(f, "line started: line {line} (block {block}, rank {rank})")
+            }
+            Event::LineFinished { block, rank, line } => {
+                write!(f, "line finished: line {line} (block {block}, rank {rank})")
+            }
+            Event::TurnStarted { from_line, to_line } => {
+                write!(f, "turn started: line {from_line} → line {to_line}")
+            }
+            Event::BlockChanged { block } => write!(f, "block changed: block {block}"),
+            Event::JobFinished { lines_done } => write!(f, "job finished: {lines_done} lines"),
+        }
+    }
+}
+
 /// Tuning of the state machine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GuidanceParams {

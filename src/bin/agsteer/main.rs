@@ -185,38 +185,7 @@ fn check_config(path: &Path, set: &[String]) -> Result<u8> {
 }
 
 fn log_event(t: f64, ev: &Event) {
-    match ev {
-        Event::LineStarted { block, rank, line } => {
-            tracing::info!(
-                t_s = format_args!("{t:.2}"),
-                block,
-                rank,
-                line,
-                "line started"
-            )
-        }
-        Event::LineFinished { block, rank, line } => {
-            tracing::info!(
-                t_s = format_args!("{t:.2}"),
-                block,
-                rank,
-                line,
-                "line finished"
-            )
-        }
-        Event::TurnStarted { from_line, to_line } => tracing::info!(
-            t_s = format_args!("{t:.2}"),
-            from_line,
-            to_line,
-            "turn started"
-        ),
-        Event::BlockChanged { block } => {
-            tracing::info!(t_s = format_args!("{t:.2}"), block, "block changed")
-        }
-        Event::JobFinished { lines_done } => {
-            tracing::info!(t_s = format_args!("{t:.2}"), lines_done, "job finished")
-        }
-    }
+    tracing::info!(t_s = format_args!("{t:.2}"), "{ev}");
 }
 
 fn run_demo(
