@@ -82,6 +82,7 @@ fn recv_within(bus: &mut SocketCanBus, d: Duration) -> Option<agsteer::can::Time
 fn a_closed_loop_job_on_vcan() {
     let Some(iface) = vcan() else { return };
     let daemon = start_daemon(&[]);
+    let probe = StallProbe::start();
     let dump = Candump::start(&iface);
     let traj = "/tmp/agsteer-trajectory.csv";
     let _sim = Proc::spawn(
@@ -106,6 +107,7 @@ fn a_closed_loop_job_on_vcan() {
     let (rss, hwm) = proc_rss_kb(daemon.pid());
     let last = status().unwrap_or_default();
     let lines = dump.stop();
+    let stalls = probe.stop();
     assert!(done.is_some(), "job finished: {last}");
     println!(
         "DAEMON-RESOURCES cpu_percent={:.1} rss_kb={rss} hwm_kb={hwm} wall_s={wall:.1} loop={}",
@@ -123,13 +125,14 @@ fn a_closed_loop_job_on_vcan() {
     println!("VCAN-JOB-XTE rms_m={rms:.4} p95_m={p95:.4} max_m={max:.4} samples={n}");
     assert!(n > 100);
     assert!(rms < 0.05, "true XTE RMS {rms}");
-    // At dt = 10 ms the emulated VM (TCG) itself stalls now and then for 10-30 ms, so here
-    // the gap bound is held for 99.9 % of frames; (b) holds it for every frame at dt = 20 ms.
-    capture_checks(&lines, 0.01, 0.999);
+    // Gaps are counted less the time the whole guest was frozen (see `StallProbe`). At
+    // dt = 10 ms the bound is held for 99.9 % of gaps; (b) holds it for every gap at 20 ms.
+    capture_checks(&lines, &stalls, 0.01, 0.999);
 }
 
 /// (b) A candump capture of a closed-loop run at the default dt = 20 ms decodes with zero
-/// unknown or invalid frames, and every gap between command frames is within 2·dt.
+/// unknown or invalid frames, and every gap between command frames is within 2·dt, less the
+/// time the whole emulated guest was frozen (measured by a [`StallProbe`]).
 #[test]
 fn b_capture_decodes_and_commands_come_every_dt() {
     let Some(iface) = vcan() else { return };
@@ -148,16 +151,18 @@ fn b_capture_decodes_and_commands_come_every_dt() {
     );
     let mut term = Terminal::new(&iface);
     assert!(term.engage(Duration::from_secs(10)), "engaged");
+    let probe = StallProbe::start();
     let dump = Candump::start(&iface);
     std::thread::sleep(Duration::from_secs(20));
     let lines = dump.stop();
-    capture_checks(&lines, 0.02, 1.0);
+    let stalls = probe.stop();
+    capture_checks(&lines, &stalls, 0.02, 1.0);
 }
 
 /// The capture decodes with `agsteer dbc decode` with zero unknown or invalid frames, and
-/// at least `share` of the gaps between command frames are within 2·dt. Also prints the
-/// GNSS-to-command latency.
-fn capture_checks(lines: &[String], dt: f64, share: f64) {
+/// at least `share` of the gaps between command frames, less guest stalls, are within 2·dt.
+/// Also prints the raw gaps and the GNSS-to-command latency.
+fn capture_checks(lines: &[String], stalls: &[Stall], dt: f64, share: f64) {
     std::fs::write("/tmp/agsteer-capture.log", lines.join("\n") + "\n").unwrap();
     let out = run_ok("agsteer", &["dbc", "decode", "/tmp/agsteer-capture.log"]);
     let objs: Vec<serde_json::Value> = out
@@ -185,21 +190,32 @@ fn capture_checks(lines: &[String], dt: f64, share: f64) {
         cmds.len()
     );
     let mut gaps: Vec<f64> = cmds.windows(2).map(|w| w[1].0 - w[0].0).collect();
+    let mut net: Vec<f64> = cmds
+        .windows(2)
+        .map(|w| gap_less_stalls(w[0].0, w[1].0, stalls))
+        .collect();
     gaps.sort_by(|a, b| a.total_cmp(b));
-    let max_gap = *gaps.last().unwrap();
-    let within = gaps.iter().filter(|g| **g <= 2.0 * dt + 1e-6).count() as f64 / gaps.len() as f64;
+    net.sort_by(|a, b| a.total_cmp(b));
+    let bound = 2.0 * dt + 1e-6;
+    let share_within =
+        |g: &[f64]| g.iter().filter(|g| **g <= bound).count() as f64 / g.len() as f64;
+    let (within_raw, within) = (share_within(&gaps), share_within(&net));
+    let max_net = *net.last().unwrap();
     println!(
-        "COMMAND-GAPS dt_ms={} median_ms={:.2} p99_ms={:.2} max_ms={:.2} within_2dt={:.5} over {}",
+        "COMMAND-GAPS dt_ms={} median_ms={:.2} p99_ms={:.2} max_ms={:.2} within_2dt={:.5} \
+         less_stalls: max_ms={:.2} within_2dt={:.5} over {}",
         dt * 1e3,
         pct(&gaps, 0.5) * 1e3,
         pct(&gaps, 0.99) * 1e3,
-        max_gap * 1e3,
+        gaps.last().unwrap() * 1e3,
+        within_raw,
+        max_net * 1e3,
         within,
         gaps.len()
     );
     assert!(
         within >= share,
-        "gaps within 2·dt: {within} (max {max_gap} s)"
+        "gaps less guest stalls within 2·dt: {within} (max {max_net} s)"
     );
     // GNSS position frame arrival → next command frame.
     let mut lat = Vec::new();
@@ -384,4 +400,43 @@ fn proc_rss_kb(pid: u32) -> (u64, u64) {
             .unwrap_or(0)
     };
     (get("VmRSS:"), get("VmHWM:"))
+}
+
+/// Host-side check of the helpers the scenarios rely on (runs without vcan).
+#[test]
+fn helpers_parse_candump_and_subtract_stalls() {
+    let lines = vec![
+        "(1700000000.100000) vcan0 0CFF2000#0102FF".to_string(),
+        "garbage".to_string(),
+        "(1700000000.150000) vcan0 0CFF2000#010201".to_string(),
+    ];
+    let cap = parse_candump(&lines);
+    assert_eq!(cap.len(), 2);
+    assert_eq!(cap[0].1, 0x0CFF2000);
+    assert_eq!(cap[0].2, vec![1, 2, 0xFF]);
+    assert_eq!(
+        steering_frames(&cap)
+            .iter()
+            .map(|c| c.1)
+            .collect::<Vec<_>>(),
+        vec![0xFF, 1]
+    );
+    let stalls = [
+        Stall {
+            from_s: 0.9,
+            to_s: 1.02,
+        },
+        Stall {
+            from_s: 1.04,
+            to_s: 1.05,
+        },
+        Stall {
+            from_s: 2.0,
+            to_s: 2.1,
+        },
+    ];
+    // 1.00 → 1.10: 20 ms + 10 ms of it frozen.
+    let net = gap_less_stalls(1.0, 1.1, &stalls);
+    assert!((net - 0.07).abs() < 1e-9, "{net}");
+    assert!((gap_less_stalls(3.0, 3.05, &stalls) - 0.05).abs() < 1e-9);
 }
