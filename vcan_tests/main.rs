@@ -121,9 +121,15 @@ fn a_closed_loop_job_on_vcan() {
     {
         println!("DAEMON-LOG {l}");
     }
-    let (rms, p95, max, n) = xte_from_trajectory(traj);
-    println!("VCAN-JOB-XTE rms_m={rms:.4} p95_m={p95:.4} max_m={max:.4} samples={n}");
-    assert!(n > 100);
+    let (rms, p95, max, n, expected) = xte_from_trajectory(traj);
+    println!(
+        "VCAN-JOB-XTE rms_m={rms:.4} p95_m={p95:.4} max_m={max:.4} samples={n} of ~{expected:.0}"
+    );
+    // The simulator samples every 50 ms of its monotonic time; guest stalls skip samples.
+    assert!(
+        n as f64 > 0.6 * expected,
+        "{n} trajectory samples on the lines"
+    );
     assert!(rms < 0.05, "true XTE RMS {rms}");
     // Gaps are counted less the time the whole guest was frozen (see `StallProbe`). At
     // dt = 10 ms the bound is held for 99.9 % of gaps; (b) holds it for every gap at 20 ms.
@@ -335,8 +341,8 @@ fn e_sigterm_disengages_last() {
 }
 
 /// True |XTE| on the work lines from the simulator's trajectory (10 m at each line end
-/// excluded): (rms, p95, max, samples).
-fn xte_from_trajectory(path: &str) -> (f64, f64, f64, usize) {
+/// excluded): (rms, p95, max, samples, samples expected at the 50 ms trajectory period).
+fn xte_from_trajectory(path: &str) -> (f64, f64, f64, usize, f64) {
     use agsteer::config::Config;
     use agsteer::control::ab_params;
     use agsteer::plan::abline::AbPlan;
@@ -370,11 +376,13 @@ fn xte_from_trajectory(path: &str) -> (f64, f64, f64, usize) {
     xs.sort_by(|a, b| a.total_cmp(b));
     let n = xs.len().max(1);
     let rms = (xs.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
+    let expected = cfg.job.line_num as f64 * (plan.line_length() - 20.0) / cfg.speed() / 0.05;
     (
         rms,
         pct(&xs, 0.95),
         xs.last().copied().unwrap_or(0.0),
         xs.len(),
+        expected,
     )
 }
 
