@@ -80,9 +80,9 @@ fn recv_within(bus: &mut SocketCanBus, d: Duration) -> Option<agsteer::can::Time
 /// (b) is checked on the candump capture of the same run (see `capture_checks`).
 ///
 /// An attempt that the daemon ends by disengaging is repeated (at most [`JOB_ATTEMPTS`] in all)
-/// only if the whole guest froze, at the same time, for longer than the wheel-angle freshness
-/// timeout allows: then the disengage was the supervisor doing its job on inputs the emulator
-/// made stale. Any other cut-short job fails the test.
+/// only if the whole guest was frozen for at least half of some wheel-angle freshness window
+/// (`safety.wheel_angle_timeout_s`): then the disengage may well be the supervisor doing its
+/// job on inputs the emulator made stale. Any other cut-short job fails the test.
 #[test]
 fn a_closed_loop_job_on_vcan() {
     let Some(iface) = vcan() else { return };
@@ -91,7 +91,8 @@ fn a_closed_loop_job_on_vcan() {
             None => return,
             Some(stall_s) => {
                 println!(
-                    "VCAN-JOB attempt {attempt} invalid: the guest froze for {:.0} ms",
+                    "VCAN-JOB attempt {attempt} invalid: the guest was frozen {:.0} ms \
+                     of one freshness window",
                     stall_s * 1e3
                 );
             }
@@ -103,13 +104,12 @@ fn a_closed_loop_job_on_vcan() {
 /// Runs of (a) before giving up on a host too loaded to keep the guest running.
 const JOB_ATTEMPTS: usize = 3;
 
-/// One run of (a): `None` when the job finished and passed every check; `Some(longest guest
-/// stall, s)` when the daemon disengaged while the guest had frozen past the freshness limit.
-/// Panics on any other failure.
+/// One run of (a): `None` when the job finished and passed every check; `Some(frozen time, s)`
+/// when the daemon disengaged and the guest had been frozen for at least half of some
+/// freshness window. Panics on any other failure.
 fn job_attempt(iface: &str) -> Option<f64> {
     let cfg = agsteer::config::Config::load(std::path::Path::new(CONFIG), &[]).unwrap();
-    // The wheel angle comes every dt; a freeze this long can make it stale by itself.
-    let stale_stall_s = cfg.safety.wheel_angle_timeout_s - 2.0 * cfg.control.dt_s;
+    let window_s = cfg.safety.wheel_angle_timeout_s;
     let daemon = start_daemon(&[]);
     let probe = StallProbe::start();
     let dump = Candump::start(iface);
@@ -145,10 +145,18 @@ fn job_attempt(iface: &str) -> Option<f64> {
     let lines = dump.stop();
     let stalls = probe.stop();
     let finished = end.as_ref().is_some_and(|s| s["finished"] == true);
+    let log = std::fs::read_to_string("/tmp/agsteerd.log").unwrap_or_default();
+    for l in log
+        .lines()
+        .filter(|l| l.contains("WARN") || l.contains("ERROR"))
+        .take(20)
+    {
+        println!("DAEMON-LOG {l}");
+    }
     if !finished {
-        let longest = stalls.iter().map(|s| s.to_s - s.from_s).fold(0.0, f64::max);
-        if end.is_some() && longest >= stale_stall_s {
-            return Some(longest);
+        let frozen = most_frozen_in_window(&stalls, window_s);
+        if end.is_some() && frozen >= 0.5 * window_s {
+            return Some(frozen);
         }
     }
     assert!(finished, "job finished: {last}");
@@ -157,13 +165,6 @@ fn job_attempt(iface: &str) -> Option<f64> {
         100.0 * cpu / wall,
         last["loop"]
     );
-    let log = std::fs::read_to_string("/tmp/agsteerd.log").unwrap_or_default();
-    for l in log
-        .lines()
-        .filter(|l| l.contains("WARN") || l.contains("ERROR"))
-    {
-        println!("DAEMON-LOG {l}");
-    }
     let (rms, p95, max, n, expected) = xte_from_trajectory(traj);
     println!(
         "VCAN-JOB-XTE rms_m={rms:.4} p95_m={p95:.4} max_m={max:.4} samples={n} of ~{expected:.0}"
@@ -491,4 +492,43 @@ fn helpers_parse_candump_and_subtract_stalls() {
     let net = gap_less_stalls(1.0, 1.1, &stalls);
     assert!((net - 0.07).abs() < 1e-9, "{net}");
     assert!((gap_less_stalls(3.0, 3.05, &stalls) - 0.05).abs() < 1e-9);
+    // No 100 ms window holds more than 100 ms of stall, and [0.9, 1.0] holds that much.
+    assert!((most_frozen_in_window(&stalls, 0.1) - 0.1).abs() < 1e-9);
+    // [0.9, 1.05] holds all of the first two stalls.
+    assert!((most_frozen_in_window(&stalls, 0.15) - 0.13).abs() < 1e-9);
+    // Against a brute-force scan of window starts on a 0.1 ms grid, on made-up stalls.
+    let mut seed: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 33) as f64 / (1u64 << 31) as f64
+    };
+    let mut t = 0.0;
+    let mut many = Vec::new();
+    for _ in 0..40 {
+        t += 0.001 + 0.05 * next();
+        let len = 0.002 + 0.04 * next();
+        many.push(Stall {
+            from_s: t,
+            to_s: t + len,
+        });
+        t += len;
+    }
+    for window in [0.03, 0.1, 0.25] {
+        let brute = (0..(t / 1e-4) as usize)
+            .map(|k| {
+                let from = k as f64 * 1e-4 - window;
+                many.iter()
+                    .map(|s| s.overlap_s(from, from + window))
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max);
+        let fast = most_frozen_in_window(&many, window);
+        assert!(
+            fast >= brute - 1e-9 && fast <= brute + 1e-4,
+            "{fast} vs {brute}"
+        );
+    }
+    assert_eq!(most_frozen_in_window(&[], 0.1), 0.0);
 }

@@ -410,3 +410,23 @@ pub fn gap_less_stalls(from_s: f64, to_s: f64, stalls: &[Stall]) -> f64 {
     let frozen: f64 = stalls.iter().map(|s| s.overlap_s(from_s, to_s)).sum();
     (to_s - from_s - frozen).max(0.0)
 }
+
+/// The most time the guest spent frozen within any window of `window_s` seconds, s.
+/// `stalls` are in time order and do not overlap (as [`StallProbe`] records them).
+pub fn most_frozen_in_window(stalls: &[Stall], window_s: f64) -> f64 {
+    let frozen_in = |from_s: f64| -> f64 {
+        stalls
+            .iter()
+            .skip_while(|s| s.to_s <= from_s)
+            .take_while(|s| s.from_s < from_s + window_s)
+            .map(|s| s.overlap_s(from_s, from_s + window_s))
+            .sum()
+    };
+    // The frozen time is piecewise linear in the window's start: its maximum is at a window
+    // starting where a stall starts or ending where one ends.
+    stalls
+        .iter()
+        .flat_map(|s| [s.from_s, s.to_s - window_s])
+        .map(frozen_in)
+        .fold(0.0, f64::max)
+}
