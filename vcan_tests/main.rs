@@ -175,9 +175,8 @@ fn job_attempt(iface: &str) -> Option<f64> {
         "{n} trajectory samples on the lines"
     );
     assert!(rms < 0.05, "true XTE RMS {rms}");
-    // Gaps are counted less the time the whole guest was frozen (see `StallProbe`). At
-    // dt = 10 ms the bound is held for 99.9 % of gaps; (b) holds it for every gap at 20 ms.
-    capture_checks(&lines, &stalls, 0.01, 0.999);
+    // Every gap, less the time the whole guest was frozen (see `StallProbe`), within 2·dt.
+    capture_checks(&lines, &stalls, 0.01, 1.0);
     None
 }
 
