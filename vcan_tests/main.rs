@@ -117,18 +117,7 @@ fn job_attempt(iface: &str) -> Option<f64> {
     let probe = StallProbe::start();
     let dump = Candump::start(iface);
     let traj = "/tmp/agsteer-trajectory.csv";
-    let _sim = Proc::spawn(
-        "agsteer",
-        &[
-            "sim",
-            "--config",
-            CONFIG,
-            "--iface",
-            iface,
-            "--trajectory",
-            traj,
-        ],
-    );
+    let _sim = start_sim(iface, &["--trajectory", traj]);
     let mut term = Terminal::new(iface);
     assert!(term.engage(Duration::from_secs(10)), "engaged");
     let cpu0 = proc_cpu_s(daemon.pid());
@@ -191,18 +180,7 @@ fn job_attempt(iface: &str) -> Option<f64> {
 fn b_capture_decodes_and_commands_come_every_dt() {
     let Some(iface) = vcan() else { return };
     let _daemon = start_daemon(&["--set", "control.dt_s=0.02"]);
-    let _sim = Proc::spawn(
-        "agsteer",
-        &[
-            "sim",
-            "--config",
-            CONFIG,
-            "--iface",
-            &iface,
-            "--set",
-            "control.dt_s=0.02",
-        ],
-    );
+    let _sim = start_sim(&iface, &["--set", "control.dt_s=0.02"]);
     let mut term = Terminal::new(&iface);
     assert!(term.engage(Duration::from_secs(10)), "engaged");
     let probe = StallProbe::start();
@@ -299,7 +277,7 @@ fn capture_checks(lines: &[String], stalls: &[Stall], dt: f64, share: f64) {
 fn c_engage_and_disengage_from_cansend() {
     let Some(iface) = vcan() else { return };
     let _daemon = start_daemon(&[]);
-    let _sim = Proc::spawn("agsteer", &["sim", "--config", CONFIG, "--iface", &iface]);
+    let _sim = start_sim(&iface, &[]);
     let mut term = Terminal::new(&iface);
     assert!(wait_status(Duration::from_secs(10), |s| s["state"] == "ready").is_some());
     assert_eq!(
@@ -329,7 +307,7 @@ fn c_engage_and_disengage_from_cansend() {
 fn d_link_down_and_up() {
     let Some(iface) = vcan() else { return };
     let mut daemon = start_daemon(&[]);
-    let _sim = Proc::spawn("agsteer", &["sim", "--config", CONFIG, "--iface", &iface]);
+    let _sim = start_sim(&iface, &[]);
     let mut term = Terminal::new(&iface);
     assert!(term.engage(Duration::from_secs(10)));
     let _guard = LinkGuard(iface.clone());
@@ -369,7 +347,7 @@ fn d_link_down_and_up() {
 fn e_sigterm_disengages_last() {
     let Some(iface) = vcan() else { return };
     let mut daemon = start_daemon(&[]);
-    let _sim = Proc::spawn("agsteer", &["sim", "--config", CONFIG, "--iface", &iface]);
+    let _sim = start_sim(&iface, &[]);
     let mut term = Terminal::new(&iface);
     assert!(term.engage(Duration::from_secs(10)));
     let dump = Candump::start(&iface);
