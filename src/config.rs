@@ -463,6 +463,57 @@ pub fn apply_overrides(root: &mut toml::Table, overrides: &[String]) -> Result<(
     Ok(())
 }
 
+/// Edit distance between two keys (for "did you mean").
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// Add "did you mean `key`?" to serde's unknown-field messages.
+fn suggest_nearest(msg: String) -> String {
+    let Some(start) = msg.find("unknown field `") else {
+        return msg;
+    };
+    let rest = &msg[start + "unknown field `".len()..];
+    let Some(end) = rest.find('`') else {
+        return msg;
+    };
+    let unknown = &rest[..end];
+    // serde says "expected `a`", "expected `a` or `b`" or "expected one of `a`, `b`, …".
+    let Some(list) = rest.find("expected ").map(|i| &rest[i..]) else {
+        return msg;
+    };
+    let list = list.lines().next().unwrap_or("");
+    let best = list
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .min_by_key(|k| edit_distance(unknown, k));
+    match best {
+        Some(k) => {
+            // Put the hint on the first line, before serde's "in `section`" line.
+            let (first, more) = msg.split_once('\n').unwrap_or((msg.as_str(), ""));
+            let more = more.trim();
+            if more.is_empty() {
+                format!("{first}; did you mean `{k}`?")
+            } else {
+                format!("{first}; did you mean `{k}`? ({more})")
+            }
+        }
+        None => msg,
+    }
+}
+
 impl Config {
     /// Parse TOML text with overrides, without validating.
     pub fn parse_with(text: &str, overrides: &[String]) -> Result<Config, ConfigError> {
@@ -470,7 +521,7 @@ impl Config {
             .parse()
             .map_err(|e: toml::de::Error| ConfigError::Parse(e.to_string()))?;
         apply_overrides(&mut root, overrides)?;
-        Config::deserialize(root).map_err(|e| ConfigError::Parse(e.to_string()))
+        Config::deserialize(root).map_err(|e| ConfigError::Parse(suggest_nearest(e.to_string())))
     }
 
     /// Read, override and validate a configuration file.
@@ -686,6 +737,38 @@ impl Config {
         c.problems
     }
 
+    /// The keys that cannot change while the daemon runs a job: those defining the job, the
+    /// bus identity and the control period. Returns the ones that differ in `new`.
+    pub fn fixed_key_changes(&self, new: &Config) -> Vec<&'static str> {
+        let mut v = Vec::new();
+        let mut check = |key: &'static str, same: bool| {
+            if !same {
+                v.push(key);
+            }
+        };
+        check("job", self.job == new.job);
+        check("guidance", self.guidance == new.guidance);
+        check(
+            "vehicle.r_min_m",
+            self.vehicle.r_min_m == new.vehicle.r_min_m,
+        );
+        check("control.dt_s", self.control.dt_s == new.control.dt_s);
+        check("bus.interface", self.bus.interface == new.bus.interface);
+        check(
+            "bus.source_address",
+            self.bus.source_address == new.bus.source_address,
+        );
+        check(
+            "bus.status_socket",
+            self.bus.status_socket == new.bus.status_socket,
+        );
+        check(
+            "progress.state_dir",
+            self.progress.state_dir == new.progress.state_dir,
+        );
+        v
+    }
+
     /// The resolved configuration as TOML text.
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot print: {e}"))
@@ -801,6 +884,13 @@ mod tests {
         assert!(err.to_string().contains("unknown field `dt`"), "{err}");
         let err = Config::parse_with("", &["track.nope=1".into()]).unwrap_err();
         assert!(err.to_string().contains("nope"), "{err}");
+        let err = Config::parse_with("[control]\nspeed_kmn = 9\n", &[]).unwrap_err();
+        assert!(
+            err.to_string().contains("did you mean `speed_kmh`?"),
+            "{err}"
+        );
+        let err = Config::parse_with("[vehicel]\n", &[]).unwrap_err();
+        assert!(err.to_string().contains("did you mean `vehicle`?"), "{err}");
     }
 
     #[test]
@@ -830,6 +920,21 @@ mod tests {
         assert!(msgs
             .iter()
             .any(|m| m.starts_with("control.speed_kmh = NaN")));
+    }
+
+    #[test]
+    fn job_keys_are_fixed_tuning_keys_are_not() {
+        let a = Config::default();
+        let tuned = Config::parse_with(
+            "[track]\nld_min_m = 4.0\n[safety]\na_lat_max_m_s2 = 1.5\n",
+            &[],
+        )
+        .unwrap();
+        assert!(a.fixed_key_changes(&tuned).is_empty());
+        let moved =
+            Config::parse_with("[job]\nline_width_m = 4.0\n[vehicle]\nr_min_m = 6.0\n", &[])
+                .unwrap();
+        assert_eq!(a.fixed_key_changes(&moved), vec!["job", "vehicle.r_min_m"]);
     }
 
     #[test]

@@ -135,33 +135,24 @@ pub struct Proc {
 impl Proc {
     /// Spawn with stderr to /tmp/NAME.log (the VM's serial console is slow).
     pub fn spawn(prog: &str, args: &[&str]) -> Proc {
-        Proc::spawn_with(prog, args, None)
+        Proc::spawn_logging(prog, args, false)
     }
-    /// Spawn under SCHED_FIFO at `priority` (1..=99), stderr to /tmp/NAME.log.
-    pub fn spawn_realtime(prog: &str, args: &[&str], priority: i32) -> Proc {
-        Proc::spawn_with(prog, args, Some(priority))
-    }
-    fn spawn_with(prog: &str, args: &[&str], realtime: Option<i32>) -> Proc {
-        use std::os::unix::process::CommandExt;
-        let log = std::fs::File::create(format!("/tmp/{prog}.log")).expect("log file");
-        let mut cmd = Command::new(prog);
-        cmd.args(args).stdin(Stdio::null()).stderr(log);
-        if let Some(priority) = realtime {
-            // SAFETY: runs in the child between fork and exec and only calls
-            // sched_setscheduler, which is async-signal-safe.
-            unsafe {
-                cmd.pre_exec(move || {
-                    let param = libc::sched_param {
-                        sched_priority: priority,
-                    };
-                    if libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) != 0 {
-                        return Err(std::io::Error::last_os_error());
-                    }
-                    Ok(())
-                });
-            }
-        }
-        let child = cmd.spawn().unwrap_or_else(|e| panic!("{prog}: {e}"));
+
+    /// Spawn, appending stderr to /tmp/NAME.log when `append`.
+    pub fn spawn_logging(prog: &str, args: &[&str], append: bool) -> Proc {
+        let log = std::fs::OpenOptions::new()
+            .create(true)
+            .append(append)
+            .write(true)
+            .truncate(!append)
+            .open(format!("/tmp/{prog}.log"))
+            .expect("log file");
+        let child = Command::new(prog)
+            .args(args)
+            .stdin(Stdio::null())
+            .stderr(log)
+            .spawn()
+            .unwrap_or_else(|e| panic!("{prog}: {e}"));
         Proc { child }
     }
     pub fn pid(&self) -> u32 {
@@ -201,13 +192,22 @@ pub const CONFIG: &str = "config/vcan.toml";
 /// receiver, separate hardware in the field, so on the guest's one vCPU it runs above the
 /// daemon (`daemon.realtime_priority` = 50 in config/vcan.toml), below the [`StallProbe`], and
 /// the daemon's CPU use cannot make its inputs stale. It sleeps 2 ms per loop.
-pub const SIM_PRIORITY: i32 = 60;
+pub const SIM_PRIORITY: u8 = 60;
 
 /// Start `agsteer sim` on `iface` with `extra` arguments, at [`SIM_PRIORITY`].
 pub fn start_sim(iface: &str, extra: &[&str]) -> Proc {
-    let mut args = vec!["sim", "--config", CONFIG, "--iface", iface];
+    let priority = SIM_PRIORITY.to_string();
+    let mut args = vec![
+        "sim",
+        "--config",
+        CONFIG,
+        "--iface",
+        iface,
+        "--rt-priority",
+        &priority,
+    ];
     args.extend_from_slice(extra);
-    Proc::spawn_realtime("agsteer", &args, SIM_PRIORITY)
+    Proc::spawn("agsteer", &args)
 }
 pub const STATUS_SOCKET: &str = "/tmp/agsteer/status.sock";
 

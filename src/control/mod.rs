@@ -179,6 +179,12 @@ impl Controller {
         Ok(out)
     }
 
+    /// Replace the tracker and estimator tuning (look-ahead, gains, latency) at once.
+    pub fn set_tuning(&mut self, cfg: &Config) {
+        self.tracker = tracker_params(cfg);
+        self.estimator.set_params(estimator_params(cfg));
+    }
+
     pub fn guidance(&self) -> &Guidance {
         &self.guidance
     }

@@ -132,6 +132,15 @@ impl ControllerNode {
     pub fn supervisor_mut(&mut self) -> &mut Supervisor {
         &mut self.supervisor
     }
+    /// Apply the tuning keys of `cfg` (tracker, estimator, safety limits, output) at once.
+    /// The caller has checked that nothing defining the job changed.
+    pub fn apply_tuning(&mut self, cfg: &Config) {
+        self.ctrl.set_tuning(cfg);
+        self.supervisor.set_params(cfg.safety_params());
+        self.output = cfg.bus.output;
+        self.status_every = ((cfg.bus.status_period_s / cfg.dt()).round() as u64).max(1);
+    }
+
     pub fn status(&self) -> NodeStatus {
         self.status
     }

@@ -126,7 +126,7 @@ pub fn load_progress(cfg: &Config, path: &Path) -> Option<Progress> {
 }
 
 /// Run this thread under SCHED_FIFO at `priority` (0 = leave it alone).
-fn set_realtime_priority(priority: u8) {
+pub fn set_realtime_priority(priority: u8) {
     if priority == 0 {
         return;
     }
@@ -175,16 +175,57 @@ fn log_event(ev: &Event) {
     }
 }
 
+/// Where the configuration came from, for SIGHUP.
+#[derive(Debug, Clone)]
+pub struct ConfigSource {
+    pub path: PathBuf,
+    pub overrides: Vec<String>,
+}
+
+/// Apply a re-read configuration: all at once when valid and when nothing that defines the
+/// running job changed; otherwise the running configuration stays and the reason is logged.
+fn apply_reload(
+    cfg: &mut Config,
+    source: &ConfigSource,
+    node: &mut ControllerNode,
+    loaded: Result<Config, crate::config::ConfigError>,
+) {
+    let new = match loaded {
+        Ok(c) => c,
+        Err(e) => {
+            tracing::error!(
+                "SIGHUP: {} is not valid, keeping the running configuration: {e}",
+                source.path.display()
+            );
+            return;
+        }
+    };
+    let fixed = cfg.fixed_key_changes(&new);
+    if !fixed.is_empty() {
+        tracing::error!(
+            "SIGHUP: refused: {} cannot change while the daemon runs a job (restart agsteerd to change them); keeping the running configuration",
+            fixed.join(", ")
+        );
+        return;
+    }
+    node.apply_tuning(&new);
+    *cfg = new;
+    tracing::info!(
+        "SIGHUP: configuration reloaded from {}",
+        source.path.display()
+    );
+}
+
 /// Run the daemon until SIGTERM or SIGINT.
-pub fn run(cfg: Config) -> Result<(), DaemonError> {
+pub fn run(cfg: Config, source: ConfigSource) -> Result<(), DaemonError> {
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
         .map_err(DaemonError::Runtime)?;
-    rt.block_on(run_async(cfg))
+    rt.block_on(run_async(cfg, source))
 }
 
-async fn run_async(cfg: Config) -> Result<(), DaemonError> {
+async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonError> {
     use tokio::signal::unix::{signal, SignalKind};
     let iface = cfg.bus.interface.clone();
     let bus = std::rc::Rc::new(AsyncSocketCan::open(&iface, &receive_filters()).map_err(
@@ -251,6 +292,9 @@ async fn run_async(cfg: Config) -> Result<(), DaemonError> {
     let mut late_sum = 0.0;
     let mut bus_up = true;
     tracing::info!(interface = %iface, dt_s = dt, "agsteerd running");
+    let mut watchdog = crate::daemon::notify::Watchdog::from_env();
+    let mut reloading: Option<tokio::task::JoinHandle<Result<Config, crate::config::ConfigError>>> =
+        None;
     crate::daemon::notify::ready();
 
     local
@@ -261,7 +305,23 @@ async fn run_async(cfg: Config) -> Result<(), DaemonError> {
                     _ = sigterm.recv() => break,
                     _ = sigint.recv() => break,
                     _ = sighup.recv() => {
-                        tracing::warn!("SIGHUP: configuration reload is not supported yet; keeping the running configuration");
+                        // The file is read on the blocking pool, never in the control loop.
+                        let src = source.clone();
+                        reloading = Some(tokio::task::spawn_blocking(move || {
+                            Config::load(&src.path, &src.overrides)
+                        }));
+                    }
+                    loaded = async {
+                        match reloading.as_mut() {
+                            Some(h) => h.await,
+                            None => std::future::pending().await,
+                        }
+                    } => {
+                        reloading = None;
+                        match loaded {
+                            Ok(l) => apply_reload(&mut cfg, &source, &mut node, l),
+                            Err(e) => tracing::error!("SIGHUP: reading the configuration failed: {e}"),
+                        }
                     }
                     scheduled = interval.tick() => {
                         let late = scheduled.elapsed().as_secs_f64();
@@ -307,9 +367,7 @@ async fn run_async(cfg: Config) -> Result<(), DaemonError> {
                             );
                         }
                         stats.max_step_us = stats.max_step_us.max(stats.last_step_us);
-                        if late <= dt {
-                            crate::daemon::notify::watchdog();
-                        }
+                        watchdog.period(late <= dt);
                     }
                     ev = rx.recv() => match ev {
                         Some(BusEvent::Frame(tf)) => {

@@ -191,6 +191,8 @@ pub struct DemoRun {
     pub finished_lines: Vec<u64>,
     /// Progress at the end of the run.
     pub progress: Progress,
+    /// Every end of an engagement: (simulated time s, fault).
+    pub disengage_events: Vec<(f64, String)>,
 }
 
 fn tracker_name(kind: TrackerChoice) -> &'static str {
@@ -279,6 +281,7 @@ pub fn run(
     let mut engagements = 0u64;
     let mut frames = 0u64;
     let mut disengagements = std::collections::BTreeMap::new();
+    let mut disengage_events = Vec::new();
     let mut t = 0.0;
     let mut k: u64 = 0;
     let mut stopped = false;
@@ -330,7 +333,8 @@ pub fn run(
                 .ok()
                 .and_then(|v| v.as_str().map(str::to_string))
                 .unwrap_or_else(|| format!("{:?}", cmd.fault));
-            *disengagements.entry(name).or_insert(0) += 1;
+            *disengagements.entry(name.clone()).or_insert(0) += 1;
+            disengage_events.push((t, name));
         }
         was_engaged = cmd.engaged;
 
@@ -439,5 +443,6 @@ pub fn run(
         trace,
         finished_lines,
         progress: ctrl.guidance().progress(),
+        disengage_events,
     })
 }

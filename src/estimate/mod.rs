@@ -97,6 +97,11 @@ impl Estimator {
         &self.params
     }
 
+    /// New tuning; the fix and the wheel-angle history are kept.
+    pub fn set_params(&mut self, params: EstimatorParams) {
+        self.params = params;
+    }
+
     /// Rear-axle position from the antenna position, heading and roll.
     pub fn antenna_to_rear_axle(&self, antenna: &Vec2, heading: f64, roll: Option<f64>) -> Vec2 {
         let a = &self.params.antenna;

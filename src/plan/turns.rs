@@ -14,6 +14,9 @@ use super::PlanError;
 use crate::geo::{cross, left_normal, v2, PathPoint, Vec2};
 use std::f64::consts::TAU;
 
+/// Arc sweeps below this are treated as zero, rad.
+const ZERO_SWEEP: f64 = 1e-6;
+
 /// Shape parameters of every turn.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TurnParams {
@@ -58,9 +61,10 @@ impl TurnParams {
     }
 }
 
-/// Append the points of an arc about `centre` from `from` to `to`, turning counter-clockwise
-/// when `ccw`, with steps of at most `step` rad. `from` itself is appended only when
-/// `include_start`; `to` is appended exactly.
+/// Append the points of an arc about `centre` from `from` to `to` (positions, m), turning
+/// counter-clockwise when `ccw`, with steps of at most `step` rad. `from` itself is appended
+/// only when `include_start`; `to` is appended exactly. An arc of (numerically) zero sweep adds
+/// no point beyond `from` (when asked for), so touching arcs never duplicate a point.
 pub fn arc_points(
     centre: Vec2,
     from: Vec2,
@@ -74,15 +78,28 @@ pub fn arc_points(
     let a0 = (from.y - centre.y).atan2(from.x - centre.x);
     let a1 = (to.y - centre.y).atan2(to.x - centre.x);
     let mut sweep = if ccw { a1 - a0 } else { a0 - a1 }.rem_euclid(TAU);
-    if sweep > TAU - 1e-12 {
+    // A sweep within a micro-radian of zero or of a full turn is a zero arc (rounding of
+    // touching arcs); no turn arc legitimately sweeps a full circle.
+    if sweep > TAU - ZERO_SWEEP {
         sweep = 0.0;
+    }
+    if include_start {
+        out.push(PathPoint::turn(from));
+    }
+    if sweep < ZERO_SWEEP {
+        // `to` is `from` up to rounding. When the caller put `from` down already, make that
+        // point exactly `to` (so a turn still ends exactly on its target).
+        if !include_start {
+            match out.last_mut() {
+                Some(last) => last.pos = to,
+                None => out.push(PathPoint::turn(to)),
+            }
+        }
+        return;
     }
     let sign = if ccw { 1.0 } else { -1.0 };
     // At least two steps, so every arc has an interior point and a well-defined tangent.
     let n = ((sweep / step).ceil() as usize).max(2);
-    if include_start {
-        out.push(PathPoint::turn(from));
-    }
     for i in 1..n {
         let a = a0 + sign * sweep * i as f64 / n as f64;
         out.push(PathPoint::turn(centre + v2(a.cos(), a.sin()) * r));
@@ -114,8 +131,14 @@ fn toward_next(p1: &Vec2, dir1: &Vec2, p2: &Vec2) -> (Vec2, f64) {
 
 /// The seed-000 turn: quarter arc, straight (or merge), quarter arc.
 ///
-/// `p1` is the end of the current line, `dir1` its unit travel direction; `p2` is the start of
-/// the next line. The lines must be at least `2·r_min` apart (within 1 mm).
+/// `p1` is the end of the current line (m), `dir1` its unit travel direction; `p2` is the
+/// start of the next line (m), on either side. Circle 1 (radius `r_min`) touches the current
+/// line at `p1`, circle 2 the next line at `p2`, both toward the other line; the turning sense
+/// follows the seed: positive `cross(dir1, p1 − c1)` turns clockwise, else counter-clockwise.
+/// Arc points are at most `arc_step` apart; the straight between the arc ends is interpolated
+/// to `point_spacing` (at most `max_points` interior points) unless the ends are closer than
+/// `merge_distance`, in which case the two arcs merge into one semicircle. The lines must be
+/// at least `2·r_min` apart (within 1 mm), else [`PlanError::Turn`].
 pub fn pi_turn(
     p1: Vec2,
     dir1: Vec2,
@@ -139,16 +162,33 @@ pub fn pi_turn(
     let e1 = c1 + dir1 * r;
     let c2 = p2 - n * r;
     let s2 = c2 + dir1 * r;
-    arc_points(c1, p1, e1, ccw, params.arc_step, true, out);
-    if (s2 - e1).norm() >= params.merge_distance {
+    let gap = s2 - e1;
+    if gap.norm() >= params.merge_distance {
+        arc_points(c1, p1, e1, ccw, params.arc_step, true, out);
         straight_points(e1, s2, params.point_spacing, params.max_points, out);
+        arc_points(c2, s2, p2, ccw, params.arc_step, false, out);
+    } else if gap.dot(&dir1).abs() < 1e-3 {
+        // Merge, next line level with this one: one semicircle through p1 and p2 (radius
+        // d/2 ≥ r_min up to the 1 mm tolerance), tangent to both lines, evenly stepped.
+        arc_points((p1 + p2) / 2.0, p1, p2, ccw, params.arc_step, true, out);
+    } else {
+        // Merge with a small longitudinal offset: the two quarter arcs back to back (the
+        // skipped straight is shorter than `merge_distance`).
+        arc_points(c1, p1, e1, ccw, params.arc_step, true, out);
+        arc_points(c2, s2, p2, ccw, params.arc_step, false, out);
     }
-    arc_points(c2, s2, p2, ccw, params.arc_step, false, out);
     Ok(())
 }
 
-/// A forward-only bulb turn between lines closer than `2·r_min`: an arc away from the next
-/// line, a large arc toward it, and an arc away again, all of radius `r_min` and tangent.
+/// A forward-only bulb (omega) turn between lines closer than `2·r_min`: an arc away from the
+/// next line by β, a large arc the other way by π + 2β, and an arc away again by β, all of
+/// radius `r_min` (m) and tangent to each other, ending exactly at `p2` heading along `−dir1`.
+///
+/// `p1` is the end of the current line (m), `dir1` its unit travel direction, `p2` the start
+/// of the next line (m), `0 ≤ d ≤ 2·r_min` apart sideways (within 1 mm). `d = 0` (the same
+/// line back) gives the symmetric omega with β = 60°; `d = 2·r_min` degenerates to the merged
+/// pi turn (β = 0, one semicircle). Errors when the lines are farther apart, or `p2` lies so
+/// far along the current line that the middle circle cannot touch both others.
 pub fn bulb_turn(
     p1: Vec2,
     dir1: Vec2,
@@ -169,10 +209,22 @@ pub fn bulb_turn(
     // the far side, c2 ahead in the headland tangent to both.
     let c1 = p1 - n * r;
     let c3 = p2 + n * r;
-    let m = (c1 + c3) / 2.0;
-    let half = (c3 - c1).norm() / 2.0;
+    // |c3 − c1| ≥ d + 2r − (rounding) > 0 whatever the longitudinal offset of p2.
+    let span = c3 - c1;
+    let half = span.norm() / 2.0;
+    if half > 2.0 * r + 1e-3 {
+        return Err(PlanError::Turn {
+            reason: "next line starts too far along the current one for a bulb turn",
+            distance: d,
+        });
+    }
+    // c2 on the perpendicular bisector of c1–c3, on the headland side, 2r from both.
+    let mut bisector = left_normal(&(span / (2.0 * half)));
+    if bisector.dot(&dir1) < 0.0 {
+        bisector = -bisector;
+    }
     let h = ((2.0 * r).powi(2) - half * half).max(0.0).sqrt();
-    let c2 = m + dir1 * h;
+    let c2 = (c1 + c3) / 2.0 + bisector * h;
     let t1 = (c1 + c2) / 2.0;
     let t2 = (c2 + c3) / 2.0;
     // Turning toward the next line is counter-clockwise when it lies to the left.
@@ -302,23 +354,102 @@ mod tests {
         assert_eq!(ccount, 4, "90 m straight in 4 pieces");
     }
 
+    fn assert_no_duplicates(pts: &[Vec2]) {
+        for w in pts.windows(2) {
+            assert!((w[1] - w[0]).norm() > 1e-6, "duplicate point {:?}", w[0]);
+        }
+    }
+
     #[test]
     fn bulb_turn_geometry() {
-        for &d in &[0.5, 3.0, 6.0, 9.99] {
+        // d = 0 (same line back), up to d = 2r (degenerates into the merged pi turn).
+        for &d in &[0.0, 0.5, 3.0, 6.0, 9.99, 10.0] {
             for &left in &[true, false] {
-                let dir1 = heading_vec(1.1);
-                let n = if left {
-                    left_normal(&dir1)
-                } else {
-                    -left_normal(&dir1)
-                };
-                let p1 = v2(-4.0, 7.0);
-                let p2 = p1 + n * d;
-                let mut out = Vec::new();
-                bulb_turn(p1, dir1, p2, &params(5.0), &mut out).unwrap();
-                let pts: Vec<Vec2> = out.iter().map(|p| p.pos).collect();
-                check_turn(&pts, p1, dir1, p2, -dir1, 5.0);
+                // Next line starting level with the current end, or a little along/behind it.
+                for &along in &[0.0, 1.5, -2.0] {
+                    // Near d = 2r the middle circle cannot reach an offset start.
+                    if along != 0.0 && d > 6.0 {
+                        continue;
+                    }
+                    let dir1 = heading_vec(1.1);
+                    let n = if left {
+                        left_normal(&dir1)
+                    } else {
+                        -left_normal(&dir1)
+                    };
+                    let p1 = v2(-4.0, 7.0);
+                    let p2 = p1 + n * d + dir1 * along;
+                    let mut out = Vec::new();
+                    bulb_turn(p1, dir1, p2, &params(5.0), &mut out).unwrap();
+                    let pts: Vec<Vec2> = out.iter().map(|p| p.pos).collect();
+                    check_turn(&pts, p1, dir1, p2, -dir1, 5.0);
+                    assert_no_duplicates(&pts);
+                    assert!(out.iter().all(|p| p.tag == crate::geo::Tag::Turn));
+                    assert!(out
+                        .iter()
+                        .all(|p| p.direction == crate::geo::Direction::Forward));
+                    // The middle arc reaches r (d = 2r) to (1 + √3)·r (d = 0) beyond the line
+                    // end.
+                    let reach = pts
+                        .iter()
+                        .map(|q| (q - p1).dot(&dir1))
+                        .fold(f64::MIN, f64::max);
+                    let top = (1.0 + 3f64.sqrt()) * 5.0 + along.abs();
+                    assert!(reach >= 5.0 - 1e-6 && reach <= top, "reach {reach}");
+                    // Going away from the next line first (for d > 0).
+                    if d > 0.0 && d <= 6.0 {
+                        let side = |q: &Vec2| (q - p1).dot(&n);
+                        assert!(pts.iter().take(4).skip(1).all(|q| side(q) < 0.0));
+                    }
+                }
             }
+        }
+        // The middle circle cannot touch both when the next line starts far ahead.
+        let mut out = Vec::new();
+        assert!(bulb_turn(
+            v2(0.0, 0.0),
+            v2(1.0, 0.0),
+            v2(30.0, 2.0),
+            &params(5.0),
+            &mut out
+        )
+        .is_err());
+    }
+
+    #[test]
+    fn pi_turn_merges_nearly_touching_arcs_without_a_kink() {
+        // d slightly above 2r: arc ends 3 cm apart, below the 5 cm merge distance.
+        let (r, d) = (5.0, 10.03);
+        for &left in &[true, false] {
+            let dir1 = heading_vec(-2.5);
+            let n = if left {
+                left_normal(&dir1)
+            } else {
+                -left_normal(&dir1)
+            };
+            let p1 = v2(1.0, 2.0);
+            let p2 = p1 + n * d;
+            let mut merged = Vec::new();
+            pi_turn(p1, dir1, p2, &params(r), &mut merged).unwrap();
+            let pts: Vec<Vec2> = merged.iter().map(|p| p.pos).collect();
+            check_turn(&pts, p1, dir1, p2, -dir1, r);
+            assert_no_duplicates(&pts);
+            // With a zero merge distance the 3 cm straight is kept as its own point pair.
+            let mut p = params(r);
+            p.merge_distance = 0.0;
+            let mut joined = Vec::new();
+            pi_turn(p1, dir1, p2, &p, &mut joined).unwrap();
+            // Merged: every point on the one semicircle about the midpoint.
+            let centre = (p1 + p2) / 2.0;
+            assert!(pts
+                .iter()
+                .all(|q| ((q - centre).norm() - d / 2.0).abs() < 1e-9));
+            // Joined: two quarter arcs of radius r with the 3 cm straight between them.
+            let straight = joined
+                .windows(2)
+                .filter(|w| ((w[1].pos - w[0].pos).norm() - (d - 2.0 * r)).abs() < 1e-9)
+                .count();
+            assert_eq!(straight, 1);
         }
     }
 

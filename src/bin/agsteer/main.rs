@@ -70,6 +70,10 @@ enum Command {
         /// Stop after this many seconds (default: run until killed).
         #[arg(long)]
         duration: Option<f64>,
+        /// SCHED_FIFO priority (1..=99; 0 = normal), so a loaded test machine does not starve
+        /// the simulated sensors.
+        #[arg(long, default_value_t = 0)]
+        rt_priority: u8,
         #[command(flatten)]
         cfg: ConfigArgs,
     },
@@ -126,6 +130,7 @@ fn main() -> ExitCode {
             scenario,
             trajectory,
             duration,
+            rt_priority,
             cfg,
         } => load_config(&config, &cfg.set).and_then(|c| {
             let iface = iface.unwrap_or_else(|| c.bus.interface.clone());
@@ -135,6 +140,7 @@ fn main() -> ExitCode {
                 scenario.as_deref(),
                 trajectory.as_deref(),
                 duration,
+                rt_priority,
             )
         }),
         Command::Status { socket, config } => {

@@ -22,7 +22,10 @@ pub fn run(
     scenario: Option<&Path>,
     trajectory: Option<&Path>,
     duration_s: Option<f64>,
+    realtime_priority: u8,
 ) -> Result<u8> {
+    // The simulator stands in for sensors that are separate devices on a real bus.
+    agsteer::daemon::run::set_realtime_priority(realtime_priority);
     let scenario: Scenario = match scenario {
         Some(p) => {
             let text = std::fs::read_to_string(p)

@@ -57,7 +57,11 @@ fn main() -> ExitCode {
         .with_writer(writer)
         .with_ansi(false)
         .try_init();
-    match agsteer::daemon::run::run(cfg).context("agsteerd") {
+    let source = agsteer::daemon::run::ConfigSource {
+        path: args.config.clone(),
+        overrides: args.set.clone(),
+    };
+    match agsteer::daemon::run::run(cfg, source).context("agsteerd") {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
