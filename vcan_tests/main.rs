@@ -78,37 +78,36 @@ fn recv_within(bus: &mut SocketCanBus, d: Duration) -> Option<agsteer::can::Time
 /// (a) A whole AB job closed-loop, agsteerd and agsteer sim as separate processes; true XTE
 /// figures from the simulator's trajectory. Also the daemon's CPU and memory at dt = 10 ms.
 /// (b) is checked on the candump capture of the same run (see `capture_checks`).
+///
+/// The operator presses engage again if anything disengaged the system (on a loaded host the
+/// emulated guest can freeze long enough to make inputs stale); the run prints how often, and
+/// the most the guest was frozen within one wheel-angle freshness window.
 #[test]
 fn a_closed_loop_job_on_vcan() {
     let Some(iface) = vcan() else { return };
+    let cfg = agsteer::config::Config::load(std::path::Path::new(CONFIG), &[]).unwrap();
     let daemon = start_daemon(&[]);
+    let probe = StallProbe::start();
     let dump = Candump::start(&iface);
     let traj = "/tmp/agsteer-trajectory.csv";
-    let _sim = Proc::spawn(
-        "agsteer",
-        &[
-            "sim",
-            "--config",
-            CONFIG,
-            "--iface",
-            &iface,
-            "--trajectory",
-            traj,
-        ],
-    );
+    let _sim = start_sim(&iface, &["--trajectory", traj]);
     let mut term = Terminal::new(&iface);
     assert!(term.engage(Duration::from_secs(10)), "engaged");
     let cpu0 = proc_cpu_s(daemon.pid());
     let t0 = Instant::now();
-    // The operator presses engage again if anything disengaged the system.
     let mut done = None;
+    let mut reengaged = 0;
     while t0.elapsed() < Duration::from_secs(150) {
         match status() {
             Some(s) if s["finished"] == true => {
                 done = Some(s);
                 break;
             }
-            Some(s) if s["state"] == "ready" && s["engaged"] == false => term.send(1),
+            Some(s) if s["state"] == "ready" && s["engaged"] == false => {
+                println!("VCAN-JOB operator re-engages after: {s}");
+                reengaged += 1;
+                term.send(1);
+            }
             _ => {}
         }
         std::thread::sleep(Duration::from_millis(100));
@@ -118,6 +117,11 @@ fn a_closed_loop_job_on_vcan() {
     let (rss, hwm) = proc_rss_kb(daemon.pid());
     let last = status().unwrap_or_default();
     let lines = dump.stop();
+    let stalls = probe.stop();
+    println!(
+        "VCAN-JOB reengaged={reengaged} most_frozen_ms_per_freshness_window={:.0}",
+        most_frozen_in_window(&stalls, cfg.safety.wheel_angle_timeout_s) * 1e3
+    );
     assert!(done.is_some(), "job finished: {last}");
     println!(
         "DAEMON-RESOURCES cpu_percent={:.1} rss_kb={rss} hwm_kb={hwm} wall_s={wall:.1} loop={}",
@@ -128,50 +132,49 @@ fn a_closed_loop_job_on_vcan() {
     for l in log
         .lines()
         .filter(|l| l.contains("WARN") || l.contains("ERROR"))
+        .take(20)
     {
         println!("DAEMON-LOG {l}");
     }
-    let (rms, p95, max, n) = xte_from_trajectory(traj);
-    println!("VCAN-JOB-XTE rms_m={rms:.4} p95_m={p95:.4} max_m={max:.4} samples={n}");
-    assert!(n > 100);
+    let (rms, p95, max, n, expected) = xte_from_trajectory(traj);
+    println!(
+        "VCAN-JOB-XTE rms_m={rms:.4} p95_m={p95:.4} max_m={max:.4} samples={n} of ~{expected:.0}"
+    );
+    // The simulator samples every 50 ms of its monotonic time; guest stalls skip samples.
+    assert!(
+        n as f64 > 0.6 * expected,
+        "{n} trajectory samples on the lines"
+    );
     assert!(rms < 0.05, "true XTE RMS {rms}");
-    // At dt = 10 ms the emulated VM (TCG) itself stalls now and then for 10-30 ms.
-    capture_checks(&lines, 0.01, 0.995);
+    // Every gap, less the time the whole guest was frozen (see `StallProbe`), within 2·dt.
+    capture_checks(&lines, &stalls, 0.01, 1.0);
 }
 
 /// (b) A candump capture of a closed-loop run at the default dt = 20 ms decodes with zero
-/// unknown or invalid frames, and every gap between command frames is within 2·dt.
+/// unknown or invalid frames, and every gap between command frames is within 2·dt, less the
+/// time the whole emulated guest was frozen (measured by a [`StallProbe`]).
 #[test]
 fn b_capture_decodes_and_commands_come_every_dt() {
     let Some(iface) = vcan() else { return };
     let _daemon = start_daemon(&["--set", "control.dt_s=0.02"]);
-    let _sim = Proc::spawn(
-        "agsteer",
-        &[
-            "sim",
-            "--config",
-            CONFIG,
-            "--iface",
-            &iface,
-            "--set",
-            "control.dt_s=0.02",
-        ],
-    );
+    let _sim = start_sim(&iface, &["--set", "control.dt_s=0.02"]);
     let mut term = Terminal::new(&iface);
     assert!(term.engage(Duration::from_secs(10)), "engaged");
+    let probe = StallProbe::start();
     let dump = Candump::start(&iface);
     std::thread::sleep(Duration::from_secs(20));
     let lines = dump.stop();
+    let stalls = probe.stop();
     // Every gap within 2·dt is what the daemon does on an idle machine (seen: max 23.6 ms);
-    // the emulated VM on a shared 2-core host stalls now and then for tens of ms, so CI holds
-    // 99.5 % of the gaps to 2·dt and every gap to 5·dt, and prints the maximum.
-    capture_checks(&lines, 0.02, 0.995);
+    // the emulated VM on a shared 2-core host freezes now and then for tens of ms, which the
+    // stall probe measures and the check subtracts: every gap less those within 2·dt.
+    capture_checks(&lines, &stalls, 0.02, 1.0);
 }
 
 /// The capture decodes with `agsteer dbc decode` with zero unknown or invalid frames, and
-/// at least `share` of the gaps between command frames are within 2·dt. Also prints the
-/// GNSS-to-command latency.
-fn capture_checks(lines: &[String], dt: f64, share: f64) {
+/// at least `share` of the gaps between command frames, less guest stalls, are within 2·dt.
+/// Also prints the raw gaps and the GNSS-to-command latency.
+fn capture_checks(lines: &[String], stalls: &[Stall], dt: f64, share: f64) {
     std::fs::write("/tmp/agsteer-capture.log", lines.join("\n") + "\n").unwrap();
     let out = run_ok("agsteer", &["dbc", "decode", "/tmp/agsteer-capture.log"]);
     let objs: Vec<serde_json::Value> = out
@@ -199,21 +202,32 @@ fn capture_checks(lines: &[String], dt: f64, share: f64) {
         cmds.len()
     );
     let mut gaps: Vec<f64> = cmds.windows(2).map(|w| w[1].0 - w[0].0).collect();
+    let mut net: Vec<f64> = cmds
+        .windows(2)
+        .map(|w| gap_less_stalls(w[0].0, w[1].0, stalls))
+        .collect();
     gaps.sort_by(|a, b| a.total_cmp(b));
-    let max_gap = *gaps.last().unwrap();
-    let within = gaps.iter().filter(|g| **g <= 2.0 * dt + 1e-6).count() as f64 / gaps.len() as f64;
+    net.sort_by(|a, b| a.total_cmp(b));
+    let bound = 2.0 * dt + 1e-6;
+    let share_within =
+        |g: &[f64]| g.iter().filter(|g| **g <= bound).count() as f64 / g.len() as f64;
+    let (within_raw, within) = (share_within(&gaps), share_within(&net));
+    let max_net = *net.last().unwrap();
     println!(
-        "COMMAND-GAPS dt_ms={} median_ms={:.2} p99_ms={:.2} max_ms={:.2} within_2dt={:.5} over {}",
+        "COMMAND-GAPS dt_ms={} median_ms={:.2} p99_ms={:.2} max_ms={:.2} within_2dt={:.5} \
+         less_stalls: max_ms={:.2} within_2dt={:.5} over {}",
         dt * 1e3,
         pct(&gaps, 0.5) * 1e3,
         pct(&gaps, 0.99) * 1e3,
-        max_gap * 1e3,
+        gaps.last().unwrap() * 1e3,
+        within_raw,
+        max_net * 1e3,
         within,
         gaps.len()
     );
     assert!(
         within >= share,
-        "gaps within 2·dt: {within} (max {max_gap} s)"
+        "gaps less guest stalls within 2·dt: {within} (max {max_net} s)"
     );
     // GNSS position frame arrival → next command frame.
     let mut lat = Vec::new();
@@ -243,7 +257,7 @@ fn capture_checks(lines: &[String], dt: f64, share: f64) {
 fn c_engage_and_disengage_from_cansend() {
     let Some(iface) = vcan() else { return };
     let _daemon = start_daemon(&[]);
-    let _sim = Proc::spawn("agsteer", &["sim", "--config", CONFIG, "--iface", &iface]);
+    let _sim = start_sim(&iface, &[]);
     let mut term = Terminal::new(&iface);
     assert!(wait_status(Duration::from_secs(10), |s| s["state"] == "ready").is_some());
     assert_eq!(
@@ -273,7 +287,7 @@ fn c_engage_and_disengage_from_cansend() {
 fn d_link_down_and_up() {
     let Some(iface) = vcan() else { return };
     let mut daemon = start_daemon(&[]);
-    let _sim = Proc::spawn("agsteer", &["sim", "--config", CONFIG, "--iface", &iface]);
+    let _sim = start_sim(&iface, &[]);
     let mut term = Terminal::new(&iface);
     assert!(term.engage(Duration::from_secs(10)));
     let _guard = LinkGuard(iface.clone());
@@ -313,7 +327,7 @@ fn d_link_down_and_up() {
 fn e_sigterm_disengages_last() {
     let Some(iface) = vcan() else { return };
     let mut daemon = start_daemon(&[]);
-    let _sim = Proc::spawn("agsteer", &["sim", "--config", CONFIG, "--iface", &iface]);
+    let _sim = start_sim(&iface, &[]);
     let mut term = Terminal::new(&iface);
     assert!(term.engage(Duration::from_secs(10)));
     let dump = Candump::start(&iface);
@@ -333,8 +347,8 @@ fn e_sigterm_disengages_last() {
 }
 
 /// True |XTE| on the work lines from the simulator's trajectory (10 m at each line end
-/// excluded): (rms, p95, max, samples).
-fn xte_from_trajectory(path: &str) -> (f64, f64, f64, usize) {
+/// excluded): (rms, p95, max, samples, samples expected at the 50 ms trajectory period).
+fn xte_from_trajectory(path: &str) -> (f64, f64, f64, usize, f64) {
     use agsteer::config::Config;
     use agsteer::control::ab_params;
     use agsteer::plan::abline::AbPlan;
@@ -368,11 +382,13 @@ fn xte_from_trajectory(path: &str) -> (f64, f64, f64, usize) {
     xs.sort_by(|a, b| a.total_cmp(b));
     let n = xs.len().max(1);
     let rms = (xs.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
+    let expected = cfg.job.line_num as f64 * (plan.line_length() - 20.0) / cfg.speed() / 0.05;
     (
         rms,
         pct(&xs, 0.95),
         xs.last().copied().unwrap_or(0.0),
         xs.len(),
+        expected,
     )
 }
 
@@ -400,6 +416,84 @@ fn proc_rss_kb(pid: u32) -> (u64, u64) {
     (get("VmRSS:"), get("VmHWM:"))
 }
 
+/// Host-side check of the helpers the scenarios rely on (runs without vcan).
+#[test]
+fn helpers_parse_candump_and_subtract_stalls() {
+    let lines = vec![
+        "(1700000000.100000) vcan0 0CFF2000#0102FF".to_string(),
+        "garbage".to_string(),
+        "(1700000000.150000) vcan0 0CFF2000#010201".to_string(),
+    ];
+    let cap = parse_candump(&lines);
+    assert_eq!(cap.len(), 2);
+    assert_eq!(cap[0].1, 0x0CFF2000);
+    assert_eq!(cap[0].2, vec![1, 2, 0xFF]);
+    assert_eq!(
+        steering_frames(&cap)
+            .iter()
+            .map(|c| c.1)
+            .collect::<Vec<_>>(),
+        vec![0xFF, 1]
+    );
+    let stalls = [
+        Stall {
+            from_s: 0.9,
+            to_s: 1.02,
+        },
+        Stall {
+            from_s: 1.04,
+            to_s: 1.05,
+        },
+        Stall {
+            from_s: 2.0,
+            to_s: 2.1,
+        },
+    ];
+    // 1.00 → 1.10: 20 ms + 10 ms of it frozen.
+    let net = gap_less_stalls(1.0, 1.1, &stalls);
+    assert!((net - 0.07).abs() < 1e-9, "{net}");
+    assert!((gap_less_stalls(3.0, 3.05, &stalls) - 0.05).abs() < 1e-9);
+    // No 100 ms window holds more than 100 ms of stall, and [0.9, 1.0] holds that much.
+    assert!((most_frozen_in_window(&stalls, 0.1) - 0.1).abs() < 1e-9);
+    // [0.9, 1.05] holds all of the first two stalls.
+    assert!((most_frozen_in_window(&stalls, 0.15) - 0.13).abs() < 1e-9);
+    // Against a brute-force scan of window starts on a 0.1 ms grid, on made-up stalls.
+    let mut seed: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 33) as f64 / (1u64 << 31) as f64
+    };
+    let mut t = 0.0;
+    let mut many = Vec::new();
+    for _ in 0..40 {
+        t += 0.001 + 0.05 * next();
+        let len = 0.002 + 0.04 * next();
+        many.push(Stall {
+            from_s: t,
+            to_s: t + len,
+        });
+        t += len;
+    }
+    for window in [0.03, 0.1, 0.25] {
+        let brute = (0..(t / 1e-4) as usize)
+            .map(|k| {
+                let from = k as f64 * 1e-4 - window;
+                many.iter()
+                    .map(|s| s.overlap_s(from, from + window))
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max);
+        let fast = most_frozen_in_window(&many, window);
+        assert!(
+            fast >= brute - 1e-9 && fast <= brute + 1e-4,
+            "{fast} vs {brute}"
+        );
+    }
+    assert_eq!(most_frozen_in_window(&[], 0.1), 0.0);
+}
+
 /// Fault scenarios on vcan, through the simulator's scenario file: each finds the fault's
 /// first sign in the candump capture and the first disengaged command after it.
 #[test]
@@ -423,18 +517,7 @@ fn f_fault_scenarios_on_vcan() {
         )
         .unwrap();
         let _daemon = start_daemon(&[]);
-        let _sim = Proc::spawn(
-            "agsteer",
-            &[
-                "sim",
-                "--config",
-                CONFIG,
-                "--iface",
-                &iface,
-                "--scenario",
-                &scen,
-            ],
-        );
+        let _sim = start_sim(&iface, &["--scenario", &scen]);
         let mut term = Terminal::new(&iface);
         assert!(term.engage(Duration::from_secs(5)), "{kind}: engaged");
         let dump = Candump::start(&iface);
@@ -684,20 +767,7 @@ fn i_kill_9_resume() {
     };
     let mut daemon = start();
     let traj = "/tmp/agsteer-kill9.csv";
-    let _sim = Proc::spawn(
-        "agsteer",
-        &[
-            "sim",
-            "--config",
-            CONFIG,
-            "--set",
-            &set,
-            "--iface",
-            &iface,
-            "--trajectory",
-            traj,
-        ],
-    );
+    let _sim = start_sim(&iface, &["--set", &set, "--trajectory", traj]);
     let mut term = Terminal::new(&iface);
     assert!(term.engage(Duration::from_secs(10)));
     let mut x: u64 = 0x9E37_79B9;

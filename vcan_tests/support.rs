@@ -187,6 +187,28 @@ impl Drop for Proc {
 }
 
 pub const CONFIG: &str = "config/vcan.toml";
+
+/// SCHED_FIFO priority of the simulator: it stands for the tractor's own ECUs and GNSS
+/// receiver, separate hardware in the field, so on the guest's one vCPU it runs above the
+/// daemon (`daemon.realtime_priority` = 50 in config/vcan.toml), below the [`StallProbe`], and
+/// the daemon's CPU use cannot make its inputs stale. It sleeps 2 ms per loop.
+pub const SIM_PRIORITY: u8 = 60;
+
+/// Start `agsteer sim` on `iface` with `extra` arguments, at [`SIM_PRIORITY`].
+pub fn start_sim(iface: &str, extra: &[&str]) -> Proc {
+    let priority = SIM_PRIORITY.to_string();
+    let mut args = vec![
+        "sim",
+        "--config",
+        CONFIG,
+        "--iface",
+        iface,
+        "--rt-priority",
+        &priority,
+    ];
+    args.extend_from_slice(extra);
+    Proc::spawn("agsteer", &args)
+}
 pub const STATUS_SOCKET: &str = "/tmp/agsteer/status.sock";
 
 /// A fresh state directory and a started daemon.
@@ -311,4 +333,133 @@ pub fn pct(sorted: &[f64], p: f64) -> f64 {
         return f64::NAN;
     }
     sorted[((sorted.len() as f64 * p) as usize).min(sorted.len() - 1)]
+}
+
+/// A stretch of time, in seconds on the realtime clock (the clock of candump's timestamps),
+/// during which the whole guest did not run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stall {
+    pub from_s: f64,
+    pub to_s: f64,
+}
+
+impl Stall {
+    /// Length of the overlap with `[from_s, to_s]`, s.
+    pub fn overlap_s(&self, from_s: f64, to_s: f64) -> f64 {
+        (self.to_s.min(to_s) - self.from_s.max(from_s)).max(0.0)
+    }
+}
+
+/// Watches for stalls of the whole VM (under TCG the host descheduling qemu freezes the guest
+/// for 10–70 ms now and then). A SCHED_FIFO 99 thread, above the daemon and simulator, sleeps
+/// 1 ms at a time and records every wake-up more than [`StallProbe::LATE_S`] late. As the
+/// highest-priority task on the guest's one vCPU it is late only when the guest as a whole did
+/// not run, never because the daemon or another task held the CPU, so a command gap that
+/// overlaps a recorded stall is the emulator's doing, not the daemon's.
+pub struct StallProbe {
+    stop: Arc<std::sync::atomic::AtomicBool>,
+    handle: Option<std::thread::JoinHandle<Vec<Stall>>>,
+}
+
+impl StallProbe {
+    /// Lateness of a wake-up past which it counts as a stall, s.
+    pub const LATE_S: f64 = 0.002;
+    const PERIOD: Duration = Duration::from_millis(1);
+
+    pub fn start() -> StallProbe {
+        let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let stop2 = stop.clone();
+        let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+        let handle = std::thread::spawn(move || {
+            let param = libc::sched_param { sched_priority: 99 };
+            // SAFETY: sets this thread's own scheduling policy; param outlives the call.
+            let realtime = unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) } == 0;
+            let _ = ready_tx.send(());
+            if !realtime {
+                // At normal priority lateness proves nothing: excuse no gap.
+                println!("STALL-PROBE off: SCHED_FIFO refused");
+                return Vec::new();
+            }
+            let mut stalls = Vec::with_capacity(1024);
+            let now = || {
+                std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map(|d| d.as_secs_f64())
+                    .unwrap_or(0.0)
+            };
+            while !stop2.load(std::sync::atomic::Ordering::Relaxed) {
+                let before = now();
+                std::thread::sleep(StallProbe::PERIOD);
+                let after = now();
+                let due = before + StallProbe::PERIOD.as_secs_f64();
+                if after - due > StallProbe::LATE_S {
+                    stalls.push(Stall {
+                        from_s: due,
+                        to_s: after,
+                    });
+                }
+            }
+            stalls
+        });
+        let _ = ready_rx.recv();
+        StallProbe {
+            stop,
+            handle: Some(handle),
+        }
+    }
+
+    /// Stop and return the stalls seen, printing a summary line.
+    pub fn stop(mut self) -> Vec<Stall> {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        let stalls = self
+            .handle
+            .take()
+            .and_then(|h| h.join().ok())
+            .unwrap_or_default();
+        let total: f64 = stalls.iter().map(|s| s.to_s - s.from_s).sum();
+        let max = stalls.iter().map(|s| s.to_s - s.from_s).fold(0.0, f64::max);
+        println!(
+            "GUEST-STALLS count={} total_ms={:.1} max_ms={:.1}",
+            stalls.len(),
+            total * 1e3,
+            max * 1e3
+        );
+        stalls
+    }
+}
+
+impl Drop for StallProbe {
+    fn drop(&mut self) {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// A gap between two frames at `from_s` and `to_s` (realtime s) less the time the guest was
+/// stalled within it, s.
+pub fn gap_less_stalls(from_s: f64, to_s: f64, stalls: &[Stall]) -> f64 {
+    let frozen: f64 = stalls.iter().map(|s| s.overlap_s(from_s, to_s)).sum();
+    (to_s - from_s - frozen).max(0.0)
+}
+
+/// The most time the guest spent frozen within any window of `window_s` seconds, s.
+/// `stalls` are in time order and do not overlap (as [`StallProbe`] records them).
+pub fn most_frozen_in_window(stalls: &[Stall], window_s: f64) -> f64 {
+    let frozen_in = |from_s: f64| -> f64 {
+        stalls
+            .iter()
+            .skip_while(|s| s.to_s <= from_s)
+            .take_while(|s| s.from_s < from_s + window_s)
+            .map(|s| s.overlap_s(from_s, from_s + window_s))
+            .sum()
+    };
+    // The frozen time is piecewise linear in the window's start: its maximum is at a window
+    // starting where a stall starts or ending where one ends.
+    stalls
+        .iter()
+        .flat_map(|s| [s.from_s, s.to_s - window_s])
+        .map(frozen_in)
+        .fold(0.0, f64::max)
 }

@@ -56,8 +56,10 @@ struct Hub {
     now: f64,
 }
 
-/// An in-memory bus: every node sees every frame the other nodes send, stamped with the hub's
-/// time (set by the caller), so runs are deterministic and faster than real time.
+/// An in-memory bus: every node sees every frame the other nodes send, in send order,
+/// stamped with the hub's time (set by the caller), so runs are deterministic and faster than
+/// real time. A node sees only frames sent after it was attached. `clone()` gives another
+/// handle on the same node (same receive queue); [`MemBus::node`] attaches a new node.
 #[derive(Debug, Clone)]
 pub struct MemBus {
     hub: Arc<Mutex<Hub>>,
@@ -240,6 +242,79 @@ mod tests {
         assert_eq!(fb.t, 1.5);
         assert!(c.try_recv().unwrap().is_some());
         assert!(c.try_recv().unwrap().is_none());
+    }
+
+    #[test]
+    fn mem_bus_keeps_send_order_across_senders() {
+        let mut a = MemBus::new();
+        let mut b = a.node();
+        let mut c = a.node();
+        a.send(&Frame::new(0x100, &[1])).unwrap();
+        b.send(&Frame::new(0x200, &[2])).unwrap();
+        a.send(&Frame::new(0x101, &[3])).unwrap();
+        let ids = |bus: &mut MemBus| {
+            std::iter::from_fn(|| bus.try_recv().unwrap())
+                .map(|f| f.frame.id)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(ids(&mut c), vec![0x100, 0x200, 0x101]);
+        assert_eq!(ids(&mut b), vec![0x100, 0x101]);
+        assert_eq!(ids(&mut a), vec![0x200]);
+    }
+
+    #[test]
+    fn mem_bus_stamps_each_frame_with_the_time_at_sending() {
+        let mut a = MemBus::new();
+        let mut b = a.node();
+        a.set_time(0.25);
+        a.send(&Frame::new(0x100, &[])).unwrap();
+        b.set_time(0.5);
+        a.send(&Frame::new(0x101, &[])).unwrap();
+        let t: Vec<f64> = std::iter::from_fn(|| b.try_recv().unwrap())
+            .map(|f| f.t)
+            .collect();
+        assert_eq!(t, vec![0.25, 0.5]);
+    }
+
+    #[test]
+    fn mem_bus_late_node_sees_only_later_frames_and_clones_share_a_node() {
+        let mut a = MemBus::new();
+        a.send(&Frame::new(0x100, &[1])).unwrap();
+        let mut late = a.node();
+        assert!(late.try_recv().unwrap().is_none());
+        let mut same = late.clone();
+        a.send(&Frame::new(0x101, &[2])).unwrap();
+        same.send(&Frame::new(0x300, &[3])).unwrap();
+        assert_eq!(late.try_recv().unwrap().map(|f| f.frame.id), Some(0x101));
+        assert!(same.try_recv().unwrap().is_none(), "one queue per node");
+        assert_eq!(a.try_recv().unwrap().map(|f| f.frame.id), Some(0x300));
+    }
+
+    #[test]
+    fn frame_new_masks_the_id_and_truncates_the_payload() {
+        let f = Frame::new(0xFFFF_FFFF, &[1, 2, 3, 4, 5, 6, 7, 8, 9]);
+        assert_eq!(f.id, 0x1FFF_FFFF);
+        assert_eq!(f.len, 8);
+        assert_eq!(f.payload(), &[1, 2, 3, 4, 5, 6, 7, 8]);
+    }
+
+    #[test]
+    fn filters_carry_the_extended_frame_flag() {
+        let f = socketcan_filters(&[Filter {
+            id: 0x00FF_2000,
+            mask: 0x03FF_FF00,
+        }]);
+        assert_eq!(f.len(), 1);
+        // The EFF flag in both id and mask: only extended frames with matching bits pass.
+        let raw: &libc::can_filter = f[0].as_ref();
+        assert_eq!(raw.can_id, 0x80FF_2000);
+        assert_eq!(raw.can_mask, 0x83FF_FF00);
+    }
+
+    #[test]
+    fn other_io_errors_stay_io_errors() {
+        let other = BusError::from(std::io::Error::from_raw_os_error(libc::EINVAL));
+        assert!(matches!(other, BusError::Io(_)));
     }
 
     #[test]
