@@ -849,3 +849,51 @@ fn line_crossings(path: &str, set: &str) -> Vec<u32> {
     }
     counts
 }
+
+/// Every known identifier with payloads of every length 0–8 and random bytes, sent at the
+/// running daemon: it survives, keeps answering, and counts each invalid frame (wrong length,
+/// bad CRC).
+#[test]
+fn j_garbage_on_every_known_id() {
+    let Some(iface) = vcan() else { return };
+    let mut daemon = start_daemon(&[]);
+    let before = status().unwrap()["bad_frames"].as_u64().unwrap();
+    let mut tx = SocketCanBus::open(&iface, &[]).unwrap();
+    let mut x: u64 = 0xDEAD_BEEF_1234_5678;
+    let mut expected_bad = 0u64;
+    for def in agsteer::can::codec::MESSAGES {
+        // The daemon listens to what others send; its own frames it only writes.
+        if def.transmitter == "AGSTEER" {
+            continue;
+        }
+        for len in 0..=8usize {
+            for _ in 0..20 {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                let f = Frame::new(def.id, &x.to_le_bytes()[..len]);
+                let valid = agsteer::can::codec::decode(f.id, f.payload()).is_ok();
+                if !valid && def.name != "GnssPositionData" {
+                    expected_bad += 1;
+                }
+                while tx.send(&f).is_err() {
+                    std::thread::sleep(Duration::from_millis(1));
+                }
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    let st = status().expect("daemon still answers");
+    let bad = st["bad_frames"].as_u64().unwrap() - before;
+    println!(
+        "VCAN-GARBAGE expected_invalid>={expected_bad} counted={bad} engaged={}",
+        st["engaged"]
+    );
+    assert!(daemon.alive(), "no panic");
+    assert!(
+        bad >= expected_bad,
+        "every invalid frame counted: {bad} < {expected_bad}"
+    );
+    assert_eq!(st["engaged"], false);
+}
