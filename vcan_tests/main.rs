@@ -208,7 +208,10 @@ fn capture_checks(lines: &[String], stalls: &[Stall], dt: f64, share: f64) {
         .collect();
     gaps.sort_by(|a, b| a.total_cmp(b));
     net.sort_by(|a, b| a.total_cmp(b));
-    let bound = 2.0 * dt + 1e-6;
+    // Gaps less recorded stalls are within 2·dt up to the probe's resolution: a guest pause
+    // shorter than `StallProbe::LATE_S` is not recorded (seen once on CI: 20.03 ms at dt 10 ms,
+    // raw 24.18 ms), so it cannot be subtracted either.
+    let bound = 2.0 * dt + StallProbe::LATE_S;
     let share_within =
         |g: &[f64]| g.iter().filter(|g| **g <= bound).count() as f64 / g.len() as f64;
     let (within_raw, within) = (share_within(&gaps), share_within(&net));
