@@ -16,6 +16,7 @@ pub mod control;
 pub mod daemon;
 pub mod demo;
 pub mod estimate;
+pub mod field;
 pub mod geo;
 pub mod guidance;
 pub mod plan;

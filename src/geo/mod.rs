@@ -4,6 +4,7 @@
 //! y = North); heading is counter-clockwise from East in (-π, π]; positive curvature and
 //! positive front-wheel angle turn left.
 
+pub mod polygon;
 pub mod wgs84;
 
 use serde::{Deserialize, Serialize};

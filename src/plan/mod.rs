@@ -2,6 +2,8 @@
 //! clocks, no globals.
 
 pub mod abline;
+pub mod coverage;
+pub mod maneuver;
 pub mod turns;
 
 /// Why a plan cannot be made.
