@@ -47,6 +47,8 @@ pub enum JobKind {
     /// Parallel AB lines (SPEC §2).
     #[default]
     Ab,
+    /// A field coverage plan (SPEC §3) made from the field at `job.field_path`.
+    Field,
 }
 
 /// Side of A→B on which the following lines are laid.
@@ -73,8 +75,12 @@ pub enum TrackerChoice {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct JobConfig {
-    /// Job kind: "ab".
+    /// Job kind: "ab" (parallel lines from A and B) or "field" (a coverage plan of the field
+    /// at `field_path`).
     pub kind: JobKind,
+    /// For `kind = "field"`: the field, a GeoJSON (WGS-84) or ISO 11783-10 TASKDATA.XML file.
+    /// A relative path is taken from the working directory.
+    pub field_path: String,
     /// Point A of the first work line, local ENU [east, north], m.
     pub point_a_m: [f64; 2],
     /// Point B of the first work line, local ENU [east, north], m.
@@ -95,6 +101,7 @@ impl Default for JobConfig {
     fn default() -> Self {
         JobConfig {
             kind: JobKind::Ab,
+            field_path: String::new(),
             point_a_m: [0.0, 0.0],
             point_b_m: [0.0, 150.0],
             line_width_m: 3.0,
@@ -556,6 +563,13 @@ impl Config {
             );
         }
         c.range("job.line_width_m", j.line_width_m, 0.1, 100.0);
+        if j.kind == JobKind::Field && j.field_path.trim().is_empty() {
+            c.push(
+                "job.field_path",
+                format!("{:?}", j.field_path),
+                "must name a GeoJSON or TASKDATA.XML file when job.kind = \"field\"",
+            );
+        }
         c.range("job.origin_lat_deg", j.origin_lat_deg, -89.0, 89.0);
         c.range("job.origin_lon_deg", j.origin_lon_deg, -180.0, 180.0);
 

@@ -5,11 +5,11 @@
 //! allocation-free per cycle and never does I/O: callers feed it inputs and persist the
 //! progress snapshots it hands out.
 
-use crate::config::{Config, LineSide, TrackerChoice};
+use crate::config::{Config, JobKind, LineSide, TrackerChoice};
 use crate::estimate::{AntennaOffset, Estimator, EstimatorParams, GnssFix, VehicleEstimate};
 use crate::geo::{v2, Pose};
 use crate::guidance::progress::{JobDefinition, Progress};
-use crate::guidance::{Guidance, GuidanceError, GuidanceParams};
+use crate::guidance::{Guidance, GuidanceError, GuidanceParams, JobPlan};
 use crate::plan::abline::{AbParams, AbPlan, Side};
 use crate::plan::turns::TurnParams;
 use crate::track::local_path::LocalPathParams;
@@ -112,6 +112,8 @@ pub enum ControlError {
     Guidance(#[from] GuidanceError),
     #[error("cannot plan the job: {0}")]
     Plan(#[from] crate::plan::PlanError),
+    #[error("job.kind = \"field\" needs its field plan: load it first (the daemon and `agsteer demo` read job.field_path)")]
+    NoPlan,
 }
 
 /// Estimation, guidance and tracking for one job.
@@ -124,8 +126,20 @@ pub struct Controller {
 impl Controller {
     /// A new job, or the continuation of `resume`.
     pub fn from_config(cfg: &Config, resume: Option<&Progress>) -> Result<Self, ControlError> {
-        let plan = AbPlan::new(ab_params(cfg))?;
-        let job = JobDefinition::from_config(cfg);
+        if cfg.job.kind == JobKind::Field {
+            return Err(ControlError::NoPlan);
+        }
+        Controller::with_job(cfg, AbPlan::new(ab_params(cfg))?.into(), resume)
+    }
+
+    /// A job given by its plan (an AB plan or a segment job such as a field plan), or the
+    /// continuation of `resume` when it belongs to the same plan.
+    pub fn with_job(
+        cfg: &Config,
+        plan: JobPlan,
+        resume: Option<&Progress>,
+    ) -> Result<Self, ControlError> {
+        let job = JobDefinition::for_job(cfg, &plan);
         let guidance = match resume {
             Some(p) => Guidance::resume(plan, job, guidance_params(cfg), p)?,
             None => Guidance::new(plan, job, guidance_params(cfg))?,

@@ -87,8 +87,21 @@ fn checked_input(name: &str) -> Option<CheckedInput> {
 
 impl ControllerNode {
     pub fn new(cfg: &Config, resume: Option<&Progress>) -> Result<Self, ControlError> {
+        Self::with_controller(cfg, Controller::from_config(cfg, resume)?)
+    }
+
+    /// A node driving `plan` (see [`Controller::with_job`]).
+    pub fn with_job(
+        cfg: &Config,
+        plan: crate::guidance::JobPlan,
+        resume: Option<&Progress>,
+    ) -> Result<Self, ControlError> {
+        Self::with_controller(cfg, Controller::with_job(cfg, plan, resume)?)
+    }
+
+    fn with_controller(cfg: &Config, ctrl: Controller) -> Result<Self, ControlError> {
         Ok(ControllerNode {
-            ctrl: Controller::from_config(cfg, resume)?,
+            ctrl,
             supervisor: Supervisor::new(cfg.safety_params()),
             enu: EnuFrame::new(LatLon {
                 lat_deg: cfg.job.origin_lat_deg,

@@ -14,7 +14,7 @@ use crate::control::node::{operator, ControllerNode};
 use crate::control::ControlError;
 use crate::geo::{left_normal, signed_offset, v2, Pose, Vec2};
 use crate::guidance::progress::{Phase, Progress};
-use crate::guidance::Event;
+use crate::guidance::{Event, JobPlan};
 use crate::safety::SafetyState;
 use crate::sim::can_node::{Scenario, SimAddresses, SimNode};
 use crate::sim::{SimParams, Simulator};
@@ -125,7 +125,7 @@ impl XteStats {
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
     pub finished: bool,
-    /// Lines in the job; `null` when unlimited.
+    /// Lines in the job (for a field plan: segments, turns included); `null` when unlimited.
     pub lines_planned: Option<u64>,
     pub lines_completed: u64,
     /// RMS |XTE| on work lines, excluding the first 10 m of each line, m.
@@ -163,6 +163,10 @@ pub struct DemoOptions {
     /// The simulated operator never presses engage again after the first engagement ends
     /// (fault scenarios); by default they re-engage whenever the system is ready.
     pub no_reengage: bool,
+    /// The job to drive (a field plan as a segment job); `None` = the configuration's AB job.
+    pub job: Option<JobPlan>,
+    /// Outlines drawn under the trace in the SVG (field boundary, obstacles, headland).
+    pub outlines: Vec<Vec<Vec2>>,
 }
 
 /// A recorded point of the true trajectory.
@@ -178,8 +182,77 @@ pub struct TracePoint {
 pub struct Trace {
     pub points: Vec<TracePoint>,
     pub turns: Vec<Vec<Vec2>>,
-    /// (start, end) of every work line driven.
-    pub lines: Vec<(Vec2, Vec2)>,
+    /// Every work line or work segment driven, as planned.
+    pub lines: Vec<Vec<Vec2>>,
+    /// Field outlines drawn under the trace (boundary, obstacles, headland), local m.
+    pub outlines: Vec<Vec<Vec2>>,
+}
+
+/// The work path being scored against the true pose, with its cumulative lengths.
+#[derive(Debug, Default)]
+struct ScoredPath {
+    points: Vec<Vec2>,
+    cumulative: Vec<f64>,
+}
+
+impl ScoredPath {
+    fn first_point(&self) -> Option<Vec2> {
+        self.points.first().copied()
+    }
+
+    fn set(&mut self, path: &[crate::geo::PathPoint]) {
+        self.points.clear();
+        self.points.extend(path.iter().map(|p| p.pos));
+        self.cumulative.clear();
+        let mut s = 0.0;
+        self.cumulative.push(0.0);
+        for w in self.points.windows(2) {
+            s += (w[1] - w[0]).norm();
+            self.cumulative.push(s);
+        }
+    }
+
+    fn length(&self) -> f64 {
+        self.cumulative.last().copied().unwrap_or(0.0)
+    }
+
+    /// Distance along the path and signed cross-track error (positive left) of `p`, from the
+    /// nearest path segment within a few points of `hint`.
+    fn locate(&self, p: &Vec2, hint: usize) -> Option<(f64, f64)> {
+        let n = self.points.len();
+        if n < 2 {
+            return None;
+        }
+        let lo = hint.saturating_sub(4).min(n - 2);
+        let hi = (hint + 4).min(n - 2);
+        let mut best: Option<(f64, f64, f64)> = None;
+        for i in lo..=hi {
+            let a = self.points[i];
+            let d = self.points[i + 1] - a;
+            let len = d.norm();
+            if len <= 0.0 {
+                continue;
+            }
+            let dir = d / len;
+            let t = (p - a).dot(&dir);
+            let tc = t.clamp(0.0, len);
+            let dist = (p - (a + dir * tc)).norm();
+            if best.is_none_or(|b| dist < b.0) {
+                // Beyond the ends of the whole path, keep measuring along the end segments.
+                let along_seg = if (i == 0 && t < 0.0) || (i == n - 2 && t > len) {
+                    t
+                } else {
+                    tc
+                };
+                best = Some((
+                    dist,
+                    self.cumulative[i] + along_seg,
+                    signed_offset(p, &a, &dir),
+                ));
+            }
+        }
+        best.map(|(_, along, xte)| (along, xte))
+    }
 }
 
 /// A finished run.
@@ -227,11 +300,23 @@ pub fn run(
     on_event: &mut dyn FnMut(f64, &Event),
 ) -> Result<DemoRun, ControlError> {
     let wall = std::time::Instant::now();
-    let mut node = ControllerNode::new(cfg, opts.resume.as_ref())?;
+    let mut node = match &opts.job {
+        Some(job) => ControllerNode::with_job(cfg, job.clone(), opts.resume.as_ref())?,
+        None => ControllerNode::new(cfg, opts.resume.as_ref())?,
+    };
     let speed = cfg.speed();
-    let start = match &opts.resume {
-        Some(_) => node.controller().path_start_pose(),
-        None => None,
+    let start = match (&opts.resume, &opts.job) {
+        (None, Some(JobPlan::Segments(_))) => node.controller().path_start_pose().map(|p| {
+            let normal = left_normal(&crate::geo::heading_vec(p.heading));
+            let pos = p.pos + normal * cfg.sim.start_offset_m;
+            Pose::new(
+                pos.x,
+                pos.y,
+                p.heading + cfg.sim.start_heading_deg.to_radians(),
+            )
+        }),
+        (Some(_), _) => node.controller().path_start_pose(),
+        (None, _) => None,
     }
     .unwrap_or_else(|| {
         let a = v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]);
@@ -258,11 +343,15 @@ pub fn run(
     let dt = cfg.dt();
     let max_time = if cfg.sim.max_time_s > 0.0 {
         cfg.sim.max_time_s
+    } else if let Some(JobPlan::Segments(job)) = &opts.job {
+        let length: f64 = job.segments().iter().map(|s| s.length()).sum();
+        60.0 + 3.0 * length / cfg.speed().max(0.1)
     } else {
         default_max_time(cfg)
     };
 
     let mut stats = XteStats::default();
+    let mut scored_path = ScoredPath::default();
     let mut acquisition_max: f64 = 0.0;
     let mut turns = 0u64;
     let mut finished_lines = Vec::new();
@@ -270,7 +359,10 @@ pub fn run(
     let mut after_turn = opts.resume.is_some();
     let mut sim_frames: Vec<(f64, Frame)> = Vec::with_capacity(64);
     let mut ctrl_frames: Vec<Frame> = Vec::with_capacity(8);
-    let mut trace = Trace::default();
+    let mut trace = Trace {
+        outlines: opts.outlines.clone(),
+        ..Trace::default()
+    };
     let mut distance = 0.0;
     let mut next_trace_at = 0.0;
     let mut max_wheel: f64 = 0.0;
@@ -389,23 +481,21 @@ pub fn run(
         let g = node.controller().guidance();
         let mut xte_abs = None;
         if g.phase() == Phase::Work {
-            let (block, rank) = (g.index_block(), g.index_rank());
-            let plan = g.plan();
-            let (s, e) =
-                plan.line_endpoints(plan.line_of(block, rank), plan.line_reversed(block, rank));
-            let len = (e - s).norm();
-            let dir = (e - s) / len;
-            let along = (truth.pose.pos - s).dot(&dir);
-            let xte = signed_offset(&truth.pose.pos, &s, &dir);
-            if (ACQUISITION_SKIP_M..=len).contains(&along) {
-                stats.add(xte);
-                if after_turn && along <= ACQUISITION_END_M {
-                    acquisition_max = acquisition_max.max(xte.abs());
+            let path = g.global_path();
+            if scored_path.first_point() != path.first().map(|p| p.pos) {
+                scored_path.set(path);
+                if opts.record_trace {
+                    trace.lines.push(scored_path.points.clone());
                 }
             }
-            xte_abs = Some(xte.abs());
-            if opts.record_trace && trace.lines.last() != Some(&(s, e)) {
-                trace.lines.push((s, e));
+            if let Some((along, xte)) = scored_path.locate(&truth.pose.pos, g.index_global()) {
+                if (ACQUISITION_SKIP_M..=scored_path.length()).contains(&along) {
+                    stats.add(xte);
+                    if after_turn && along <= ACQUISITION_END_M {
+                        acquisition_max = acquisition_max.max(xte.abs());
+                    }
+                }
+                xte_abs = Some(xte.abs());
             }
         }
         if opts.record_trace && distance >= next_trace_at {
@@ -421,7 +511,10 @@ pub fn run(
     let finished = ctrl.guidance().is_finished() && !stopped;
     let report = Report {
         finished,
-        lines_planned: (cfg.job.line_num > 0).then_some(cfg.job.line_num),
+        lines_planned: match &opts.job {
+            Some(JobPlan::Segments(job)) => Some(job.len() as u64),
+            _ => (cfg.job.line_num > 0).then_some(cfg.job.line_num),
+        },
         lines_completed: ctrl.guidance().lines_done(),
         xte_rms_m: stats.rms(),
         xte_p95_m: stats.quantile(0.95),

@@ -211,13 +211,20 @@ pub fn demo_svg(trace: &Trace, report: &Report) -> String {
     let extent = trace
         .lines
         .iter()
-        .flat_map(|(a, b)| [a, b])
+        .flatten()
+        .chain(trace.outlines.iter().flatten())
         .chain(trace.turns.iter().flatten())
         .chain(trace.points.iter().map(|p| &p.pos));
     let mut c = SvgCanvas::fit(extent, 900.0);
-    for (a, b) in &trace.lines {
+    for o in &trace.outlines {
+        c.polygon(
+            o,
+            r##"fill="#f3efe0" stroke="#8c7b4f" stroke-width="1.5" fill-opacity="0.5""##,
+        );
+    }
+    for l in &trace.lines {
         c.polyline(
-            [a, b],
+            l,
             r##"stroke="#bbbbbb" stroke-width="5" stroke-linecap="round""##,
         );
     }

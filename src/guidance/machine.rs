@@ -6,10 +6,23 @@
 //! and events are pushed only when something changes.
 
 use super::progress::{JobDefinition, Phase, Progress, PROGRESS_VERSION};
+use super::segments::SegmentJob;
 use crate::geo::{signed_offset, wrap_angle, PathPoint, Pose, Tag, Vec2};
 use crate::plan::abline::AbPlan;
 use crate::plan::PlanError;
 use crate::track::local_path::{nearest_global, LocalPath, LocalPathParams};
+
+impl From<AbPlan> for JobPlan {
+    fn from(plan: AbPlan) -> Self {
+        JobPlan::Ab(plan)
+    }
+}
+
+impl From<SegmentJob> for JobPlan {
+    fn from(job: SegmentJob) -> Self {
+        JobPlan::Segments(job)
+    }
+}
 
 /// Something the binaries log.
 #[derive(Debug, Clone, PartialEq)]
@@ -62,9 +75,19 @@ pub enum GuidanceError {
     Plan(#[from] PlanError),
 }
 
+/// What the state machine drives.
+#[derive(Debug, Clone)]
+pub enum JobPlan {
+    /// An AB job: work lines generated lazily by block and rank, turns between them.
+    Ab(AbPlan),
+    /// A fixed list of segments (a field plan) driven in order. Its positions are
+    /// (block 0, rank = segment index); turns are segments of their own.
+    Segments(SegmentJob),
+}
+
 /// The job state machine.
 pub struct Guidance {
-    plan: AbPlan,
+    plan: JobPlan,
     job: JobDefinition,
     params: GuidanceParams,
     index_block: u64,
@@ -80,13 +103,13 @@ pub struct Guidance {
 impl Guidance {
     /// Start a job on its first line (step 1).
     pub fn new(
-        plan: AbPlan,
+        plan: impl Into<JobPlan>,
         job: JobDefinition,
         params: GuidanceParams,
     ) -> Result<Self, GuidanceError> {
         let local = LocalPath::new(&params.local);
         let mut g = Guidance {
-            plan,
+            plan: plan.into(),
             job,
             params,
             index_block: 0,
@@ -105,7 +128,7 @@ impl Guidance {
     /// Continue a job from saved progress. A turn in progress is regenerated and driven again;
     /// finished lines are never driven again.
     pub fn resume(
-        plan: AbPlan,
+        plan: impl Into<JobPlan>,
         job: JobDefinition,
         params: GuidanceParams,
         saved: &Progress,
@@ -116,8 +139,13 @@ impl Guidance {
         let mut g = Guidance::new(plan, job, params)?;
         g.events.clear();
         let (block, rank) = (saved.index_block, saved.index_rank);
-        let in_range = g.plan.block_count().is_none_or(|n| block < n)
-            && (rank as usize) < g.plan.block_len(block);
+        let in_range = match &g.plan {
+            JobPlan::Ab(plan) => {
+                plan.block_count().is_none_or(|n| block < n)
+                    && (rank as usize) < plan.block_len(block)
+            }
+            JobPlan::Segments(job) => block == 0 && (rank as usize) < job.len(),
+        };
         if !in_range {
             return Err(GuidanceError::OutOfRange { block, rank });
         }
@@ -129,6 +157,7 @@ impl Guidance {
                 g.phase = Phase::Finished;
                 g.path.clear();
             }
+            _ if matches!(g.plan, JobPlan::Segments(_)) => g.start_segment(),
             Phase::Work => g.start_work_line()?,
             Phase::Turn => match g.previous_position() {
                 Some(prev) => g.start_turn(prev)?,
@@ -152,9 +181,10 @@ impl Guidance {
         );
         if self.near_end(&pose.pos) {
             match self.phase {
+                Phase::Finished => {}
+                _ if matches!(self.plan, JobPlan::Segments(_)) => self.finish_segment(),
                 Phase::Turn => self.start_work_line()?,
                 Phase::Work => self.finish_line()?,
-                Phase::Finished => {}
             }
             if self.phase == Phase::Finished {
                 return Ok(());
@@ -182,16 +212,80 @@ impl Guidance {
         (p - last).dot(&(d / len)) > -self.params.end_distance
     }
 
+    /// The AB plan (`None` for a segment job).
+    fn ab(&self) -> Option<&AbPlan> {
+        match &self.plan {
+            JobPlan::Ab(plan) => Some(plan),
+            JobPlan::Segments(_) => None,
+        }
+    }
+
+    /// Load segment `index_rank` of a segment job as the global path.
+    fn start_segment(&mut self) {
+        let JobPlan::Segments(job) = &self.plan else {
+            return;
+        };
+        let i = self.index_rank;
+        job.points_into(i, &mut self.path);
+        let work = job.segments().get(i).is_some_and(|s| s.is_work());
+        self.phase = if work { Phase::Work } else { Phase::Turn };
+        self.index_global = 0;
+        self.events.push(if work {
+            Event::LineStarted {
+                block: 0,
+                rank: i as u64,
+                line: i as u64,
+            }
+        } else {
+            Event::TurnStarted {
+                from_line: i.saturating_sub(1) as u64,
+                to_line: i as u64 + 1,
+            }
+        });
+    }
+
+    /// A segment of a segment job is done: count it and load the next one.
+    fn finish_segment(&mut self) {
+        let JobPlan::Segments(job) = &self.plan else {
+            return;
+        };
+        let i = self.index_rank;
+        let n = job.len();
+        if self.phase == Phase::Work {
+            self.events.push(Event::LineFinished {
+                block: 0,
+                rank: i as u64,
+                line: i as u64,
+            });
+        }
+        // Every finished segment counts, so saved progress resumes on the next one.
+        self.lines_done += 1;
+        if i + 1 >= n {
+            self.phase = Phase::Finished;
+            self.path.clear();
+            self.events.push(Event::JobFinished {
+                lines_done: self.lines_done,
+            });
+        } else {
+            self.index_rank = i + 1;
+            self.start_segment();
+        }
+    }
+
     fn finish_line(&mut self) -> Result<(), GuidanceError> {
+        let Some(plan) = self.ab() else {
+            return Ok(());
+        };
         let (block, rank) = (self.index_block, self.index_rank);
-        let line = self.plan.line_of(block, rank);
+        let line = plan.line_of(block, rank);
+        let next = plan.next_position(block, rank);
         self.lines_done += 1;
         self.events.push(Event::LineFinished {
             block,
             rank: rank as u64,
             line,
         });
-        match self.plan.next_position(block, rank) {
+        match next {
             None => {
                 self.phase = Phase::Finished;
                 self.path.clear();
@@ -212,22 +306,28 @@ impl Guidance {
     }
 
     fn start_turn(&mut self, from: (u64, usize)) -> Result<(), GuidanceError> {
+        let JobPlan::Ab(plan) = &self.plan else {
+            return Ok(());
+        };
         let to = (self.index_block, self.index_rank);
         self.path.clear();
-        self.plan.turn_points(from, to, &mut self.path)?;
+        plan.turn_points(from, to, &mut self.path)?;
         self.phase = Phase::Turn;
         self.index_global = 0;
         self.events.push(Event::TurnStarted {
-            from_line: self.plan.line_of(from.0, from.1),
-            to_line: self.plan.line_of(to.0, to.1),
+            from_line: plan.line_of(from.0, from.1),
+            to_line: plan.line_of(to.0, to.1),
         });
         Ok(())
     }
 
     fn start_work_line(&mut self) -> Result<(), GuidanceError> {
+        let JobPlan::Ab(plan) = &self.plan else {
+            self.start_segment();
+            return Ok(());
+        };
         self.path.clear();
-        self.plan
-            .work_line_points(self.index_block, self.index_rank, &mut self.path);
+        plan.work_line_points(self.index_block, self.index_rank, &mut self.path);
         self.phase = Phase::Work;
         self.index_global = 0;
         self.events.push(Event::LineStarted {
@@ -243,7 +343,7 @@ impl Guidance {
             Some((self.index_block, self.index_rank - 1))
         } else if self.index_block > 0 {
             let b = self.index_block - 1;
-            Some((b, self.plan.block_len(b).checked_sub(1)?))
+            Some((b, self.ab()?.block_len(b).checked_sub(1)?))
         } else {
             None
         }
@@ -290,7 +390,12 @@ impl Guidance {
         Some((xte, wrap_angle(pose.heading - dir.y.atan2(dir.x))))
     }
 
-    pub fn plan(&self) -> &AbPlan {
+    /// The AB plan, when this is an AB job.
+    pub fn plan(&self) -> Option<&AbPlan> {
+        self.ab()
+    }
+    /// What the job drives.
+    pub fn job_plan(&self) -> &JobPlan {
         &self.plan
     }
     pub fn local_path(&self) -> &LocalPath {
@@ -318,8 +423,12 @@ impl Guidance {
         self.lines_done
     }
     /// Absolute index of the line being driven (or turned into).
+    /// For a segment job: the index of the segment being driven.
     pub fn current_line(&self) -> u64 {
-        self.plan.line_of(self.index_block, self.index_rank)
+        match &self.plan {
+            JobPlan::Ab(plan) => plan.line_of(self.index_block, self.index_rank),
+            JobPlan::Segments(_) => self.index_rank as u64,
+        }
     }
     /// Tag of the path being driven.
     pub fn tag(&self) -> Tag {
@@ -406,6 +515,94 @@ mod tests {
             all.extend(&second);
             assert_eq!(all, full, "stop after {stop}");
         }
+    }
+
+    /// A segment job: two swaths joined by a semicircle, driven by an ideal vehicle.
+    fn segment_job() -> SegmentJob {
+        use crate::geo::{v2, Direction};
+        use crate::guidance::segments::JobSegment;
+        use crate::plan::coverage::SegmentKind;
+        let line = |x: f64, up: bool| -> Vec<Vec2> {
+            let ys: Vec<f64> = (0..=30).map(|i| i as f64).collect();
+            let pts = ys.iter().map(|&y| v2(x, y));
+            if up {
+                pts.collect()
+            } else {
+                pts.rev().collect()
+            }
+        };
+        let arc: Vec<Vec2> = (0..=18)
+            .map(|i| {
+                let a = std::f64::consts::PI * (1.0 - i as f64 / 18.0);
+                v2(5.0 + 5.0 * a.cos(), 30.0 + 5.0 * a.sin())
+            })
+            .collect();
+        let seg = |kind, points| JobSegment {
+            kind,
+            direction: Direction::Forward,
+            cell: 0,
+            points,
+        };
+        SegmentJob::new(vec![
+            seg(SegmentKind::Work, line(0.0, true)),
+            seg(SegmentKind::Turn, arc),
+            seg(SegmentKind::Work, line(10.0, false)),
+        ])
+        .unwrap()
+    }
+
+    fn drive_segments(resume: Option<&Progress>, stop_after: usize) -> (Vec<u64>, Progress) {
+        let cfg = Config::default();
+        let plan = JobPlan::from(segment_job());
+        let job = JobDefinition::for_job(&cfg, &plan);
+        let mut g = match resume {
+            Some(p) => Guidance::resume(plan, job, guidance_params(&cfg), p).unwrap(),
+            None => Guidance::new(plan, job, guidance_params(&cfg)).unwrap(),
+        };
+        let mut finished = Vec::new();
+        let mut started = 0;
+        for _ in 0..100_000 {
+            if g.is_finished() || started > stop_after {
+                break;
+            }
+            let path = g.global_path();
+            let i = (g.index_global() + 1).min(path.len() - 1);
+            let d = path[i].pos - path[i - 1].pos;
+            g.update(&Pose::new(path[i].pos.x, path[i].pos.y, d.y.atan2(d.x)))
+                .unwrap();
+            for ev in g.drain_events() {
+                match ev {
+                    Event::LineFinished { line, .. } => finished.push(line),
+                    Event::LineStarted { .. } | Event::TurnStarted { .. } => started += 1,
+                    _ => {}
+                }
+            }
+        }
+        (finished, g.progress())
+    }
+
+    #[test]
+    fn segment_job_drives_every_segment_in_order_and_resumes_per_segment() {
+        let (finished, end) = drive_segments(None, usize::MAX);
+        assert_eq!(end.phase, Phase::Finished);
+        assert_eq!(finished, vec![0, 2], "work segments finished in order");
+        assert_eq!(end.lines_done, 3, "every segment counts");
+        // Stop after the turn has started: the saved progress points at the turn segment.
+        let (first, saved) = drive_segments(None, 1);
+        assert_eq!(first, vec![0]);
+        assert_eq!((saved.index_rank, saved.phase), (1, Phase::Turn));
+        assert!(saved.job.plan_checksum.is_some());
+        let (second, end) = drive_segments(Some(&saved), usize::MAX);
+        assert_eq!(second, vec![2], "resume drives no segment twice");
+        assert_eq!(end.phase, Phase::Finished);
+        // Another plan refuses the saved progress.
+        let cfg = Config::default();
+        let mut other = segment_job().segments().to_vec();
+        other[2].points[0].x += 0.5;
+        let other = JobPlan::from(SegmentJob::new(other).unwrap());
+        let job = JobDefinition::for_job(&cfg, &other);
+        let err = Guidance::resume(other, job, guidance_params(&cfg), &saved).err();
+        assert_eq!(err, Some(GuidanceError::DifferentJob));
     }
 
     #[test]

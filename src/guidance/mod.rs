@@ -2,5 +2,6 @@
 
 pub mod machine;
 pub mod progress;
+pub mod segments;
 
-pub use machine::{Event, Guidance, GuidanceError, GuidanceParams};
+pub use machine::{Event, Guidance, GuidanceError, GuidanceParams, JobPlan};

@@ -25,6 +25,10 @@ pub struct JobDefinition {
     pub side: crate::config::LineSide,
     pub a: i64,
     pub point_spacing_m: f64,
+    /// For a segment job (a field plan): the CRC-32C of its segments
+    /// ([`SegmentJob::checksum`](crate::guidance::segments::SegmentJob::checksum)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plan_checksum: Option<u32>,
 }
 
 impl JobDefinition {
@@ -38,7 +42,17 @@ impl JobDefinition {
             side: cfg.job.side,
             a: cfg.guidance.a,
             point_spacing_m: cfg.guidance.point_spacing_m,
+            plan_checksum: None,
         }
+    }
+
+    /// The definition of the job `plan` configured by `cfg`.
+    pub fn for_job(cfg: &crate::config::Config, plan: &crate::guidance::JobPlan) -> Self {
+        let mut job = JobDefinition::from_config(cfg);
+        if let crate::guidance::JobPlan::Segments(s) = plan {
+            job.plan_checksum = Some(s.checksum());
+        }
+        job
     }
 }
 

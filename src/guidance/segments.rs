@@ -1,0 +1,172 @@
+//! A job given as a fixed list of segments (a field plan, later a manoeuvre), driven in order
+//! by the same state machine, local path and tracker as an AB job.
+
+use crate::geo::{Direction, PathPoint, Tag, Vec2};
+use crate::plan::coverage::{FieldPlan, SegmentKind};
+use crate::plan::PlanError;
+
+/// One driveable piece of a segment job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JobSegment {
+    /// What the segment is for (work, turn, headland, detour, transit).
+    pub kind: SegmentKind,
+    pub direction: Direction,
+    /// The cell of a field plan it belongs to.
+    pub cell: usize,
+    /// Points in driving order, local ENU m, at least two.
+    pub points: Vec<Vec2>,
+}
+
+impl JobSegment {
+    /// Work-like segments (the implement works: swaths, headland passes, detours) count as
+    /// lines; turns and transits do not.
+    pub fn is_work(&self) -> bool {
+        matches!(
+            self.kind,
+            SegmentKind::Work | SegmentKind::Headland | SegmentKind::Detour
+        )
+    }
+
+    /// The path-point tag of this segment.
+    pub fn tag(&self) -> Tag {
+        if self.is_work() {
+            Tag::Work
+        } else {
+            Tag::Turn
+        }
+    }
+
+    /// Length along the points, m.
+    pub fn length(&self) -> f64 {
+        self.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+    }
+}
+
+/// A list of segments with a checksum that identifies it in saved progress.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SegmentJob {
+    segments: Vec<JobSegment>,
+    checksum: u32,
+}
+
+const CRC: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI);
+
+impl SegmentJob {
+    /// A job of `segments` in driving order. Consecutive duplicate points are dropped; a
+    /// segment left with fewer than two points, or with a non-finite point, is an error.
+    pub fn new(mut segments: Vec<JobSegment>) -> Result<Self, PlanError> {
+        if segments.is_empty() {
+            return Err(PlanError::Invalid {
+                name: "segments",
+                value: 0.0,
+                rule: "a segment job needs at least one segment",
+            });
+        }
+        let mut digest = CRC.digest();
+        for (i, s) in segments.iter_mut().enumerate() {
+            if s.points
+                .iter()
+                .any(|p| !(p.x.is_finite() && p.y.is_finite()))
+            {
+                return Err(PlanError::Invalid {
+                    name: "segment point",
+                    value: i as f64,
+                    rule: "every point must be finite",
+                });
+            }
+            s.points.dedup_by(|a, b| (*a - *b).norm() < 1e-6);
+            if s.points.len() < 2 {
+                return Err(PlanError::Invalid {
+                    name: "segment points",
+                    value: i as f64,
+                    rule: "every segment needs two distinct points",
+                });
+            }
+            digest.update(&[s.kind as u8, s.direction as u8]);
+            digest.update(&(s.cell as u64).to_le_bytes());
+            for p in &s.points {
+                digest.update(&p.x.to_le_bytes());
+                digest.update(&p.y.to_le_bytes());
+            }
+        }
+        Ok(SegmentJob {
+            segments,
+            checksum: digest.finalize(),
+        })
+    }
+
+    /// The segments of a field plan, in its driving order.
+    pub fn from_field_plan(plan: &FieldPlan) -> Result<Self, PlanError> {
+        SegmentJob::new(
+            plan.segments
+                .iter()
+                .map(|s| JobSegment {
+                    kind: s.kind,
+                    direction: s.direction,
+                    cell: s.cell,
+                    points: s.points.clone(),
+                })
+                .collect(),
+        )
+    }
+
+    pub fn segments(&self) -> &[JobSegment] {
+        &self.segments
+    }
+    pub fn len(&self) -> usize {
+        self.segments.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.segments.is_empty()
+    }
+    /// CRC-32C over every segment's kind, direction, cell and points.
+    pub fn checksum(&self) -> u32 {
+        self.checksum
+    }
+
+    /// Write segment `i`'s points into `out` (cleared first).
+    pub fn points_into(&self, i: usize, out: &mut Vec<PathPoint>) {
+        out.clear();
+        if let Some(s) = self.segments.get(i) {
+            let (tag, direction) = (s.tag(), s.direction);
+            out.extend(s.points.iter().map(|&pos| PathPoint {
+                pos,
+                tag,
+                direction,
+            }));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geo::v2;
+
+    fn seg(kind: SegmentKind, pts: &[(f64, f64)]) -> JobSegment {
+        JobSegment {
+            kind,
+            direction: Direction::Forward,
+            cell: 0,
+            points: pts.iter().map(|&(x, y)| v2(x, y)).collect(),
+        }
+    }
+
+    #[test]
+    fn rejects_degenerate_segments_and_checksums_content() {
+        assert!(SegmentJob::new(vec![]).is_err());
+        assert!(SegmentJob::new(vec![seg(SegmentKind::Work, &[(0.0, 0.0), (0.0, 0.0)])]).is_err());
+        assert!(
+            SegmentJob::new(vec![seg(SegmentKind::Work, &[(0.0, 0.0), (f64::NAN, 1.0)])]).is_err()
+        );
+        let a = SegmentJob::new(vec![seg(SegmentKind::Work, &[(0.0, 0.0), (0.0, 10.0)])]).unwrap();
+        let b = SegmentJob::new(vec![seg(SegmentKind::Work, &[(0.0, 0.0), (0.0, 10.5)])]).unwrap();
+        let c = SegmentJob::new(vec![seg(SegmentKind::Turn, &[(0.0, 0.0), (0.0, 10.0)])]).unwrap();
+        assert_ne!(a.checksum(), b.checksum());
+        assert_ne!(a.checksum(), c.checksum());
+        let mut out = Vec::new();
+        c.points_into(0, &mut out);
+        assert_eq!(out.len(), 2);
+        assert_eq!(out[0].tag, Tag::Turn);
+    }
+}
