@@ -129,6 +129,13 @@ pub struct GuidanceConfig {
     pub turn_max_points: usize,
     /// The path counts as "near its end" within this distance of its last point, m.
     pub end_distance_m: f64,
+    /// Before a cusp (a change of driving direction) the daemon asks the tractor to stop
+    /// when the remaining distance is within the stopping distance at this deceleration, m/s².
+    pub cusp_decel_mps2: f64,
+    /// Below this speed the vehicle counts as stopped (for a change of direction), m/s.
+    pub stopped_speed_mps: f64,
+    /// A vehicle stopped within this distance of a cusp moves on to the next segment, m.
+    pub cusp_capture_m: f64,
 }
 
 impl Default for GuidanceConfig {
@@ -140,6 +147,9 @@ impl Default for GuidanceConfig {
             turn_merge_distance_m: 0.05,
             turn_max_points: 500,
             end_distance_m: 0.3,
+            cusp_decel_mps2: 0.5,
+            stopped_speed_mps: 0.05,
+            cusp_capture_m: 1.0,
         }
     }
 }
@@ -266,6 +276,9 @@ pub struct SimConfig {
     pub start_heading_deg: f64,
     /// Stop the simulation after this much simulated time even if unfinished, s (0 = auto).
     pub max_time_s: f64,
+    /// The simulated tractor's acceleration and braking when a direction request changes its
+    /// speed, m/s².
+    pub accel_mps2: f64,
 }
 
 impl Default for SimConfig {
@@ -285,6 +298,7 @@ impl Default for SimConfig {
             start_offset_m: 0.0,
             start_heading_deg: 0.0,
             max_time_s: 0.0,
+            accel_mps2: 0.5,
         }
     }
 }
@@ -343,6 +357,9 @@ pub struct SafetyConfig {
     /// Allowed speed range, km/h.
     pub min_speed_kmh: f64,
     pub max_speed_kmh: f64,
+    /// While the daemon has asked for a stop to change direction (a cusp of a manoeuvre), the
+    /// speed may be below min_speed_kmh for at most this long, s.
+    pub max_stop_time_s: f64,
     /// Measured wheel angle this far from the command…, degrees
     pub override_angle_deg: f64,
     /// …for longer than this is an operator override, s.
@@ -369,6 +386,7 @@ impl Default for SafetyConfig {
             wheel_angle_timeout_s: 0.1,
             min_speed_kmh: 0.5,
             max_speed_kmh: 25.0,
+            max_stop_time_s: 10.0,
             override_angle_deg: 8.0,
             override_time_s: 0.5,
             max_engage_xte_m: 1.0,
@@ -593,6 +611,14 @@ impl Config {
             );
         }
         c.range("guidance.end_distance_m", g.end_distance_m, 0.0, 10.0);
+        c.range("guidance.cusp_decel_mps2", g.cusp_decel_mps2, 0.05, 5.0);
+        c.range(
+            "guidance.stopped_speed_mps",
+            g.stopped_speed_mps,
+            0.001,
+            1.0,
+        );
+        c.range("guidance.cusp_capture_m", g.cusp_capture_m, 0.05, 10.0);
 
         let v = &self.vehicle;
         c.range("vehicle.wheelbase_m", v.wheelbase_m, 0.5, 20.0);
@@ -663,6 +689,7 @@ impl Config {
         c.range("sim.start_offset_m", s.start_offset_m, -50.0, 50.0);
         c.range("sim.start_heading_deg", s.start_heading_deg, -90.0, 90.0);
         c.range("sim.max_time_s", s.max_time_s, 0.0, 1e7);
+        c.range("sim.accel_mps2", s.accel_mps2, 0.05, 10.0);
         let b = &self.bus;
         if b.interface.trim().is_empty() || b.interface.len() > 15 {
             c.push(
@@ -694,6 +721,7 @@ impl Config {
             2.0,
         );
         c.range("safety.min_speed_kmh", f.min_speed_kmh, 0.0, 50.0);
+        c.range("safety.max_stop_time_s", f.max_stop_time_s, 0.0, 120.0);
         c.range("safety.max_speed_kmh", f.max_speed_kmh, 0.5, 60.0);
         if f.min_speed_kmh >= f.max_speed_kmh {
             c.push(
@@ -810,6 +838,7 @@ impl Config {
             wheel_angle_timeout: f.wheel_angle_timeout_s,
             invalid_threshold: 5,
             min_speed: f.min_speed_kmh / 3.6,
+            max_stop_time: f.max_stop_time_s,
             max_speed: f.max_speed_kmh / 3.6,
             override_angle: f.override_angle_deg.to_radians(),
             override_time: f.override_time_s,

@@ -7,13 +7,13 @@
 
 use crate::config::{Config, JobKind, LineSide, TrackerChoice};
 use crate::estimate::{AntennaOffset, Estimator, EstimatorParams, GnssFix, VehicleEstimate};
-use crate::geo::{v2, Pose};
+use crate::geo::{v2, Direction, Pose};
 use crate::guidance::progress::{JobDefinition, Progress};
 use crate::guidance::{Guidance, GuidanceError, GuidanceParams, JobPlan};
 use crate::plan::abline::{AbParams, AbPlan, Side};
 use crate::plan::turns::TurnParams;
 use crate::track::local_path::LocalPathParams;
-use crate::track::{pure_pursuit, TrackOutput, TrackerParams};
+use crate::track::{pure_pursuit, steering_from_travel, travel_pose, TrackOutput, TrackerParams};
 
 pub mod node;
 
@@ -104,6 +104,8 @@ pub struct ControlOutput {
     pub heading_error: Option<f64>,
     /// The tracker's detail.
     pub track: Option<TrackOutput>,
+    /// Driving direction of the path being followed.
+    pub direction: Direction,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -167,6 +169,7 @@ impl Controller {
             xte: None,
             heading_error: None,
             track: None,
+            direction: Direction::Forward,
         };
         let Some(est) = self.estimator.estimate(t) else {
             return Ok(out);
@@ -180,11 +183,17 @@ impl Controller {
             out.xte = Some(xte);
             out.heading_error = Some(he);
         }
-        let tr = pure_pursuit(
-            self.guidance.local_path(),
-            &est.pose,
-            est.speed,
-            &self.tracker,
+        let direction = self.guidance.direction();
+        out.direction = direction;
+        // Reverse segments are tracked about the rear axle in the driving direction.
+        let tr = steering_from_travel(
+            pure_pursuit(
+                self.guidance.local_path(),
+                &travel_pose(&est.pose, direction),
+                est.speed.abs(),
+                &self.tracker,
+            ),
+            direction,
         );
         if tr.wheel_angle.is_finite() {
             out.wheel_angle = Some(tr.wheel_angle);

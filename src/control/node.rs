@@ -4,9 +4,9 @@
 
 use super::{ControlError, Controller};
 use crate::can::codec::{
-    self, CodecError, CogSogRapid, CounterCheck, DbcMessage, GnssPositionData, GuidanceStatus,
-    GuidanceSystemCommand, OperatorCommand, Packer, PositionRapid, SteeringCommand, VesselHeading,
-    WheelAngle, WheelSpeed,
+    self, CodecError, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, GnssPositionData,
+    GuidanceStatus, GuidanceSystemCommand, OperatorCommand, Packer, PositionRapid, SteeringCommand,
+    VesselHeading, WheelAngle, WheelSpeed,
 };
 use crate::can::fastpacket::Reassembler;
 use crate::can::gnss::{yaw_from_north_cw, GnssPosition, METHOD_RTK_FIXED, METHOD_RTK_FLOAT};
@@ -65,6 +65,31 @@ pub struct ControllerNode {
     status_every: u64,
     ticks: u64,
     status: NodeStatus,
+    cusps: CuspParams,
+    /// A stop for a change of direction is under way (from the stop request until the vehicle
+    /// moves the new way at the minimum speed).
+    cusp: bool,
+    last_request: Option<f64>,
+}
+
+/// How the node handles a change of driving direction (SPEC §4: the daemon asks for it on the
+/// bus before each cusp, waits until the vehicle has stopped and turned, then steers on).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct CuspParams {
+    decel: f64,
+    stopped_speed: f64,
+    capture: f64,
+    end_distance: f64,
+    min_speed: f64,
+}
+
+use crate::can::direction_request;
+
+fn request_of(d: crate::geo::Direction) -> f64 {
+    match d {
+        crate::geo::Direction::Forward => direction_request::FORWARD,
+        crate::geo::Direction::Reverse => direction_request::REVERSE,
+    }
 }
 
 fn quality_of(method: u8) -> FixQuality {
@@ -116,6 +141,15 @@ impl ControllerNode {
             quality: None,
             status_every: ((cfg.bus.status_period_s / cfg.dt()).round() as u64).max(1),
             ticks: 0,
+            cusps: CuspParams {
+                decel: cfg.guidance.cusp_decel_mps2,
+                stopped_speed: cfg.guidance.stopped_speed_mps,
+                capture: cfg.guidance.cusp_capture_m,
+                end_distance: cfg.guidance.end_distance_m,
+                min_speed: cfg.safety.min_speed_kmh / 3.6,
+            },
+            cusp: false,
+            last_request: None,
             status: NodeStatus {
                 state: SafetyState::Disengaged,
                 fault: FaultCode::None,
@@ -225,7 +259,8 @@ impl ControllerNode {
         } else if let Some(m) = d.to::<CogSogRapid>() {
             if let Some(sog) = m.sog {
                 if self.heading.is_none() {
-                    self.speed = sog;
+                    // SOG has no sign: keep the direction the wheel-speed frame reported.
+                    self.speed = if self.speed < 0.0 { -sog } else { sog };
                 }
             }
         } else if let Some(m) = d.to::<WheelSpeed>() {
@@ -256,6 +291,53 @@ impl ControllerNode {
         }
     }
 
+    /// The direction to request this period, for segment jobs (AB jobs are driven forward
+    /// throughout and send none). Before a cusp: stop once within the stopping distance; when
+    /// stopped near the cusp, move on to the next segment and request its direction.
+    fn direction_request(&mut self, c: &super::ControlOutput) -> Option<f64> {
+        use crate::geo::Direction;
+        use direction_request::STOP;
+        let p = self.cusps;
+        let g = self.ctrl.guidance();
+        if !matches!(g.job_plan(), crate::guidance::JobPlan::Segments(_)) {
+            return None;
+        }
+        if g.is_finished() {
+            self.cusp = false;
+            return Some(STOP);
+        }
+        let v = self.speed;
+        let stopped = v.abs() < p.stopped_speed;
+        let want = c.direction;
+        let moving = if v < 0.0 {
+            Direction::Reverse
+        } else {
+            Direction::Forward
+        };
+        if let (Some(next), Some(est)) = (g.next_direction(), c.estimate) {
+            if next != want {
+                let remaining = g.remaining(&est.pose.pos);
+                if remaining <= v * v / (2.0 * p.decel) + p.end_distance {
+                    self.cusp = true;
+                    if stopped && remaining <= p.capture {
+                        self.ctrl.guidance_mut().advance_segment();
+                        return Some(request_of(next));
+                    }
+                    return Some(STOP);
+                }
+            }
+        }
+        if self.cusp && moving == want && v.abs() >= p.min_speed {
+            self.cusp = false;
+        }
+        if !stopped && moving != want {
+            // Still rolling the old way (e.g. past a cusp): stop first.
+            self.cusp = true;
+            return Some(STOP);
+        }
+        Some(request_of(want))
+    }
+
     /// One control period at `t`: appends the frames to send.
     pub fn tick(&mut self, t: f64, out: &mut Vec<Frame>) -> Cmd {
         let c = match self.ctrl.tick(t) {
@@ -268,9 +350,21 @@ impl ControllerNode {
                     xte: None,
                     heading_error: None,
                     track: None,
+                    direction: crate::geo::Direction::Forward,
                 }
             }
         };
+        let request = self.direction_request(&c);
+        if let Some(r) = request {
+            self.supervisor.set_direction_change(t, self.cusp);
+            let due = self.last_request != Some(r) || self.ticks % self.status_every == 0;
+            if due {
+                if let Ok(f) = self.packer.pack(&DirectionRequest { direction: r }) {
+                    out.push(f);
+                }
+                self.last_request = Some(r);
+            }
+        }
         let cmd = self
             .supervisor
             .step(t, c.wheel_angle, c.xte, c.heading_error);

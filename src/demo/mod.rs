@@ -47,6 +47,7 @@ pub fn sim_params(cfg: &Config) -> SimParams {
         was_noise: s.was_noise_deg.to_radians(),
         step: s.step_s,
         seed: s.seed,
+        accel: s.accel_mps2,
         ..SimParams::default()
     }
 }

@@ -7,7 +7,7 @@
 
 use super::progress::{JobDefinition, Phase, Progress, PROGRESS_VERSION};
 use super::segments::SegmentJob;
-use crate::geo::{signed_offset, wrap_angle, PathPoint, Pose, Tag, Vec2};
+use crate::geo::{signed_offset, wrap_angle, Direction, PathPoint, Pose, Tag, Vec2};
 use crate::plan::abline::AbPlan;
 use crate::plan::PlanError;
 use crate::track::local_path::{nearest_global, LocalPath, LocalPathParams};
@@ -430,6 +430,54 @@ impl Guidance {
             JobPlan::Segments(_) => self.index_rank as u64,
         }
     }
+    /// Driving direction at the current point of the path (forward when there is none).
+    pub fn direction(&self) -> Direction {
+        self.path
+            .get(self.index_global)
+            .map(|p| p.direction)
+            .unwrap_or_default()
+    }
+
+    /// Driving direction of the next segment of a segment job (`None` at the last one and for
+    /// AB jobs, which are driven forward throughout).
+    pub fn next_direction(&self) -> Option<Direction> {
+        match &self.plan {
+            JobPlan::Segments(job) => job.segments().get(self.index_rank + 1).map(|s| s.direction),
+            JobPlan::Ab(_) => None,
+        }
+    }
+
+    /// Distance from `p` to the end of the current path, measured along it from the nearest
+    /// point, m (0 when finished).
+    pub fn remaining(&self, p: &Vec2) -> f64 {
+        let n = self.path.len();
+        if n < 2 {
+            return 0.0;
+        }
+        let i = self.index_global.min(n - 1);
+        let rest: f64 = self.path[i..]
+            .windows(2)
+            .map(|w| (w[1].pos - w[0].pos).norm())
+            .sum();
+        let d = self.path[(i + 1).min(n - 1)].pos - self.path[i.min(n - 2)].pos;
+        let len = d.norm();
+        let ahead = if len > 0.0 {
+            (p - self.path[i].pos).dot(&(d / len))
+        } else {
+            0.0
+        };
+        (rest - ahead).max(0.0)
+    }
+
+    /// At a cusp the vehicle stops within reach of the end of a segment: move on to the next
+    /// segment as if its end had been reached. Does nothing unless a segment job's next
+    /// segment exists.
+    pub fn advance_segment(&mut self) {
+        if matches!(self.plan, JobPlan::Segments(_)) && self.phase != Phase::Finished {
+            self.finish_segment();
+        }
+    }
+
     /// Tag of the path being driven.
     pub fn tag(&self) -> Tag {
         match self.phase {

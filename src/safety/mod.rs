@@ -93,6 +93,9 @@ pub struct SafetyParams {
     /// Allowed speed range, m/s (defaults 0.5–25 km/h).
     pub min_speed: f64,
     pub max_speed: f64,
+    /// During a requested stop for a change of direction the speed may be below `min_speed`
+    /// for at most this long, s (default 10).
+    pub max_stop_time: f64,
     /// Measured angle this far from the command counts toward an override, rad.
     pub override_angle: f64,
     /// … for longer than this, s.
@@ -125,6 +128,7 @@ impl Default for SafetyParams {
             invalid_threshold: 5,
             min_speed: 0.5 / 3.6,
             max_speed: 25.0 / 3.6,
+            max_stop_time: 10.0,
             override_angle: 8f64.to_radians(),
             override_time: 0.5,
             max_engage_xte: 1.0,
@@ -168,6 +172,8 @@ pub struct Supervisor {
     actuator_fault: bool,
     speed_t: Option<f64>,
     speed: f64,
+    /// Since when a stop for a change of direction is under way.
+    stopping_since: Option<f64>,
     scores: [u32; CHECKED_INPUTS],
     diverged_since: Option<f64>,
     last_command: f64,
@@ -199,6 +205,7 @@ impl Supervisor {
             actuator_fault: false,
             speed_t: None,
             speed: 0.0,
+            stopping_since: None,
             scores: [0; CHECKED_INPUTS],
             diverged_since: None,
             last_command: 0.0,
@@ -294,6 +301,16 @@ impl Supervisor {
         self.actuator_fault = fault_bit;
     }
 
+    /// A stop for a change of direction (a cusp) starts (`true`) or ends at `t`: while it
+    /// lasts, and for at most `max_stop_time`, a speed below `min_speed` is not a fault.
+    pub fn set_direction_change(&mut self, t: f64, active: bool) {
+        if !active {
+            self.stopping_since = None;
+        } else if self.stopping_since.is_none() && t.is_finite() {
+            self.stopping_since = Some(t);
+        }
+    }
+
     /// Vehicle speed (m/s, signed) measured at `t`.
     pub fn on_speed(&mut self, t: f64, speed: f64) {
         if t.is_finite() && speed.is_finite() {
@@ -375,8 +392,11 @@ impl Supervisor {
         if self.override_bit {
             return FaultCode::OperatorOverride;
         }
+        let stopping = self
+            .stopping_since
+            .is_some_and(|since| t - since <= p.max_stop_time);
         let speed_ok = fresh(self.speed_t, p.gnss_timeout.max(p.wheel_angle_timeout))
-            && self.speed.abs() >= p.min_speed
+            && (self.speed.abs() >= p.min_speed || stopping)
             && self.speed.abs() <= p.max_speed;
         if !speed_ok {
             return FaultCode::SpeedOutOfRange;

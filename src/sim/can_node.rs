@@ -8,9 +8,10 @@
 
 use super::{FixQuality, SimOutput, Simulator};
 use crate::can::codec::{
-    self, CogSogRapid, CounterCheck, DbcMessage, Packer, PositionRapid, SteeringCommand,
-    VesselHeading, WheelAngle, WheelSpeed,
+    self, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, Packer, PositionRapid,
+    SteeringCommand, VesselHeading, WheelAngle, WheelSpeed,
 };
+use crate::can::direction_request::{REVERSE, STOP};
 use crate::can::fastpacket::split;
 use crate::can::gnss::{north_cw_from_yaw, GnssPosition, METHOD_RTK_FIXED, METHOD_RTK_FLOAT};
 use crate::can::{Frame, TimedFrame};
@@ -99,11 +100,14 @@ pub struct SimNode {
     rejected: u64,
     frozen_counter: Option<Frame>,
     distance: f64,
+    /// Speed magnitude at the start: what the tractor drives at either way, m/s.
+    cruise: f64,
 }
 
 impl SimNode {
     pub fn new(sim: Simulator, enu: EnuFrame, addresses: SimAddresses, scenario: Scenario) -> Self {
         SimNode {
+            cruise: sim.true_state().speed.abs(),
             sim,
             enu,
             gnss: Packer::new(addresses.gnss),
@@ -145,6 +149,16 @@ impl SimNode {
             }
             return;
         };
+        if let Some(r) = d.to::<DirectionRequest>() {
+            // The tractor obeys: brake to a stop, or head for the cruise speed either way.
+            let target = match r.direction {
+                x if x == STOP => 0.0,
+                x if x == REVERSE => -self.cruise,
+                _ => self.cruise,
+            };
+            self.sim.set_speed_target(target);
+            return;
+        }
         let Some(cmd) = d.to::<SteeringCommand>() else {
             return;
         };

@@ -49,6 +49,8 @@ pub struct SimParams {
     pub step: f64,
     /// Random seed.
     pub seed: u64,
+    /// Acceleration and braking towards a requested speed (direction requests), m/s².
+    pub accel: f64,
 }
 
 impl Default for SimParams {
@@ -71,6 +73,7 @@ impl Default for SimParams {
             was_noise: 0.05f64.to_radians(),
             step: 0.001,
             seed: 1,
+            accel: 0.5,
         }
     }
 }
@@ -155,6 +158,8 @@ pub struct Simulator {
     pending: VecDeque<GnssMeasurement>,
     rng: ChaCha8Rng,
     fix: FixQuality,
+    /// Speed the driver (or the tractor's speed control) is heading for, m/s.
+    speed_target: Option<f64>,
 }
 
 impl Simulator {
@@ -193,6 +198,7 @@ impl Simulator {
         check("dead_time", p.dead_time, p.dead_time >= 0.0, "must be >= 0")?;
         check("tau", p.tau, p.tau >= 0.0, "must be >= 0")?;
         check("max_rate", p.max_rate, p.max_rate > 0.0, "must be > 0")?;
+        check("accel", p.accel, p.accel > 0.0, "must be > 0")?;
         check(
             "gnss_latency",
             p.gnss_latency,
@@ -231,6 +237,7 @@ impl Simulator {
             pending: VecDeque::with_capacity(64),
             rng: ChaCha8Rng::seed_from_u64(params.seed),
             fix: FixQuality::RtkFixed,
+            speed_target: None,
             p: params,
         })
     }
@@ -267,6 +274,14 @@ impl Simulator {
     pub fn set_speed(&mut self, speed: f64) {
         if speed.is_finite() {
             self.speed = speed;
+        }
+    }
+
+    /// Head for `speed` (m/s, negative reverses) at the acceleration `accel`, through zero
+    /// when the direction changes (as a tractor obeying a direction request).
+    pub fn set_speed_target(&mut self, speed: f64) {
+        if speed.is_finite() {
+            self.speed_target = Some(speed);
         }
     }
 
@@ -318,6 +333,10 @@ impl Simulator {
         };
         let rate = rate.clamp(-self.p.max_rate, self.p.max_rate);
         self.wheel = (self.wheel + rate * h).clamp(-self.p.max_wheel_angle, self.p.max_wheel_angle);
+        if let Some(target) = self.speed_target {
+            let dv = self.p.accel * h;
+            self.speed += (target - self.speed).clamp(-dv, dv);
+        }
         // Kinematic bicycle, midpoint heading.
         let yaw_rate = self.speed * self.wheel.tan() / self.p.wheelbase;
         let mid = self.heading + 0.5 * h * yaw_rate;

@@ -6,8 +6,9 @@
 
 pub mod local_path;
 
-use crate::geo::{cross, heading_vec, Pose, Vec2};
+use crate::geo::{cross, heading_vec, Direction, Pose, Vec2};
 use local_path::LocalPath;
+use std::f64::consts::PI;
 
 /// Tracker parameters, SI units.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,6 +38,31 @@ pub struct TrackOutput {
     /// Angle from the heading to the preview point, rad.
     pub alpha: f64,
     pub valid: bool,
+}
+
+/// Driving in reverse about the rear axle is, kinematically, driving forward with the heading
+/// turned by π and the steering curvature negated: the bicycle model ẋ = v·cos θ,
+/// θ̇ = v·κ with v < 0 becomes, for θ' = θ + π and v' = −v > 0, ẋ = v'·cos θ', θ̇' = v'·(−κ).
+/// Any law that steers forward therefore steers a reverse segment when it is given
+/// [`travel_pose`] and |v|, and its output goes through [`steering_from_travel`].
+pub fn travel_pose(pose: &Pose, direction: Direction) -> Pose {
+    match direction {
+        Direction::Forward => *pose,
+        Direction::Reverse => Pose::new(pose.pos.x, pose.pos.y, pose.heading + PI),
+    }
+}
+
+/// The steering command of a law computed in the driving direction (see [`travel_pose`]).
+pub fn steering_from_travel(out: TrackOutput, direction: Direction) -> TrackOutput {
+    match direction {
+        Direction::Forward => out,
+        Direction::Reverse => TrackOutput {
+            wheel_angle: -out.wheel_angle,
+            curvature: -out.curvature,
+            alpha: -out.alpha,
+            ..out
+        },
+    }
 }
 
 /// The look-ahead distance at speed `v`, m.
@@ -184,6 +210,57 @@ mod tests {
             out.curvature,
             1.0 / r
         );
+    }
+
+    /// Closed loop on the kinematic bicycle model: backing along a straight line from 0.5 m
+    /// off and 5° out converges onto it, with the reverse mirror of the forward law.
+    #[test]
+    fn reverse_pursuit_about_the_rear_axle_converges() {
+        // The path runs towards −x (driving order), the vehicle points +x and backs up.
+        let g: Vec<PathPoint> = (0..200)
+            .map(|i| PathPoint {
+                pos: v2(-(i as f64) * 0.5, 0.0),
+                tag: crate::geo::Tag::Work,
+                direction: Direction::Reverse,
+            })
+            .collect();
+        let mut lp = LocalPath::new(&LocalPathParams::default());
+        let p = params();
+        let (mut x, mut y, mut th) = (-2.0, 0.5, 5f64.to_radians());
+        let (v, h): (f64, f64) = (-1.0, 0.02);
+        let mut worst_late: f64 = 0.0;
+        for k in 0..2500 {
+            let pose = Pose::new(x, y, th);
+            let hint = ((-x / 0.5).round().max(0.0) as usize).min(g.len() - 1);
+            lp.rebuild(&g, hint);
+            lp.nearest(&pose.pos);
+            let out = steering_from_travel(
+                pure_pursuit(&lp, &travel_pose(&pose, Direction::Reverse), v.abs(), &p),
+                Direction::Reverse,
+            );
+            assert!(out.valid);
+            x += v * th.cos() * h;
+            y += v * th.sin() * h;
+            th += v * out.wheel_angle.tan() / p.wheelbase * h;
+            if k > 1500 {
+                worst_late = worst_late.max(y.abs());
+            }
+        }
+        assert!(x < -40.0, "backed along the path: x = {x}");
+        assert!(
+            worst_late < 0.01,
+            "converged onto the line: |y| {worst_late}"
+        );
+        // North of a westward reverse path, pointing east: the wheels go right, so that the
+        // heading turns counter-clockwise and the rear swings south onto the line.
+        let pose = Pose::new(-20.0, 0.3, 0.0);
+        lp.rebuild(&g, 40);
+        lp.nearest(&pose.pos);
+        let mirrored = steering_from_travel(
+            pure_pursuit(&lp, &travel_pose(&pose, Direction::Reverse), 1.0, &p),
+            Direction::Reverse,
+        );
+        assert!(mirrored.wheel_angle < 0.0, "{mirrored:?}");
     }
 
     #[test]

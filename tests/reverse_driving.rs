@@ -1,0 +1,100 @@
+//! Reverse driving closed-loop (SPEC §4 output, issue 6 part 5c): a segment job with two cusps
+//! — forward, reverse on a curve, forward again — through the real frames. The node requests
+//! stop before each cusp, waits for the speed frame to show the vehicle stopped and turned,
+//! and steers the reverse segment about the rear axle; the simulator obeys the requests.
+
+use agsteer::config::Config;
+use agsteer::demo::{run, DemoOptions};
+use agsteer::geo::{v2, Direction, Vec2};
+use agsteer::guidance::segments::{JobSegment, SegmentJob};
+use agsteer::guidance::{Event, JobPlan};
+use agsteer::plan::coverage::SegmentKind;
+
+fn seg(direction: Direction, points: Vec<Vec2>) -> JobSegment {
+    JobSegment {
+        kind: SegmentKind::Work,
+        direction,
+        cell: 0,
+        points,
+    }
+}
+
+/// Forward east along y = 0 for 40 m; reverse west along a gentle S (a cosine from y = 0 to
+/// y = 4 m over 40 m: curvature ≤ 0.025 /m); forward east along y = 4 for 40 m.
+fn job() -> SegmentJob {
+    let n = 80;
+    let forward: Vec<Vec2> = (0..=n).map(|i| v2(i as f64 * 0.5, 0.0)).collect();
+    let reverse: Vec<Vec2> = (0..=n)
+        .map(|i| {
+            let s = i as f64 / n as f64;
+            v2(
+                40.0 - 40.0 * s,
+                2.0 - 2.0 * (std::f64::consts::PI * s).cos(),
+            )
+        })
+        .collect();
+    let again: Vec<Vec2> = (0..=n).map(|i| v2(i as f64 * 0.5, 4.0)).collect();
+    SegmentJob::new(vec![
+        seg(Direction::Forward, forward),
+        seg(Direction::Reverse, reverse),
+        seg(Direction::Forward, again),
+    ])
+    .unwrap()
+}
+
+#[test]
+fn drives_a_job_with_two_cusps_closed_loop() {
+    let mut cfg = Config::default();
+    cfg.control.speed_kmh = 5.0;
+    let mut events = Vec::new();
+    let run = run(
+        &cfg,
+        &DemoOptions {
+            job: Some(JobPlan::Segments(job())),
+            record_trace: true,
+            ..Default::default()
+        },
+        &mut |_| {},
+        &mut |t, e| events.push((t, e.clone())),
+    )
+    .unwrap();
+    let r = &run.report;
+    assert!(r.finished, "{r:?}");
+    assert_eq!(r.lines_completed, 3);
+    // The only end of engagement is the end of the job (nothing left to steer by).
+    let job_end = events
+        .iter()
+        .find(|(_, e)| matches!(e, Event::JobFinished { .. }))
+        .map(|(t, _)| *t)
+        .expect("job finished");
+    assert!(
+        run.disengage_events
+            .iter()
+            .all(|(t, why)| *t >= job_end && why == "no_guidance"),
+        "no fault at the cusps: {:?}",
+        run.disengage_events
+    );
+    // True XTE on all three segments (from 10 m after each start), reverse included.
+    assert!(r.xte_rms_m < 0.05, "rms {}", r.xte_rms_m);
+    assert!(r.xte_max_m < 0.15, "max {}", r.xte_max_m);
+    let finished: Vec<u64> = events
+        .iter()
+        .filter_map(|(_, e)| match e {
+            Event::LineFinished { line, .. } => Some(*line),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(finished, vec![0, 1, 2]);
+    // The vehicle really reversed: the trace runs west between the cusps.
+    let xs: Vec<f64> = run.trace.points.iter().map(|p| p.pos.x).collect();
+    let max_x = xs.iter().cloned().fold(f64::MIN, f64::max);
+    let min_after = xs
+        .iter()
+        .skip_while(|x| **x < max_x)
+        .cloned()
+        .fold(f64::MAX, f64::min);
+    assert!(
+        max_x > 38.0 && min_after < 2.0,
+        "max x {max_x}, then min {min_after}"
+    );
+}
