@@ -75,6 +75,8 @@ fn configurations() -> Vec<(&'static str, SafetyParams)> {
             SafetyParams {
                 rtk_float_tolerance: 1.0,
                 gnss_timeout: 0.2,
+                // Short, so that cases outlast a direction-change stop.
+                max_stop_time: 0.1,
                 ..d.clone()
             },
         ),
@@ -110,6 +112,8 @@ enum Ev {
     Engage,
     Disengage,
     Bus(bool),
+    /// A stop for a change of direction (a cusp) starts or ends.
+    DirectionChange(bool),
     Step {
         demand: f64,
         xte: f64,
@@ -144,6 +148,7 @@ fn event() -> impl Strategy<Value = Ev> {
         2 => Just(Ev::Engage),
         1 => Just(Ev::Disengage),
         1 => prop::bool::weighted(0.8).prop_map(Ev::Bus),
+        1 => prop::bool::ANY.prop_map(Ev::DirectionChange),
         10 => (special_f64(), special_f64(), special_f64())
             .prop_map(|(demand, xte, heading_error)| Ev::Step { demand, xte, heading_error }),
         30 => (special_f64(), -0.6f64..0.6, prop_oneof![5 => 0.5f64..7.0, 1 => 0.0f64..0.5])
@@ -177,6 +182,7 @@ struct Oracle {
     last_engaged_cmd: Option<(f64, f64)>,
     last_step_t: Option<f64>,
     speed: f64,
+    stopping_since: Option<f64>,
 }
 
 fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseError> {
@@ -233,6 +239,14 @@ fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseEr
                 o.was_engaged = false;
             }
             Ev::Bus(up) => s.on_bus(*up),
+            Ev::DirectionChange(active) => {
+                s.set_direction_change(o.t, *active);
+                if !active {
+                    o.stopping_since = None;
+                } else if o.stopping_since.is_none() {
+                    o.stopping_since = Some(o.t);
+                }
+            }
             Ev::Cycle { .. } | Ev::Step { .. } => {
                 let (demand, xte, heading_error) = match ev {
                     Ev::Cycle {
@@ -305,6 +319,15 @@ fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseEr
                         o.last_wheel
                             .is_some_and(|w| o.t - w <= p.wheel_angle_timeout + 1e-9),
                         "wheel angle timed out but engaged"
+                    );
+                    // (3b) no steering below the minimum speed, except during a requested
+                    // stop for a change of direction, and then for at most max_stop_time.
+                    prop_assert!(
+                        o.speed.abs() >= p.min_speed
+                            || o.stopping_since
+                                .is_some_and(|since| o.t - since <= p.max_stop_time + 1e-9),
+                        "engaged at {} m/s, below the minimum, outside a direction change",
+                        o.speed
                     );
                     o.last_engaged_cmd = Some((o.t, cmd.wheel_angle));
                     ENGAGED_STEPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
