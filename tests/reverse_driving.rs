@@ -77,6 +77,19 @@ fn drives_a_job_with_two_cusps_closed_loop() {
     // True XTE on all three segments (from 10 m after each start), reverse included.
     assert!(r.xte_rms_m < 0.05, "rms {}", r.xte_rms_m);
     assert!(r.xte_max_m < 0.15, "max {}", r.xte_max_m);
+    // Every segment scored, the reverse one included, and the vehicle stopped at the goal.
+    assert_eq!(r.segments.len(), 3, "{:?}", r.segments);
+    assert_eq!(r.segments[1].direction, Direction::Reverse);
+    for s in &r.segments {
+        assert!(
+            s.xte_max_m < 0.15,
+            "segment {}: max {}",
+            s.index,
+            s.xte_max_m
+        );
+    }
+    let goal = r.goal_position_error_m.expect("goal error reported");
+    assert!(goal < 0.1, "goal position error {goal} m");
     let finished: Vec<u64> = events
         .iter()
         .filter_map(|(_, e)| match e {

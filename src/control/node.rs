@@ -79,7 +79,8 @@ struct CuspParams {
     decel: f64,
     stopped_speed: f64,
     capture: f64,
-    end_distance: f64,
+    /// Control period, s.
+    dt: f64,
     min_speed: f64,
 }
 
@@ -145,7 +146,7 @@ impl ControllerNode {
                 decel: cfg.guidance.cusp_decel_mps2,
                 stopped_speed: cfg.guidance.stopped_speed_mps,
                 capture: cfg.guidance.cusp_capture_m,
-                end_distance: cfg.guidance.end_distance_m,
+                dt: cfg.dt(),
                 min_speed: cfg.safety.min_speed_kmh / 3.6,
             },
             cusp: false,
@@ -314,17 +315,17 @@ impl ControllerNode {
         } else {
             Direction::Forward
         };
-        if let (Some(next), Some(est)) = (g.next_direction(), c.estimate) {
-            if next != want {
-                let remaining = g.remaining(&est.pose.pos);
-                if remaining <= v * v / (2.0 * p.decel) + p.end_distance {
-                    self.cusp = true;
-                    if stopped && remaining <= p.capture {
-                        self.ctrl.guidance_mut().advance_segment();
-                        return Some(request_of(next));
-                    }
-                    return Some(STOP);
+        // A cusp ahead, or the end of the job: stop there.
+        let next = g.next_direction();
+        if let Some(est) = c.estimate.filter(|_| next != Some(want)) {
+            let remaining = g.remaining(&est.pose.pos);
+            if remaining <= v * v / (2.0 * p.decel) + v.abs() * p.dt {
+                self.cusp = next.is_some();
+                if stopped && remaining <= p.capture {
+                    self.ctrl.guidance_mut().advance_segment();
+                    return Some(next.map(request_of).unwrap_or(STOP));
                 }
+                return Some(STOP);
             }
         }
         if self.cusp && moving == want && v.abs() >= p.min_speed {

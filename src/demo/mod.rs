@@ -148,6 +148,36 @@ pub struct Report {
     pub frames: u64,
     /// Why agsteer stopped steering, by fault, counted per disengagement.
     pub disengagements: std::collections::BTreeMap<String, u64>,
+    /// Segment jobs (field plans, manoeuvres): true |XTE| on every segment driven.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub segments: Vec<SegmentReport>,
+    /// Segment jobs: distance from the true rear-axle position to the last point of the job
+    /// when it finished, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub goal_position_error_m: Option<f64>,
+    /// Segment jobs: true heading at the finish against the last segment's, degrees.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub goal_heading_error_deg: Option<f64>,
+}
+
+/// Tracking on one segment of a segment job, from the simulator's true pose over the whole
+/// segment (no acquisition skip).
+#[derive(Debug, Clone, Serialize)]
+pub struct SegmentReport {
+    pub index: usize,
+    pub kind: crate::plan::coverage::SegmentKind,
+    pub direction: crate::geo::Direction,
+    pub length_m: f64,
+    pub xte_rms_m: f64,
+    pub xte_max_m: f64,
+}
+
+/// Running |XTE| of one segment.
+#[derive(Debug, Clone, Copy, Default)]
+struct SegmentScore {
+    count: u64,
+    sum_sq: f64,
+    max: f64,
 }
 
 /// What to record and where to start.
@@ -353,6 +383,14 @@ pub fn run(
 
     let mut stats = XteStats::default();
     let mut scored_path = ScoredPath::default();
+    // Segment jobs: every segment scored on its own, whatever its kind.
+    let mut segment_path = ScoredPath::default();
+    let segment_count = match &opts.job {
+        Some(JobPlan::Segments(job)) => job.len(),
+        _ => 0,
+    };
+    let mut segment_scores = vec![SegmentScore::default(); segment_count];
+    let mut finished_at: Option<f64> = None;
     let mut acquisition_max: f64 = 0.0;
     let mut turns = 0u64;
     let mut finished_lines = Vec::new();
@@ -468,7 +506,14 @@ pub fn run(
             }
         }
         if node.controller().guidance().is_finished() {
-            break;
+            // A segment job ends with a stop request: let the vehicle come to rest (within
+            // 30 s) so that the goal error is where it stands, not where it passed.
+            let rolling = sim.sim().true_state().speed.abs() >= cfg.guidance.stopped_speed_mps;
+            if segment_count == 0 || !rolling || t > finished_at.get_or_insert(t).to_owned() + 30.0
+            {
+                break;
+            }
+            continue;
         }
 
         // Ground truth scoring.
@@ -481,6 +526,17 @@ pub fn run(
         last_wheel = truth.wheel_angle;
         let g = node.controller().guidance();
         let mut xte_abs = None;
+        if let Some(score) = segment_scores.get_mut(g.index_rank()) {
+            let path = g.global_path();
+            if segment_path.first_point() != path.first().map(|p| p.pos) {
+                segment_path.set(path);
+            }
+            if let Some((_, xte)) = segment_path.locate(&truth.pose.pos, g.index_global()) {
+                score.count += 1;
+                score.sum_sq += xte * xte;
+                score.max = score.max.max(xte.abs());
+            }
+        }
         if g.phase() == Phase::Work {
             let path = g.global_path();
             if scored_path.first_point() != path.first().map(|p| p.pos) {
@@ -510,6 +566,46 @@ pub fn run(
 
     let ctrl = node.controller();
     let finished = ctrl.guidance().is_finished() && !stopped;
+    let (segments, goal_position_error_m, goal_heading_error_deg) = match &opts.job {
+        Some(JobPlan::Segments(job)) => {
+            let segments = job
+                .segments()
+                .iter()
+                .zip(&segment_scores)
+                .enumerate()
+                .filter(|(_, (_, sc))| sc.count > 0)
+                .map(|(index, (s, sc))| SegmentReport {
+                    index,
+                    kind: s.kind,
+                    direction: s.direction,
+                    length_m: s.length(),
+                    xte_rms_m: (sc.sum_sq / sc.count as f64).sqrt(),
+                    xte_max_m: sc.max,
+                })
+                .collect();
+            let last = job.segments().last();
+            let goal = last.and_then(|s| {
+                let n = s.points.len();
+                let d = s.points[n - 1] - s.points[n - 2];
+                let travel = d.y.atan2(d.x);
+                let heading = match s.direction {
+                    crate::geo::Direction::Forward => travel,
+                    crate::geo::Direction::Reverse => travel + std::f64::consts::PI,
+                };
+                let truth = sim.sim().true_state().pose;
+                finished.then(|| {
+                    (
+                        (truth.pos - s.points[n - 1]).norm(),
+                        crate::geo::wrap_angle(truth.heading - heading)
+                            .to_degrees()
+                            .abs(),
+                    )
+                })
+            });
+            (segments, goal.map(|g| g.0), goal.map(|g| g.1))
+        }
+        _ => (Vec::new(), None, None),
+    };
     let report = Report {
         finished,
         lines_planned: match &opts.job {
@@ -531,6 +627,9 @@ pub fn run(
         engaged_fraction: engaged_ticks as f64 / k.max(1) as f64,
         frames,
         disengagements,
+        segments,
+        goal_position_error_m,
+        goal_heading_error_deg,
     };
     Ok(DemoRun {
         report,
