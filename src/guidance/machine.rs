@@ -14,7 +14,7 @@ use crate::track::local_path::{nearest_global, LocalPath, LocalPathParams};
 
 impl From<AbPlan> for JobPlan {
     fn from(plan: AbPlan) -> Self {
-        JobPlan::Ab(plan)
+        JobPlan::Ab(Box::new(plan))
     }
 }
 
@@ -79,7 +79,7 @@ pub enum GuidanceError {
 #[derive(Debug, Clone)]
 pub enum JobPlan {
     /// An AB job: work lines generated lazily by block and rank, turns between them.
-    Ab(AbPlan),
+    Ab(Box<AbPlan>),
     /// A fixed list of segments (a field plan) driven in order. Its positions are
     /// (block 0, rank = segment index); turns are segments of their own.
     Segments(SegmentJob),
