@@ -5,6 +5,11 @@
 //! Input is a [`Field`] in the local ENU frame (see [`crate::field`] for reading GeoJSON and
 //! ISO 11783-10 TASKDATA into one). Every stage is a pure function of its inputs.
 
+pub mod decompose;
+pub mod geometry;
+pub mod headland;
+pub mod swath_angle;
+
 use crate::geo::{Direction, Vec2};
 use serde::{Deserialize, Serialize};
 
