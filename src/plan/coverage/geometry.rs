@@ -145,7 +145,7 @@ mod tests {
             vec![v2(0.0, 0.0), v2(10.0, 0.0), v2(10.0, 10.0), v2(0.0, 10.0)],
             vec![],
         );
-        let inset = offset(&[sq.clone()], -1.0);
+        let inset = offset(std::slice::from_ref(&sq), -1.0);
         assert_eq!(inset.len(), 1);
         assert!((area_m2(&inset[0]) - 64.0).abs() < 0.01);
         let iv = scan_intervals(&sq, 5.0);

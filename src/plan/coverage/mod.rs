@@ -9,8 +9,12 @@ pub mod decompose;
 pub mod geometry;
 pub mod headland;
 pub mod swath_angle;
+pub mod swaths;
+pub mod transit;
+pub mod turns;
 
-use crate::geo::{Direction, Vec2};
+use crate::geo::{v2, vec_heading, wrap_angle, Direction, Vec2};
+use crate::plan::PlanError;
 use serde::{Deserialize, Serialize};
 
 /// A field in the local ENU frame, metres.
@@ -115,4 +119,561 @@ pub struct FieldPlan {
     pub swath_angles: Vec<f64>,
     /// Number of work swaths.
     pub swaths: usize,
+    /// Overlap of adjacent swath footprints from balancing, m² (estimate: the extra width
+    /// times the mean swath length).
+    pub overlap_m2: f64,
+    /// Turn shapes solved in the canonical frame (each reused for every alike turn).
+    pub turn_shapes_solved: usize,
+}
+
+/// A point of a path keeps the implement inside the field and off the obstacles: inside the
+/// boundary and at least `half` m from every boundary edge and every obstacle.
+pub fn implement_clear(field: &Field, half: f64, q: &Vec2) -> bool {
+    use crate::geo::polygon::{contains_point, point_segment_distance};
+    let far = |ring: &[Vec2]| {
+        let n = ring.len();
+        (0..n).all(|i| point_segment_distance(q, &ring[i], &ring[(i + 1) % n]) >= half - 1e-6)
+    };
+    contains_point(&field.boundary, q)
+        && far(&field.boundary)
+        && field
+            .obstacles
+            .iter()
+            .all(|o| !contains_point(o, q) && far(o))
+}
+
+impl CoverageParams {
+    fn validate(&self) -> Result<(), PlanError> {
+        PlanError::check("line_width", self.line_width, self.line_width > 0.0)?;
+        PlanError::check("r_min", self.r_min, self.r_min > 0.0)?;
+        PlanError::check(
+            "point_spacing",
+            self.point_spacing,
+            self.point_spacing > 0.0,
+        )?;
+        PlanError::check(
+            "small_obstacle_max_m",
+            self.small_obstacle_max_m,
+            self.small_obstacle_max_m >= 0.0,
+        )?;
+        Ok(())
+    }
+
+    fn turn_params(&self) -> crate::plan::turns::TurnParams {
+        crate::plan::turns::TurnParams {
+            r_min: self.r_min,
+            arc_step: 2f64.to_radians(),
+            merge_distance: 0.05,
+            point_spacing: self.point_spacing,
+            max_points: 100_000,
+        }
+    }
+}
+
+/// Plan the whole field: headland passes (outermost first), then the cells in a short order,
+/// each swept by its runs of swaths with turns, joined by transits.
+pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> {
+    p.validate()?;
+    if field.boundary.len() < 3 || crate::geo::polygon::signed_area(&field.boundary) <= 0.0 {
+        return Err(PlanError::Invalid {
+            name: "boundary",
+            value: field.boundary.len() as f64,
+            rule: "must be a counter-clockwise polygon of at least 3 points",
+        });
+    }
+    let w = p.line_width;
+    let half = w / 2.0;
+    let margin = half + headland::CHORD_MARGIN;
+    let safe = headland::subtract_obstacles(
+        &geometry::offset(&[(field.boundary.clone(), vec![])], -margin),
+        &field.obstacles,
+        margin,
+    );
+    let working = headland::working_area(&field.boundary, &field.obstacles, p);
+    let clear = |q: &Vec2| implement_clear(field, half, q);
+    // Waypoints for transits that cannot go direct: a grid over the working area.
+    let waypoints: Vec<Vec2> = {
+        let step = 2.0 * p.r_min;
+        let mut v = Vec::new();
+        for area in &working {
+            if let Some((lo, hi)) = crate::geo::polygon::bbox(area.0.iter()) {
+                let (nx, ny) = (
+                    ((hi.x - lo.x) / step) as usize,
+                    ((hi.y - lo.y) / step) as usize,
+                );
+                if nx * ny > 20_000 {
+                    continue;
+                }
+                for i in 0..=nx {
+                    for j in 0..=ny {
+                        let q = v2(lo.x + i as f64 * step, lo.y + j as f64 * step);
+                        if clear(&q) && crate::geo::polygon::contains_point(&area.0, &q) {
+                            v.push(q);
+                        }
+                    }
+                }
+            }
+        }
+        v
+    };
+
+    // Cells and their swath directions.
+    let global_angle = match p.swath_angle {
+        SwathAngle::Fixed { angle } => Some(angle),
+        SwathAngle::MinSpan => {
+            let pts: Vec<Vec2> = working.iter().flat_map(|a| a.0.iter().copied()).collect();
+            swath_angle::min_span(&pts).map(|s| s.0)
+        }
+        SwathAngle::MinTurns => None,
+    };
+    let mut cells: Vec<(geometry::Area, f64)> = Vec::new();
+    for area in &working {
+        match global_angle {
+            Some(a) => cells.push((area.clone(), a)),
+            None => {
+                let pieces: Vec<geometry::Area> = decompose::convex_cells(&area.0)
+                    .into_iter()
+                    .flat_map(|c| {
+                        use geo::BooleanOps;
+                        let g =
+                            geometry::to_geo(&(c, vec![])).intersection(&geometry::to_geo(area));
+                        geometry::from_geo(&g)
+                    })
+                    .collect();
+                for c in decompose::merge_cells(pieces, w) {
+                    let a = swath_angle::min_span(&c.0).map(|s| s.0).unwrap_or(0.0);
+                    cells.push((c, a));
+                }
+            }
+        }
+    }
+
+    let tp = p.turn_params();
+    let mut cache = turns::TurnCache::default();
+    let mut segments: Vec<PlanSegment> = Vec::new();
+    let push = |segments: &mut Vec<PlanSegment>, kind, direction, cell, points: Vec<Vec2>| {
+        if points.len() >= 2 {
+            let index = segments.len();
+            segments.push(PlanSegment {
+                kind,
+                direction,
+                index,
+                cell,
+                points,
+            });
+        }
+    };
+    // Where the vehicle is: (position, heading).
+    let mut at: Option<(Vec2, f64)> = None;
+    let mut go_to =
+        |segments: &mut Vec<PlanSegment>, at: &mut Option<(Vec2, f64)>, to: Vec2, h: f64, cell| {
+            if let Some((from, h0)) = *at {
+                if (to - from).norm() > 1e-6 || wrap_angle(h - h0).abs() > 1e-6 {
+                    if let Some((pts, _)) = transit::route(
+                        from,
+                        h0,
+                        to,
+                        h,
+                        p.r_min,
+                        p.point_spacing,
+                        &clear,
+                        &waypoints,
+                    ) {
+                        push(
+                            segments,
+                            SegmentKind::Transit,
+                            Direction::Forward,
+                            cell,
+                            pts,
+                        );
+                    }
+                }
+            }
+            *at = Some((to, h));
+        };
+
+    for ring in headland::headland_tracks(&field.boundary, p) {
+        let n = ring.len();
+        if n < 4 {
+            continue;
+        }
+        // Start the closed track where the transit from the vehicle is clear: a little ahead
+        // of it (the first pass: mid the longest boundary edge).
+        let open = &ring[..n - 1];
+        let target = match at {
+            Some((q, h)) => q + crate::geo::heading_vec(h) * (2.5 * p.r_min),
+            None => {
+                let b = &field.boundary;
+                let i = (0..b.len())
+                    .max_by(|&i, &j| {
+                        let li = (b[(i + 1) % b.len()] - b[i]).norm();
+                        let lj = (b[(j + 1) % b.len()] - b[j]).norm();
+                        li.total_cmp(&lj)
+                    })
+                    .unwrap_or(0);
+                0.5 * (b[i] + b[(i + 1) % b.len()])
+            }
+        };
+        let nearest = (0..open.len())
+            .min_by(|&i, &j| {
+                (open[i] - target)
+                    .norm()
+                    .total_cmp(&(open[j] - target).norm())
+            })
+            .unwrap_or(0);
+        let m = open.len();
+        let mut start = nearest;
+        if let Some((q, h)) = at {
+            for k in 0..m {
+                let i = (nearest + k) % m;
+                let hi = vec_heading(&(open[(i + 1) % m] - open[i]));
+                if let Some((_, true)) =
+                    transit::transit(q, h, open[i], hi, p.r_min, p.point_spacing, &clear)
+                {
+                    start = i;
+                    break;
+                }
+            }
+        }
+        let mut track: Vec<Vec2> = (0..m).map(|k| open[(start + k) % m]).collect();
+        track.push(open[start]);
+        let n = track.len();
+        let h = vec_heading(&(track[1] - track[0]));
+        go_to(&mut segments, &mut at, track[0], h, 0);
+        let hl = vec_heading(&(track[n - 1] - track[n - 2]));
+        push(
+            &mut segments,
+            SegmentKind::Headland,
+            Direction::Forward,
+            0,
+            track.clone(),
+        );
+        at = Some((track[n - 1], hl));
+    }
+
+    // Runs of every cell, visited greedily nearest first.
+    let mut pending: Vec<(usize, f64, Vec<swaths::RunSwath>, swaths::SwathLines)> = Vec::new();
+    let mut swath_total = 0;
+    let mut overlap_m2 = 0.0;
+    for (ci, (cell, angle)) in cells.iter().enumerate() {
+        let lines = swaths::swath_lines(cell, &safe, *angle, w);
+        overlap_m2 += lines.overlap_m
+            * lines
+                .intervals
+                .iter()
+                .flatten()
+                .map(|(a, b)| b - a)
+                .sum::<f64>()
+            / lines.ys.len().max(1) as f64;
+        for run in swaths::runs(&lines) {
+            swath_total += run.len();
+            pending.push((ci, *angle, run, lines.clone()));
+        }
+    }
+    while !pending.is_empty() {
+        let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
+        let (k, _) = pending
+            .iter()
+            .enumerate()
+            .map(|(k, (_, angle, run, lines))| {
+                let (line, (x0, _)) = run[0];
+                let q = swaths::unrotate(v2(x0, lines.ys[line]), *angle);
+                (k, (q - here).norm())
+            })
+            .fold((0, f64::INFINITY), |b, c| if c.1 < b.1 { c } else { b });
+        let (ci, angle, run, lines) = pending.swap_remove(k);
+        drive_run(
+            &run,
+            &lines,
+            angle,
+            ci,
+            p,
+            &tp,
+            &mut cache,
+            &clear,
+            &mut segments,
+            &mut at,
+            &mut go_to,
+        )?;
+    }
+
+    Ok(FieldPlan {
+        segments,
+        working_area: working,
+        headland_inner: Vec::new(),
+        cells: cells.len(),
+        swath_angles: cells.iter().map(|c| c.1).collect(),
+        swaths: swath_total,
+        overlap_m2,
+        turn_shapes_solved: cache.solved,
+    })
+}
+
+/// Appends a transit from the vehicle's pose to a pose: (segments, pose, to, heading, cell).
+type GoTo<'a> = dyn FnMut(&mut Vec<PlanSegment>, &mut Option<(Vec2, f64)>, Vec2, f64, usize) + 'a;
+
+/// The driving order of a run's swaths (indices into the run): adjacent ones in turn when the
+/// spacing allows a U-turn (or the operator chose sequential lines, with fishtails); otherwise
+/// the seed-000 block skip order, so no turn is tighter than 2·r_min.
+fn run_order(n: usize, spacing: f64, p: &CoverageParams) -> Vec<usize> {
+    let sequential = spacing + 1e-3 >= 2.0 * p.r_min || p.route == RouteOrder::Sequential;
+    if sequential || n < 2 {
+        return (0..n).collect();
+    }
+    let min_gap = ((2.0 * p.r_min - 1e-3) / spacing).ceil() as usize;
+    let block = 2 * min_gap + 1;
+    let mut order = Vec::with_capacity(n);
+    let mut start = 0;
+    while start < n {
+        let len = if n - start < 2 * block {
+            n - start
+        } else {
+            block
+        };
+        let bo = crate::plan::abline::solve_block_order(len, min_gap, start + len < n);
+        order.extend(bo.lines().map(|l| start + l as usize));
+        start += len;
+    }
+    order
+}
+
+#[allow(clippy::too_many_arguments)]
+fn drive_run(
+    run: &[swaths::RunSwath],
+    lines: &swaths::SwathLines,
+    angle: f64,
+    cell: usize,
+    p: &CoverageParams,
+    tp: &crate::plan::turns::TurnParams,
+    cache: &mut turns::TurnCache,
+    clear: &dyn Fn(&Vec2) -> bool,
+    segments: &mut Vec<PlanSegment>,
+    at: &mut Option<(Vec2, f64)>,
+    go_to: &mut GoTo<'_>,
+) -> Result<(), PlanError> {
+    let order = run_order(run.len(), lines.spacing, p);
+    let here = at.map(|a| a.0);
+    // Start from the end of the first swath nearest the vehicle.
+    let (l0, (a0, b0)) = run[order[0]];
+    let start_left = match here {
+        Some(h) => {
+            let pa = swaths::unrotate(v2(a0, lines.ys[l0]), angle);
+            let pb = swaths::unrotate(v2(b0, lines.ys[l0]), angle);
+            (pa - h).norm() <= (pb - h).norm()
+        }
+        None => true,
+    };
+    // Swath ends in the rotated frame, possibly pulled back to make room for the turns.
+    let mut ends: Vec<(f64, f64)> = order.iter().map(|&i| run[i].1).collect();
+    let mut forward = start_left;
+    let mut pieces: Vec<(SegmentKind, Direction, Vec<Vec2>)> = Vec::new();
+    for (k, &i) in order.iter().enumerate() {
+        let y = lines.ys[run[i].0];
+        let (a, b) = ends[k];
+        let (s, e) = if forward { (a, b) } else { (b, a) };
+        let world = |x: f64, yy: f64| swaths::unrotate(v2(x, yy), angle);
+        pieces.push((
+            SegmentKind::Work,
+            Direction::Forward,
+            transit::straight(world(s, y), world(e, y), p.point_spacing),
+        ));
+        if let Some(&j) = order.get(k + 1) {
+            let y2 = lines.ys[run[j].0];
+            let (a2, b2) = ends[k + 1];
+            let dir = if forward { 1.0 } else { -1.0 };
+            let end2 = if forward { b2 } else { a2 };
+            // Level the two ends at the outer one (the shorter swath runs on to it), then
+            // pull the apex back, shortening the swaths, until the whole turn is clear.
+            let outer = if forward { e.max(end2) } else { e.min(end2) };
+            let inner = if forward { e.min(end2) } else { e.max(end2) };
+            let tries = ((outer - inner).abs() + 4.0 * p.r_min + 2.0 * p.line_width) as usize;
+            let d = swaths::unrotate(v2(dir, 0.0), angle);
+            let mut best = None;
+            for t in 0..=tries {
+                let apex = outer - dir * t as f64;
+                let e_new = if forward { e.min(apex) } else { e.max(apex) };
+                let start2 = if forward {
+                    end2.min(apex)
+                } else {
+                    end2.max(apex)
+                };
+                let mut parts = cache.turn(world(apex, y), d, world(apex, y2), tp)?;
+                let lead_in = world(e_new, y);
+                if let Some(first) = parts.first_mut() {
+                    let mut pts = transit::straight(lead_in, first.points[0], p.point_spacing);
+                    pts.pop();
+                    pts.extend(first.points.iter().copied());
+                    first.points = pts;
+                }
+                if let Some(last) = parts.last_mut() {
+                    let from = *last.points.last().unwrap_or(&lead_in);
+                    let tail = transit::straight(from, world(start2, y2), p.point_spacing);
+                    last.points.extend(tail.into_iter().skip(1));
+                }
+                let ok = parts.iter().all(|t| t.points.iter().all(clear));
+                if ok || best.is_none() {
+                    best = Some((parts, e_new, start2));
+                }
+                if ok {
+                    break;
+                }
+            }
+            let Some((parts, e_new, start2)) = best else {
+                continue;
+            };
+            // This swath ends where its turn begins.
+            if let Some(last) = pieces.last_mut() {
+                last.2 = transit::straight(world(s, y), world(e_new, y), p.point_spacing);
+            }
+            if forward {
+                ends[k + 1].1 = start2;
+            } else {
+                ends[k + 1].0 = start2;
+            }
+            for t in parts {
+                pieces.push((SegmentKind::Turn, t.direction, t.points));
+            }
+        }
+        forward = !forward;
+    }
+    // Drive: transit to the first swath, then the pieces in order.
+    let mut first = true;
+    for (kind, direction, pts) in pieces {
+        if pts.len() < 2 {
+            continue;
+        }
+        if first {
+            let h = vec_heading(&(pts[1] - pts[0]));
+            go_to(segments, at, pts[0], h, cell);
+            first = false;
+        }
+        let n = pts.len();
+        let travel = vec_heading(&(pts[n - 1] - pts[n - 2]));
+        let index = segments.len();
+        segments.push(PlanSegment {
+            kind,
+            direction,
+            index,
+            cell,
+            points: pts.clone(),
+        });
+        let heading = match direction {
+            Direction::Forward => travel,
+            Direction::Reverse => wrap_angle(travel + std::f64::consts::PI),
+        };
+        *at = Some((pts[n - 1], heading));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn params(w: f64, r: f64, passes: usize) -> CoverageParams {
+        CoverageParams {
+            line_width: w,
+            r_min: r,
+            headland_passes: passes,
+            point_spacing: 1.0,
+            swath_angle: SwathAngle::MinTurns,
+            route: RouteOrder::Auto,
+            small_obstacle_max_m: 0.0,
+        }
+    }
+
+    fn curvature(w: &[Vec2]) -> f64 {
+        let (a, b, c) = (w[0], w[1], w[2]);
+        2.0 * crate::geo::cross(&(b - a), &(c - b)).abs()
+            / ((b - a).norm() * (c - b).norm() * (c - a).norm()).max(1e-12)
+    }
+
+    /// Every point clear of the edge and obstacles by w/2, curvature ≤ 1/r_min (3-point, 2 %
+    /// for discretisation), consecutive segments joined.
+    pub(crate) fn check(field: &Field, p: &CoverageParams) -> FieldPlan {
+        let plan = plan_field(field, p).unwrap();
+        assert!(plan.swaths > 0);
+        if std::env::var("DBG").is_ok() {
+            for s in &plan.segments {
+                eprintln!(
+                    "{} {:?} {:?} {:?} → {:?} n={}",
+                    s.index,
+                    s.kind,
+                    s.direction,
+                    s.points[0],
+                    s.points.last().unwrap(),
+                    s.points.len()
+                );
+            }
+        }
+        for s in &plan.segments {
+            for q in &s.points {
+                assert!(
+                    implement_clear(field, p.line_width / 2.0, q),
+                    "{:?} {} at {q:?}",
+                    s.kind,
+                    s.index
+                );
+            }
+            for w in s.points.windows(3) {
+                if (w[1] - w[0]).norm() > 0.05 && (w[2] - w[1]).norm() > 0.05 {
+                    let k = curvature(w);
+                    assert!(
+                        k <= 1.02 / p.r_min,
+                        "{:?} {}: curvature {k}",
+                        s.kind,
+                        s.index
+                    );
+                }
+            }
+        }
+        for pair in plan.segments.windows(2) {
+            let gap = (pair[1].points[0] - *pair[0].points.last().unwrap()).norm();
+            assert!(
+                gap < 1e-6,
+                "segments {} → {} apart by {gap}",
+                pair[0].index,
+                pair[1].index
+            );
+        }
+        plan
+    }
+
+    #[test]
+    fn rectangle_l_and_obstacle_fields_plan_clear_and_driveable() {
+        let rect = Field {
+            boundary: vec![
+                v2(0.0, 0.0),
+                v2(300.0, 0.0),
+                v2(300.0, 150.0),
+                v2(0.0, 150.0),
+            ],
+            obstacles: vec![],
+        };
+        let plan = check(&rect, &params(12.0, 6.0, 2));
+        assert_eq!(plan.cells, 1);
+        let l = Field {
+            boundary: vec![
+                v2(0.0, 0.0),
+                v2(220.0, 0.0),
+                v2(220.0, 110.0),
+                v2(110.0, 110.0),
+                v2(110.0, 220.0),
+                v2(0.0, 220.0),
+            ],
+            obstacles: vec![vec![
+                v2(150.0, 45.0),
+                v2(162.0, 45.0),
+                v2(162.0, 57.0),
+                v2(150.0, 57.0),
+            ]],
+        };
+        check(&l, &params(12.0, 6.0, 2));
+        // Narrow lines (w < 2·r_min): the skip order.
+        let plan = check(&rect, &params(6.0, 6.0, 3));
+        assert!(plan
+            .segments
+            .iter()
+            .all(|s| s.direction == Direction::Forward));
+    }
 }

@@ -1,0 +1,181 @@
+//! Swaths (seed 003): scan lines across a cell in the frame rotated so the swaths run along x,
+//! balanced so their w-wide footprints cover the whole cell, then grouped into runs that a
+//! boustrophedon can sweep (a large obstacle splits the lines, and both sides are covered).
+
+use super::geometry::{rotate_area, scan_intervals, Area};
+use crate::geo::Vec2;
+
+/// The swath lines of one cell, in the rotated frame (swaths along +x).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SwathLines {
+    /// Swath direction in the local frame, rad.
+    pub angle: f64,
+    /// Distance between adjacent lines, m (≤ the line width).
+    pub spacing: f64,
+    /// y of every line, rotated frame, m.
+    pub ys: Vec<f64>,
+    /// The x-intervals of every line, rotated frame, m.
+    pub intervals: Vec<Vec<(f64, f64)>>,
+    /// Overlap of adjacent footprints summed across the cell, m (n·w − span).
+    pub overlap_m: f64,
+}
+
+/// Lines across `cell` (local frame) along `angle` rad, `line_width` apart at most. The n =
+/// ceil(span / w) lines are spread evenly, the first and last half a spacing inside the cell,
+/// so no pass is dropped and the footprints overlap by (n·w − span) in all.
+///
+/// Each interval is widened to the cell's extent within the line's band (so slanted edges are
+/// covered to the corner) and then cut back to `safe` (where a centre line keeps the implement
+/// inside the field and off the obstacles).
+pub fn swath_lines(cell: &Area, safe: &[Area], angle: f64, line_width: f64) -> SwathLines {
+    let rot = rotate_area(cell, -angle);
+    let safe_rot: Vec<Area> = safe.iter().map(|a| rotate_area(a, -angle)).collect();
+    let (lo, hi) = rot
+        .0
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p.y), h.max(p.y))
+        });
+    let span = (hi - lo).max(0.0);
+    let n = (span / line_width - 1e-9).ceil().max(1.0) as usize;
+    let spacing = span / n as f64;
+    let ys: Vec<f64> = (0..n).map(|k| lo + spacing * (k as f64 + 0.5)).collect();
+    let intervals = ys
+        .iter()
+        .map(|&y| {
+            let band = band_extent(&rot, y, spacing / 2.0);
+            scan_intervals(&rot, y)
+                .into_iter()
+                .filter_map(|(a, b)| {
+                    // Widen to the band's extent over this piece, then keep inside `safe`.
+                    let (mut x0, mut x1) = (a, b);
+                    for &(c, d) in &band {
+                        if c <= b && d >= a {
+                            x0 = x0.min(c);
+                            x1 = x1.max(d);
+                        }
+                    }
+                    let mid = 0.5 * (a + b);
+                    let s = safe_rot
+                        .iter()
+                        .flat_map(|s| scan_intervals(s, y))
+                        .find(|&(c, d)| c <= mid && mid <= d)?;
+                    let (x0, x1) = (x0.max(s.0), x1.min(s.1));
+                    (x1 - x0 > 1e-3).then_some((x0, x1))
+                })
+                .collect()
+        })
+        .collect();
+    SwathLines {
+        angle,
+        spacing,
+        ys,
+        intervals,
+        overlap_m: (n as f64 * line_width - span).max(0.0),
+    }
+}
+
+/// The x-extent of `rot` within the band [y − half, y + half]: intervals at both band edges and
+/// at every vertex inside the band, merged where they overlap.
+fn band_extent(rot: &Area, y: f64, half: f64) -> Vec<(f64, f64)> {
+    let mut ys = vec![y - half + 1e-6, y, y + half - 1e-6];
+    for ring in std::iter::once(&rot.0).chain(rot.1.iter()) {
+        ys.extend(ring.iter().map(|p| p.y).filter(|v| (v - y).abs() < half));
+    }
+    let mut all: Vec<(f64, f64)> = ys.iter().flat_map(|&v| scan_intervals(rot, v)).collect();
+    all.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut merged: Vec<(f64, f64)> = Vec::new();
+    for iv in all {
+        match merged.last_mut() {
+            Some(m) if iv.0 <= m.1 => m.1 = m.1.max(iv.1),
+            _ => merged.push(iv),
+        }
+    }
+    merged
+}
+
+/// One swath of a run: line index and x-interval, rotated frame.
+pub type RunSwath = (usize, (f64, f64));
+
+/// Group the swaths into runs, each swept by one boustrophedon: consecutive lines whose
+/// intervals overlap one to one. Where a line splits (an obstacle) or pieces join, new runs
+/// start, so both sides of a large obstacle are covered.
+pub fn runs(lines: &SwathLines) -> Vec<Vec<RunSwath>> {
+    let mut done: Vec<Vec<RunSwath>> = Vec::new();
+    let mut open: Vec<Vec<RunSwath>> = Vec::new();
+    for (k, ivs) in lines.intervals.iter().enumerate() {
+        let mut next_open: Vec<Vec<RunSwath>> = Vec::new();
+        let mut used = vec![false; open.len()];
+        for &iv in ivs {
+            let overlaps =
+                |r: &Vec<RunSwath>| r.last().is_some_and(|&(_, (a, b))| a < iv.1 && b > iv.0);
+            let matches: Vec<usize> = (0..open.len()).filter(|&i| overlaps(&open[i])).collect();
+            let back = ivs
+                .iter()
+                .filter(|o| {
+                    matches.len() == 1 && {
+                        let (a, b) = open[matches[0]].last().map(|s| s.1).unwrap_or((0.0, 0.0));
+                        a < o.1 && b > o.0
+                    }
+                })
+                .count();
+            if matches.len() == 1 && back == 1 && !used[matches[0]] {
+                used[matches[0]] = true;
+                let mut r = std::mem::take(&mut open[matches[0]]);
+                r.push((k, iv));
+                next_open.push(r);
+            } else {
+                next_open.push(vec![(k, iv)]);
+            }
+        }
+        for (i, r) in open.into_iter().enumerate() {
+            if !used[i] && !r.is_empty() {
+                done.push(r);
+            }
+        }
+        open = next_open;
+    }
+    done.extend(open.into_iter().filter(|r| !r.is_empty()));
+    done
+}
+
+/// A rotated-frame point back in the local frame.
+pub fn unrotate(p: Vec2, angle: f64) -> Vec2 {
+    super::geometry::rotate(&p, angle)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geo::v2;
+
+    fn rect(w: f64, h: f64) -> Area {
+        (vec![v2(0.0, 0.0), v2(w, 0.0), v2(w, h), v2(0.0, h)], vec![])
+    }
+
+    #[test]
+    fn balanced_lines_cover_the_cell_and_obstacles_split_runs() {
+        let cell = rect(100.0, 50.0);
+        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0);
+        assert_eq!(l.ys.len(), 9, "ceil(50/6)");
+        assert!((l.ys[0] - l.spacing / 2.0).abs() < 1e-9);
+        assert!((l.ys[8] - (50.0 - l.spacing / 2.0)).abs() < 1e-9);
+        assert!((l.overlap_m - (54.0 - 50.0)).abs() < 1e-9);
+        assert_eq!(runs(&l).len(), 1);
+        // A hole across the middle lines splits them: runs below, left, right and above.
+        let holed: Area = (
+            cell.0.clone(),
+            vec![vec![
+                v2(40.0, 15.0),
+                v2(60.0, 15.0),
+                v2(60.0, 35.0),
+                v2(40.0, 35.0),
+            ]],
+        );
+        let l = swath_lines(&holed, std::slice::from_ref(&holed), 0.0, 6.0);
+        let r = runs(&l);
+        assert_eq!(r.len(), 4, "{r:?}");
+        let swaths: usize = r.iter().map(|x| x.len()).sum();
+        assert_eq!(swaths, l.intervals.iter().map(|v| v.len()).sum::<usize>());
+    }
+}
