@@ -248,6 +248,16 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         }
     }
 
+    if std::env::var("DBG").is_ok() {
+        for (c, a) in &cells {
+            eprintln!("cell {} verts {} holes angle {a}", c.0.len(), c.1.len());
+        }
+        eprintln!(
+            "working {} areas, holes {:?}",
+            working.len(),
+            working.iter().map(|w| w.1.len()).collect::<Vec<_>>()
+        );
+    }
     let tp = p.turn_params();
     let mut cache = turns::TurnCache::default();
     let mut segments: Vec<PlanSegment> = Vec::new();
@@ -265,32 +275,86 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     };
     // Where the vehicle is: (position, heading).
     let mut at: Option<(Vec2, f64)> = None;
-    let mut go_to =
-        |segments: &mut Vec<PlanSegment>, at: &mut Option<(Vec2, f64)>, to: Vec2, h: f64, cell| {
-            if let Some((from, h0)) = *at {
-                if (to - from).norm() > 1e-6 || wrap_angle(h - h0).abs() > 1e-6 {
-                    if let Some((pts, _)) = transit::route(
-                        from,
-                        h0,
-                        to,
-                        h,
-                        p.r_min,
-                        p.point_spacing,
-                        &clear,
-                        &waypoints,
-                    ) {
-                        push(
-                            segments,
-                            SegmentKind::Transit,
-                            Direction::Forward,
-                            cell,
-                            pts,
-                        );
+    // A transit from the vehicle to the start of `target`: direct if clear; else with the
+    // previous work segment's end and the target's start pulled back together (a swath that
+    // ends at an obstacle leaves no room to turn), metre by metre; else through a waypoint.
+    // Returns how many points were cut from the start of `target`.
+    let mut go_to = |segments: &mut Vec<PlanSegment>,
+                     at: &mut Option<(Vec2, f64)>,
+                     target: &[Vec2],
+                     cell: usize|
+     -> usize {
+        let heading_at = |pts: &[Vec2], i: usize| vec_heading(&(pts[i + 1] - pts[i]));
+        let Some((from, h0)) = *at else {
+            return 0;
+        };
+        let to = target[0];
+        let h = heading_at(target, 0);
+        if (to - from).norm() < 1e-6 && wrap_angle(h - h0).abs() < 1e-6 {
+            return 0;
+        }
+        let prev_work = segments
+            .last()
+            .filter(|s| s.kind == SegmentKind::Work && s.direction == Direction::Forward)
+            .map(|s| s.points.clone());
+        let max_cut = ((3.0 * p.r_min + p.line_width) / p.point_spacing).ceil() as usize;
+        let mut fallback = None;
+        for t in 0..=max_cut {
+            let cut_prev = prev_work
+                .as_ref()
+                .map_or(0, |pts| t.min(pts.len().saturating_sub(3)));
+            let cut_next = t.min(target.len().saturating_sub(3));
+            if t > 0 && cut_prev == 0 && cut_next == 0 {
+                break;
+            }
+            let (f, hf) = match &prev_work {
+                Some(pts) if cut_prev > 0 => {
+                    let i = pts.len() - 1 - cut_prev;
+                    (pts[i], heading_at(pts, i - 1))
+                }
+                _ => (from, h0),
+            };
+            let (q, hq) = (target[cut_next], heading_at(target, cut_next));
+            let found = match transit::transit(f, hf, q, hq, p.r_min, p.point_spacing, &clear) {
+                Some((pts, true)) => Some((pts, true)),
+                other if t == 0 || t == max_cut / 2 || t == max_cut => {
+                    let r =
+                        transit::route(f, hf, q, hq, p.r_min, p.point_spacing, &clear, &waypoints);
+                    if t == 0 {
+                        fallback = other.or(r.clone());
+                    }
+                    r.filter(|x| x.1)
+                }
+                _ => None,
+            };
+            if let Some((pts, _)) = found {
+                if cut_prev > 0 {
+                    if let Some(last) = segments.last_mut() {
+                        let keep = last.points.len() - cut_prev;
+                        last.points.truncate(keep);
                     }
                 }
+                push(
+                    segments,
+                    SegmentKind::Transit,
+                    Direction::Forward,
+                    cell,
+                    pts,
+                );
+                return cut_next;
             }
-            *at = Some((to, h));
-        };
+        }
+        if let Some((pts, _)) = fallback {
+            push(
+                segments,
+                SegmentKind::Transit,
+                Direction::Forward,
+                cell,
+                pts,
+            );
+        }
+        0
+    };
 
     for ring in headland::headland_tracks(&field.boundary, p) {
         let n = ring.len();
@@ -338,8 +402,9 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         let mut track: Vec<Vec2> = (0..m).map(|k| open[(start + k) % m]).collect();
         track.push(open[start]);
         let n = track.len();
-        let h = vec_heading(&(track[1] - track[0]));
-        go_to(&mut segments, &mut at, track[0], h, 0);
+        let cut = go_to(&mut segments, &mut at, &track, 0);
+        let track = track[cut..].to_vec();
+        let n = n - cut;
         let hl = vec_heading(&(track[n - 1] - track[n - 2]));
         push(
             &mut segments,
@@ -365,7 +430,20 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
                 .map(|(a, b)| b - a)
                 .sum::<f64>()
             / lines.ys.len().max(1) as f64;
+        if std::env::var("DBG").is_ok() {
+            for (k, iv) in lines.intervals.iter().enumerate() {
+                if iv.len() > 1
+                    || (k > 0 && lines.intervals[k - 1].len() > 1)
+                    || lines.intervals.get(k + 1).is_some_and(|v| v.len() > 1)
+                {
+                    eprintln!("line {k} y {:.2} {:?}", lines.ys[k], iv);
+                }
+            }
+        }
         for run in swaths::runs(&lines) {
+            if std::env::var("DBG").is_ok() {
+                eprintln!("run {:?}", run.iter().map(|r| r.0).collect::<Vec<_>>());
+            }
             swath_total += run.len();
             pending.push((ci, *angle, run, lines.clone()));
         }
@@ -409,8 +487,10 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     })
 }
 
-/// Appends a transit from the vehicle's pose to a pose: (segments, pose, to, heading, cell).
-type GoTo<'a> = dyn FnMut(&mut Vec<PlanSegment>, &mut Option<(Vec2, f64)>, Vec2, f64, usize) + 'a;
+/// Appends a transit from the vehicle's pose to the start of a path: (segments, pose, path,
+/// cell) → points cut from the path's start.
+type GoTo<'a> =
+    dyn FnMut(&mut Vec<PlanSegment>, &mut Option<(Vec2, f64)>, &[Vec2], usize) -> usize + 'a;
 
 /// The driving order of a run's swaths (indices into the run): adjacent ones in turn when the
 /// spacing allows a U-turn (or the operator chose sequential lines, with fishtails); otherwise
@@ -538,13 +618,13 @@ fn drive_run(
     }
     // Drive: transit to the first swath, then the pieces in order.
     let mut first = true;
-    for (kind, direction, pts) in pieces {
+    for (kind, direction, mut pts) in pieces {
         if pts.len() < 2 {
             continue;
         }
         if first {
-            let h = vec_heading(&(pts[1] - pts[0]));
-            go_to(segments, at, pts[0], h, cell);
+            let cut = go_to(segments, at, &pts, cell);
+            pts.drain(..cut);
             first = false;
         }
         let n = pts.len();
@@ -669,6 +749,39 @@ mod tests {
             ]],
         };
         check(&l, &params(12.0, 6.0, 2));
+        // The bench's 100 ha field: a convex 12-gon with an obstacle, w = r_min = 6 m.
+        let radii = [
+            1.00, 0.93, 1.08, 0.97, 1.05, 0.9, 1.02, 0.95, 1.1, 0.92, 1.0, 0.96,
+        ];
+        let pts: Vec<Vec2> = radii
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let a = i as f64 * std::f64::consts::TAU / 12.0 + 0.1 * (i % 3) as f64;
+                v2(r * a.cos() * 1.4, r * a.sin())
+            })
+            .collect();
+        let hull = geometry::convex_hull(&pts);
+        let k = (1e6 / crate::geo::polygon::signed_area(&hull)).sqrt();
+        let c = v2(0.2 * k, 0.1 * k);
+        let gon = Field {
+            boundary: hull.iter().map(|q| q * k).collect(),
+            obstacles: vec![vec![
+                c + v2(-10.0, -7.0),
+                c + v2(10.0, -7.0),
+                c + v2(10.0, 7.0),
+                c + v2(-10.0, 7.0),
+            ]],
+        };
+        let t = std::time::Instant::now();
+        let plan = check(&gon, &params(6.0, 6.0, 3));
+        eprintln!(
+            "12-gon: {} segments, {} swaths, {} cells in {:?}",
+            plan.segments.len(),
+            plan.swaths,
+            plan.cells,
+            t.elapsed()
+        );
         // Narrow lines (w < 2·r_min): the skip order.
         let plan = check(&rect, &params(6.0, 6.0, 3));
         assert!(plan

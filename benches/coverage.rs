@@ -1,0 +1,101 @@
+//! Field coverage planning: each stage and the whole plan for a 100 ha irregular 12-gon with
+//! one obstacle (w = r_min = 6 m, 3 headland passes = 18 m), and the whole plan at 10, 100 and
+//! 1000 ha to show how it scales with field size.
+
+use agsteer::geo::{v2, Vec2};
+use agsteer::plan::coverage::{
+    decompose, headland, plan_field, swath_angle, swaths, CoverageParams, Field, RouteOrder,
+    SwathAngle,
+};
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use std::hint::black_box;
+
+/// A convex irregular 12-gon of about `hectares` ha with a 20 × 14 m obstacle inside.
+fn twelve_gon(hectares: f64) -> Field {
+    let radii = [
+        1.00, 0.93, 1.08, 0.97, 1.05, 0.9, 1.02, 0.95, 1.1, 0.92, 1.0, 0.96,
+    ];
+    let pts: Vec<Vec2> = radii
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let a = i as f64 * std::f64::consts::TAU / 12.0 + 0.1 * (i % 3) as f64;
+            v2(r * a.cos() * 1.4, r * a.sin())
+        })
+        .collect();
+    let hull = agsteer::plan::coverage::geometry::convex_hull(&pts);
+    let area = agsteer::geo::polygon::signed_area(&hull);
+    let k = (hectares * 1e4 / area).sqrt();
+    let boundary: Vec<Vec2> = hull.iter().map(|p| p * k).collect();
+    let c = v2(0.2 * k, 0.1 * k);
+    let obstacle = vec![
+        c + v2(-10.0, -7.0),
+        c + v2(10.0, -7.0),
+        c + v2(10.0, 7.0),
+        c + v2(-10.0, 7.0),
+    ];
+    Field {
+        boundary,
+        obstacles: vec![obstacle],
+    }
+}
+
+fn params() -> CoverageParams {
+    CoverageParams {
+        line_width: 6.0,
+        r_min: 6.0,
+        headland_passes: 3,
+        point_spacing: 1.0,
+        swath_angle: SwathAngle::MinTurns,
+        route: RouteOrder::Auto,
+        small_obstacle_max_m: 0.0,
+    }
+}
+
+fn stages(c: &mut Criterion) {
+    let field = twelve_gon(100.0);
+    let p = params();
+    let mut g = c.benchmark_group("coverage_100ha");
+    g.sample_size(20);
+    g.bench_function("headland_tracks", |b| {
+        b.iter(|| headland::headland_tracks(black_box(&field.boundary), &p))
+    });
+    let working = headland::working_area(&field.boundary, &field.obstacles, &p);
+    g.bench_function("working_area", |b| {
+        b.iter(|| headland::working_area(black_box(&field.boundary), &field.obstacles, &p))
+    });
+    g.bench_function("swath_angle", |b| {
+        b.iter(|| swath_angle::min_span(black_box(&working[0].0)))
+    });
+    g.bench_function("decompose", |b| {
+        b.iter(|| decompose::convex_cells(black_box(&working[0].0)))
+    });
+    let angle = swath_angle::min_span(&working[0].0)
+        .map(|s| s.0)
+        .unwrap_or(0.0);
+    g.bench_function("swaths", |b| {
+        b.iter(|| swaths::swath_lines(black_box(&working[0]), &working, angle, 6.0))
+    });
+    g.bench_function("whole_plan", |b| {
+        b.iter(|| plan_field(black_box(&field), &p))
+    });
+    g.finish();
+}
+
+fn scaling(c: &mut Criterion) {
+    let p = params();
+    let mut g = c.benchmark_group("coverage_scaling");
+    g.sample_size(10);
+    for ha in [10.0, 100.0, 1000.0] {
+        let field = twelve_gon(ha);
+        g.bench_with_input(
+            BenchmarkId::new("whole_plan_ha", ha as u64),
+            &field,
+            |b, f| b.iter(|| plan_field(black_box(f), &p)),
+        );
+    }
+    g.finish();
+}
+
+criterion_group!(benches, stages, scaling);
+criterion_main!(benches);
