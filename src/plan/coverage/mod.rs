@@ -142,6 +142,64 @@ pub fn implement_clear(field: &Field, half: f64, q: &Vec2) -> bool {
             .all(|o| !contains_point(o, q) && far(o))
 }
 
+/// [`implement_clear`] with a lazily filled grid of cells known to be clear throughout (their
+/// centre is clear by `half` plus half the cell's diagonal), so most checks are one lookup.
+struct ClearMap<'a> {
+    field: &'a Field,
+    half: f64,
+    origin: Vec2,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    /// 0 = not known yet, 1 = clear throughout, 2 = check each point.
+    state: std::cell::RefCell<Vec<u8>>,
+}
+
+impl<'a> ClearMap<'a> {
+    /// At most this many grid cells (a few MB).
+    const MAX_CELLS: f64 = 4.0e6;
+
+    fn new(field: &'a Field, half: f64) -> Self {
+        let (lo, hi) = crate::geo::polygon::bbox(field.boundary.iter())
+            .unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
+        let span = hi - lo;
+        let cell = (half.max(0.5)).max((span.x * span.y / Self::MAX_CELLS).sqrt());
+        let nx = (span.x / cell).ceil() as usize + 1;
+        let ny = (span.y / cell).ceil() as usize + 1;
+        ClearMap {
+            field,
+            half,
+            origin: lo,
+            cell,
+            nx,
+            ny,
+            state: std::cell::RefCell::new(vec![0; nx * ny]),
+        }
+    }
+
+    fn clear(&self, q: &Vec2) -> bool {
+        let i = ((q.x - self.origin.x) / self.cell).floor();
+        let j = ((q.y - self.origin.y) / self.cell).floor();
+        if i >= 0.0 && j >= 0.0 && (i as usize) < self.nx && (j as usize) < self.ny {
+            let k = j as usize * self.nx + i as usize;
+            let mut state = self.state.borrow_mut();
+            if state[k] == 0 {
+                let centre = self.origin + v2((i + 0.5) * self.cell, (j + 0.5) * self.cell);
+                let deep = self.half + self.cell * std::f64::consts::FRAC_1_SQRT_2;
+                state[k] = if implement_clear(self.field, deep, &centre) {
+                    1
+                } else {
+                    2
+                };
+            }
+            if state[k] == 1 {
+                return true;
+            }
+        }
+        implement_clear(self.field, self.half, q)
+    }
+}
+
 impl CoverageParams {
     fn validate(&self) -> Result<(), PlanError> {
         PlanError::check("line_width", self.line_width, self.line_width > 0.0)?;
@@ -190,7 +248,8 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         margin,
     );
     let working = headland::working_area(&field.boundary, &field.obstacles, p);
-    let clear = |q: &Vec2| implement_clear(field, half, q);
+    let clear_map = ClearMap::new(field, half);
+    let clear = |q: &Vec2| clear_map.clear(q);
     // Waypoints for transits that cannot go direct: a grid over the working area.
     let waypoints: Vec<Vec2> = {
         let step = 2.0 * p.r_min;
@@ -298,15 +357,12 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
             .filter(|s| s.kind == SegmentKind::Work && s.direction == Direction::Forward)
             .map(|s| s.points.clone());
         let max_cut = ((3.0 * p.r_min + p.line_width) / p.point_spacing).ceil() as usize;
-        let mut fallback = None;
-        for t in 0..=max_cut {
+        // (cut from the previous work end, cut from the target start) → the two poses.
+        let poses = |t: usize| {
             let cut_prev = prev_work
                 .as_ref()
                 .map_or(0, |pts| t.min(pts.len().saturating_sub(3)));
             let cut_next = t.min(target.len().saturating_sub(3));
-            if t > 0 && cut_prev == 0 && cut_next == 0 {
-                break;
-            }
             let (f, hf) = match &prev_work {
                 Some(pts) if cut_prev > 0 => {
                     let i = pts.len() - 1 - cut_prev;
@@ -314,46 +370,60 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
                 }
                 _ => (from, h0),
             };
-            let (q, hq) = (target[cut_next], heading_at(target, cut_next));
-            let found = match transit::transit(f, hf, q, hq, p.r_min, p.point_spacing, &clear) {
-                Some((pts, true)) => Some((pts, true)),
-                other if t == 0 || t == max_cut / 2 || t == max_cut => {
-                    let r =
-                        transit::route(f, hf, q, hq, p.r_min, p.point_spacing, &clear, &waypoints);
-                    if t == 0 {
-                        fallback = other.or(r.clone());
-                    }
-                    r.filter(|x| x.1)
-                }
-                _ => None,
-            };
-            if let Some((pts, _)) = found {
-                if cut_prev > 0 {
-                    if let Some(last) = segments.last_mut() {
-                        let keep = last.points.len() - cut_prev;
-                        last.points.truncate(keep);
-                    }
-                }
-                push(
-                    segments,
-                    SegmentKind::Transit,
-                    Direction::Forward,
-                    cell,
-                    pts,
-                );
-                return cut_next;
+            (
+                cut_prev,
+                cut_next,
+                f,
+                hf,
+                target[cut_next],
+                heading_at(target, cut_next),
+            )
+        };
+        let mut found = None;
+        for t in 0..=max_cut {
+            let (cp, cn, f, hf, q, hq) = poses(t);
+            if t > 0 && cp == 0 && cn == 0 {
+                break;
+            }
+            if let Some((pts, true)) =
+                transit::transit(f, hf, q, hq, p.r_min, p.point_spacing, &clear)
+            {
+                found = Some((pts, cp, cn));
+                break;
             }
         }
-        if let Some((pts, _)) = fallback {
-            push(
-                segments,
-                SegmentKind::Transit,
-                Direction::Forward,
-                cell,
-                pts,
-            );
+        if found.is_none() {
+            for t in [0, max_cut / 2, max_cut] {
+                let (cp, cn, f, hf, q, hq) = poses(t);
+                let r = transit::route(f, hf, q, hq, p.r_min, p.point_spacing, &clear, &waypoints);
+                if let Some((pts, true)) = r {
+                    found = Some((pts, cp, cn));
+                    break;
+                }
+            }
         }
-        0
+        let (pts, cut_prev, cut_next) = match found {
+            Some(x) => x,
+            // Nothing clear: the shortest direct curve (the plan's metrics will show it).
+            None => match transit::transit(from, h0, to, h, p.r_min, p.point_spacing, &clear) {
+                Some((pts, _)) => (pts, 0, 0),
+                None => return 0,
+            },
+        };
+        if cut_prev > 0 {
+            if let Some(last) = segments.last_mut() {
+                let keep = last.points.len() - cut_prev;
+                last.points.truncate(keep);
+            }
+        }
+        push(
+            segments,
+            SegmentKind::Transit,
+            Direction::Forward,
+            cell,
+            pts,
+        );
+        cut_next
     };
 
     for ring in headland::headland_tracks(&field.boundary, p) {
