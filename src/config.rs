@@ -436,6 +436,100 @@ impl Default for ProgressConfig {
     }
 }
 
+/// How `[field]` chooses the swath direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SwathAngleChoice {
+    /// Minimum span of the convex hull.
+    MinSpan,
+    /// Fewest turns over the cells.
+    MinTurns,
+    /// `field.swath_angle_deg`.
+    Fixed,
+}
+
+/// Where `[field]` takes the local ENU origin from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FieldOrigin {
+    /// Centre of the boundary's lat/lon bounding box.
+    Auto,
+    /// `job.origin_lat_deg` / `job.origin_lon_deg`.
+    Config,
+}
+
+/// `[field]`: field coverage planning (`agsteer plan`). Width from `job.line_width_m`, r_min
+/// from `vehicle.r_min_m`, point spacing from `guidance.point_spacing_m`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FieldConfig {
+    /// Headland passes around the boundary, each `job.line_width_m` wide.
+    pub headland_passes: usize,
+    /// Swath direction objective: "min_span", "min_turns" or "fixed".
+    pub swath_angle: SwathAngleChoice,
+    /// Swath direction for `swath_angle = "fixed"`, degrees CCW from East.
+    pub swath_angle_deg: f64,
+    /// Swath order in a cell: "auto", "sequential" or "skip".
+    pub route: crate::plan::coverage::RouteOrder,
+    /// Obstacles at most this wide across the swaths get a detour; larger ones split cells, m.
+    pub small_obstacle_max_m: f64,
+    /// Boundary clean-up tolerance (largest distance of a dropped point), m; 0 = no fitting.
+    pub boundary_tolerance_m: f64,
+    /// ENU origin: "auto" (boundary bounding-box centre) or "config" (job.origin_*).
+    pub origin: FieldOrigin,
+}
+
+impl Default for FieldConfig {
+    fn default() -> Self {
+        FieldConfig {
+            headland_passes: 2,
+            swath_angle: SwathAngleChoice::MinSpan,
+            swath_angle_deg: 0.0,
+            route: crate::plan::coverage::RouteOrder::Auto,
+            small_obstacle_max_m: 12.0,
+            boundary_tolerance_m: 0.1,
+            origin: FieldOrigin::Auto,
+        }
+    }
+}
+
+impl Config {
+    /// Coverage planner parameters from `[field]`, `job`, `vehicle` and `guidance`.
+    pub fn coverage_params(&self) -> crate::plan::coverage::CoverageParams {
+        use crate::plan::coverage::{CoverageParams, SwathAngle};
+        let f = &self.field;
+        CoverageParams {
+            line_width: self.job.line_width_m,
+            r_min: self.vehicle.r_min_m,
+            headland_passes: f.headland_passes,
+            point_spacing: self.guidance.point_spacing_m,
+            swath_angle: match f.swath_angle {
+                SwathAngleChoice::MinSpan => SwathAngle::MinSpan,
+                SwathAngleChoice::MinTurns => SwathAngle::MinTurns,
+                SwathAngleChoice::Fixed => SwathAngle::Fixed {
+                    angle: f.swath_angle_deg.to_radians(),
+                },
+            },
+            route: f.route,
+            small_obstacle_max_m: f.small_obstacle_max_m,
+        }
+    }
+
+    /// Field loading options from `[field]` (and `job.origin_*` when `field.origin = "config"`).
+    pub fn field_load_options(&self) -> crate::field::LoadOptions {
+        crate::field::LoadOptions {
+            origin: match self.field.origin {
+                FieldOrigin::Auto => None,
+                FieldOrigin::Config => Some(crate::geo::wgs84::LatLon {
+                    lat_deg: self.job.origin_lat_deg,
+                    lon_deg: self.job.origin_lon_deg,
+                }),
+            },
+            boundary_tolerance_m: self.field.boundary_tolerance_m,
+        }
+    }
+}
+
 /// The whole configuration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
@@ -450,6 +544,7 @@ pub struct Config {
     pub bus: BusConfig,
     pub safety: SafetyConfig,
     pub daemon: DaemonConfig,
+    pub field: FieldConfig,
 }
 
 /// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
@@ -590,6 +685,17 @@ impl Config {
         }
         c.range("job.origin_lat_deg", j.origin_lat_deg, -89.0, 89.0);
         c.range("job.origin_lon_deg", j.origin_lon_deg, -180.0, 180.0);
+        let fc = &self.field;
+        if fc.headland_passes > 50 {
+            c.push(
+                "field.headland_passes",
+                fc.headland_passes.to_string(),
+                "must be in 0..=50",
+            );
+        }
+        c.range("field.swath_angle_deg", fc.swath_angle_deg, -360.0, 360.0);
+        c.range("field.small_obstacle_max_m", fc.small_obstacle_max_m, 0.0, 1000.0);
+        c.range("field.boundary_tolerance_m", fc.boundary_tolerance_m, 0.0, 10.0);
 
         let g = &self.guidance;
         if g.a < 1 {
@@ -978,6 +1084,23 @@ mod tests {
             Config::parse_with("[job]\nline_width_m = 4.0\n[vehicle]\nr_min_m = 6.0\n", &[])
                 .unwrap();
         assert_eq!(a.fixed_key_changes(&moved), vec!["job", "vehicle.r_min_m"]);
+    }
+
+    #[test]
+    fn field_section_parses_validates_and_builds_params() {
+        let cfg = Config::parse_with(
+            "[field]\nswath_angle = \"fixed\"\nswath_angle_deg = 90\nroute = \"skip\"\norigin = \"config\"\n",
+            &[],
+        )
+        .unwrap();
+        let p = cfg.coverage_params();
+        assert!(matches!(p.swath_angle, crate::plan::coverage::SwathAngle::Fixed { angle } if (angle - std::f64::consts::FRAC_PI_2).abs() < 1e-12));
+        assert_eq!(p.route, crate::plan::coverage::RouteOrder::Skip);
+        assert_eq!(p.line_width, cfg.job.line_width_m);
+        assert_eq!(cfg.field_load_options().origin.map(|o| o.lat_deg), Some(cfg.job.origin_lat_deg));
+        let bad = Config::parse_with("[field]\nboundary_tolerance_m = -1\n", &[]).unwrap();
+        assert!(bad.validate().iter().any(|p| p.key == "field.boundary_tolerance_m"));
+        assert!(Config::parse_with("[field]\nswath_angle = \"diagonal\"\n", &[]).is_err());
     }
 
     #[test]

@@ -2,3 +2,325 @@
 //! [`Field`](crate::plan::coverage::Field), with an ENU origin and boundary clean-up.
 //!
 //! Parsing works on strings; reading files is the binaries' job.
+//!
+//! - GeoJSON: a FeatureCollection, a Feature or a bare Polygon/MultiPolygon geometry, in
+//!   WGS-84 (`[lon, lat]`). Exactly one boundary polygon; its holes become obstacles, and so do
+//!   Features with the property `"obstacle": true`.
+//! - ISO 11783-10 `TASKDATA.XML`: the first `PFD` (partfield) with a `PLN` of type `A="1"`
+//!   (partfield boundary). Its `LSG A="1"` is the exterior, `LSG A="2"` rings are obstacles;
+//!   `PLN`s of type 3 (water), 4 (building), 6 (obstacle) and 12 (windbreak) are obstacles too.
+//!   Other polygon types (treatment zone, road, flag, headland, …) are ignored.
+//!
+//! Every ring is cleaned ([`clean_ring`]): closing and duplicate points dropped, collinear
+//! points dropped, stretches of many short edges (arcs) replaced by straight segments fitted by
+//! line regression (seed 001) within `boundary_tolerance_m`, orientation made CCW. The area
+//! change is reported in [`CleanupReport`].
+
+mod clean;
+pub mod output;
+mod geojson;
+mod taskdata;
+
+pub use clean::{clean_ring, RingCleanup};
+
+use crate::geo::polygon::{contains_point, segments_intersect, signed_area};
+use crate::geo::wgs84::{EnuFrame, LatLon};
+use crate::geo::Vec2;
+use crate::plan::coverage::Field;
+use serde::Serialize;
+
+/// Options for loading a field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadOptions {
+    /// ENU origin; `None` = the centre of the boundary's lat/lon bounding box.
+    pub origin: Option<LatLon>,
+    /// Largest distance of a dropped boundary point from the cleaned boundary, m.
+    pub boundary_tolerance_m: f64,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        Self {
+            origin: None,
+            boundary_tolerance_m: 0.1,
+        }
+    }
+}
+
+/// What boundary clean-up did, over all rings (boundary and obstacles).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct CleanupReport {
+    /// Field area (boundary minus obstacles) before clean-up, m².
+    pub area_before_m2: f64,
+    /// Field area after clean-up, m².
+    pub area_after_m2: f64,
+    /// |after − before|, m².
+    pub area_error_m2: f64,
+    /// Area error as a percentage of the area before.
+    pub area_error_pct: f64,
+    /// Boundary tolerance used, m.
+    pub tolerance_m: f64,
+    pub vertices_before: usize,
+    pub vertices_after: usize,
+    /// Repeated (and closing) points dropped.
+    pub duplicates_removed: usize,
+    /// Points dropped because they lay on a straight line with their neighbours.
+    pub collinear_removed: usize,
+    /// Points dropped by fitting straight segments to stretches of short edges.
+    pub fitted_removed: usize,
+    /// Rings whose orientation was reversed.
+    pub rings_reoriented: usize,
+}
+
+/// A field read from a file's text: local geometry, its origin and the clean-up report.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadedField {
+    /// Name from the input (GeoJSON `name` property, TASKDATA PFD designator), if any.
+    pub name: Option<String>,
+    /// The ENU origin of `field`.
+    pub origin: LatLon,
+    pub field: Field,
+    pub cleanup: CleanupReport,
+}
+
+impl LoadedField {
+    /// The ENU frame of this field.
+    pub fn frame(&self) -> EnuFrame {
+        EnuFrame::new(self.origin)
+    }
+}
+
+/// Why a field could not be read. `feature` names the offending input element (index and
+/// name/id when present).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FieldError {
+    #[error("not valid JSON: {0}")]
+    Json(String),
+    #[error("not valid XML: {0}")]
+    Xml(String),
+    #[error("input is neither GeoJSON (starts with '{{') nor TASKDATA XML (starts with '<')")]
+    UnknownFormat,
+    #[error("{feature}: not a polygon ({detail})")]
+    NotAPolygon { feature: String, detail: String },
+    #[error("{feature}: bad coordinates ({detail})")]
+    BadCoordinates { feature: String, detail: String },
+    #[error("{feature}: {ring} has {points} distinct points, at least 3 needed")]
+    TooFewPoints {
+        feature: String,
+        ring: String,
+        points: usize,
+    },
+    #[error("{feature}: {ring} intersects itself (edges {edge_a} and {edge_b})")]
+    SelfIntersection {
+        feature: String,
+        ring: String,
+        edge_a: usize,
+        edge_b: usize,
+    },
+    #[error("{feature}: obstacle is not inside the field boundary")]
+    ObstacleOutside { feature: String },
+    #[error("no field boundary polygon found")]
+    NoBoundary,
+    #[error("{count} boundary polygons found ({features}); exactly one field boundary is supported (mark the others \"obstacle\": true or split the file)")]
+    SeveralBoundaries { count: usize, features: String },
+}
+
+/// A polygon as read, before projection: exterior plus holes in lat/lon, with a label for
+/// error messages.
+#[derive(Debug, Clone)]
+pub(crate) struct RawPolygon {
+    pub label: String,
+    pub exterior: Vec<LatLon>,
+    pub holes: Vec<Vec<LatLon>>,
+}
+
+/// Load a field from GeoJSON or TASKDATA text, chosen by the first non-blank character.
+pub fn load_field(text: &str, options: &LoadOptions) -> Result<LoadedField, FieldError> {
+    match text.trim_start().chars().next() {
+        Some('{') => load_geojson(text, options),
+        Some('<') => load_taskdata(text, options),
+        _ => Err(FieldError::UnknownFormat),
+    }
+}
+
+/// Load a field from GeoJSON text (see the module docs).
+pub fn load_geojson(text: &str, options: &LoadOptions) -> Result<LoadedField, FieldError> {
+    let parsed = geojson::parse(text)?;
+    assemble(parsed.name, parsed.boundaries, parsed.obstacles, options)
+}
+
+/// Load a field from ISO 11783-10 TASKDATA.XML text (see the module docs).
+pub fn load_taskdata(text: &str, options: &LoadOptions) -> Result<LoadedField, FieldError> {
+    let parsed = taskdata::parse(text)?;
+    assemble(parsed.name, parsed.boundaries, parsed.obstacles, options)
+}
+
+pub(crate) struct Parsed {
+    pub name: Option<String>,
+    pub boundaries: Vec<RawPolygon>,
+    pub obstacles: Vec<RawPolygon>,
+}
+
+pub(crate) fn check_coordinate(feature: &str, lat: f64, lon: f64) -> Result<LatLon, FieldError> {
+    if !lat.is_finite() || !lon.is_finite() || lat.abs() > 90.0 || lon.abs() > 180.0 {
+        return Err(FieldError::BadCoordinates {
+            feature: feature.to_string(),
+            detail: format!("lat {lat}, lon {lon} out of range"),
+        });
+    }
+    Ok(LatLon {
+        lat_deg: lat,
+        lon_deg: lon,
+    })
+}
+
+fn bbox_centre(ring: &[LatLon]) -> LatLon {
+    let (mut lat0, mut lat1, mut lon0, mut lon1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in ring {
+        lat0 = lat0.min(p.lat_deg);
+        lat1 = lat1.max(p.lat_deg);
+        lon0 = lon0.min(p.lon_deg);
+        lon1 = lon1.max(p.lon_deg);
+    }
+    LatLon {
+        lat_deg: 0.5 * (lat0 + lat1),
+        lon_deg: 0.5 * (lon0 + lon1),
+    }
+}
+
+struct Accum {
+    report: CleanupReport,
+}
+
+impl Accum {
+    fn ring(
+        &mut self,
+        frame: &EnuFrame,
+        ring: &[LatLon],
+        feature: &str,
+        ring_name: &str,
+        tolerance: f64,
+    ) -> Result<(Vec<Vec2>, f64, f64), FieldError> {
+        let local: Vec<Vec2> = ring.iter().map(|p| frame.to_enu(*p)).collect();
+        let cleaned = clean_ring(&local, tolerance);
+        let r = &mut self.report;
+        r.vertices_before += local.len();
+        r.duplicates_removed += cleaned.duplicates_removed;
+        if cleaned.ring.len() < 3 || cleaned.area_before_m2 < 1e-9 {
+            return Err(FieldError::TooFewPoints {
+                feature: feature.to_string(),
+                ring: ring_name.to_string(),
+                points: cleaned.distinct_points,
+            });
+        }
+        if let Some((a, b)) = cleaned.self_intersection {
+            return Err(FieldError::SelfIntersection {
+                feature: feature.to_string(),
+                ring: ring_name.to_string(),
+                edge_a: a,
+                edge_b: b,
+            });
+        }
+        r.vertices_after += cleaned.ring.len();
+        r.collinear_removed += cleaned.collinear_removed;
+        r.fitted_removed += cleaned.fitted_removed;
+        r.rings_reoriented += usize::from(cleaned.reoriented);
+        Ok((cleaned.ring, cleaned.area_before_m2, cleaned.area_after_m2))
+    }
+}
+
+/// Whether ring `inner` lies inside ring `outer` (all vertices inside, no edges crossing).
+fn ring_inside(inner: &[Vec2], outer: &[Vec2]) -> bool {
+    if !inner.iter().all(|p| contains_point(outer, p)) {
+        return false;
+    }
+    let n = inner.len();
+    let m = outer.len();
+    for i in 0..n {
+        for j in 0..m {
+            if segments_intersect(&inner[i], &inner[(i + 1) % n], &outer[j], &outer[(j + 1) % m]) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+fn assemble(
+    name: Option<String>,
+    boundaries: Vec<RawPolygon>,
+    mut obstacles: Vec<RawPolygon>,
+    options: &LoadOptions,
+) -> Result<LoadedField, FieldError> {
+    let boundary = match boundaries.len() {
+        0 => return Err(FieldError::NoBoundary),
+        1 => boundaries.into_iter().next().ok_or(FieldError::NoBoundary)?,
+        count => {
+            return Err(FieldError::SeveralBoundaries {
+                count,
+                features: boundaries
+                    .iter()
+                    .map(|b| b.label.clone())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+        }
+    };
+    let origin = options
+        .origin
+        .unwrap_or_else(|| bbox_centre(&boundary.exterior));
+    let frame = EnuFrame::new(origin);
+    let tol = options.boundary_tolerance_m.max(0.0);
+    let mut acc = Accum {
+        report: CleanupReport {
+            tolerance_m: tol,
+            ..Default::default()
+        },
+    };
+    let (outer, a_before, a_after) =
+        acc.ring(&frame, &boundary.exterior, &boundary.label, "exterior ring", tol)?;
+    let (mut area_before, mut area_after) = (a_before, a_after);
+    // Holes of the boundary become obstacles, labelled after the boundary feature.
+    for (k, hole) in boundary.holes.iter().enumerate() {
+        obstacles.push(RawPolygon {
+            label: format!("{} (hole {k})", boundary.label),
+            exterior: hole.clone(),
+            holes: Vec::new(),
+        });
+    }
+    let mut field_obstacles = Vec::new();
+    for obstacle in &obstacles {
+        let (ring, before, after) =
+            acc.ring(&frame, &obstacle.exterior, &obstacle.label, "exterior ring", tol)?;
+        if !ring_inside(&ring, &outer) {
+            return Err(FieldError::ObstacleOutside {
+                feature: obstacle.label.clone(),
+            });
+        }
+        area_before -= before;
+        area_after -= after;
+        field_obstacles.push(ring);
+    }
+    let mut report = acc.report;
+    report.area_before_m2 = area_before;
+    report.area_after_m2 = area_after;
+    report.area_error_m2 = (area_after - area_before).abs();
+    report.area_error_pct = if area_before > 0.0 {
+        100.0 * report.area_error_m2 / area_before
+    } else {
+        0.0
+    };
+    debug_assert!(signed_area(&outer) > 0.0);
+    Ok(LoadedField {
+        name,
+        origin,
+        field: Field {
+            boundary: outer,
+            obstacles: field_obstacles,
+        },
+        cleanup: report,
+    })
+}
+
+#[cfg(test)]
+mod tests;

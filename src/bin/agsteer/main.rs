@@ -1,6 +1,7 @@
 //! `agsteer`: the technician's and developer's tool.
 
 mod dbc_cmd;
+mod plan_cmd;
 mod sim_cmd;
 
 use agsteer::config::Config;
@@ -91,6 +92,24 @@ enum Command {
         #[command(subcommand)]
         cmd: dbc_cmd::DbcCommand,
     },
+    /// Plan coverage of a field (GeoJSON or ISO 11783-10 TASKDATA.XML): writes OUT/plan.geojson,
+    /// OUT/plan.svg and OUT/metrics.json.
+    Plan {
+        /// Field boundary: GeoJSON (WGS-84) or TASKDATA.XML.
+        #[arg(long)]
+        field: PathBuf,
+        /// Configuration file ([field], job.line_width_m, vehicle.r_min_m, guidance.point_spacing_m).
+        #[arg(long, default_value = "config/demo.toml")]
+        config: PathBuf,
+        /// Output directory.
+        #[arg(long, default_value = "out/plan")]
+        out: PathBuf,
+        /// Print the metrics JSON on stdout.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    },
     /// Validate a configuration: print it resolved, or every problem (exit status 2).
     CheckConfig {
         /// Configuration file.
@@ -123,6 +142,13 @@ fn main() -> ExitCode {
             cfg,
         } => run_demo(&config, &out, json, resume, stop_after, &cfg.set),
         Command::CheckConfig { file, cfg } => check_config(&file, &cfg.set),
+        Command::Plan {
+            field,
+            config,
+            out,
+            json,
+            cfg,
+        } => load_config(&config, &cfg.set).and_then(|c| run_plan(&field, &c, &out, json)),
         Command::Dbc { cmd } => dbc_cmd::run(cmd),
         Command::Sim {
             iface,
@@ -158,6 +184,10 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+fn run_plan(field: &Path, cfg: &Config, out: &Path, json: bool) -> Result<u8> {
+    plan_cmd::run(field, cfg, out, json, agsteer::plan::coverage::plan_field)
 }
 
 fn load_config(path: &Path, set: &[String]) -> Result<Config> {

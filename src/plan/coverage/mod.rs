@@ -8,6 +8,7 @@
 pub mod decompose;
 pub mod geometry;
 pub mod headland;
+pub mod metrics;
 pub mod swath_angle;
 pub mod swaths;
 pub mod transit;

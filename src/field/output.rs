@@ -1,0 +1,296 @@
+//! Plan writers (pure, return strings): `plan.geojson` in WGS-84 and `plan.svg`.
+
+use crate::demo::svg::SvgCanvas;
+use crate::geo::wgs84::{EnuFrame, LatLon};
+use crate::geo::{Direction, Vec2};
+use crate::plan::coverage::metrics::PlanMetrics;
+use crate::plan::coverage::{Field, FieldPlan, SegmentKind};
+use serde_json::{json, Value};
+
+fn kind_name(k: SegmentKind) -> &'static str {
+    match k {
+        SegmentKind::Work => "work",
+        SegmentKind::Turn => "turn",
+        SegmentKind::Headland => "headland",
+        SegmentKind::Detour => "detour",
+        SegmentKind::Transit => "transit",
+    }
+}
+
+fn direction_name(d: Direction) -> &'static str {
+    match d {
+        Direction::Forward => "forward",
+        Direction::Reverse => "reverse",
+    }
+}
+
+/// Colour of a segment kind in the SVG.
+pub fn kind_colour(k: SegmentKind) -> &'static str {
+    match k {
+        SegmentKind::Work => "#1a9850",
+        SegmentKind::Turn => "#4575b4",
+        SegmentKind::Headland => "#984ea3",
+        SegmentKind::Detour => "#f46d43",
+        SegmentKind::Transit => "#999999",
+    }
+}
+
+fn position(frame: &EnuFrame, p: &Vec2) -> Value {
+    let ll = frame.to_latlon(*p);
+    let r = |v: f64| (v * 1e9).round() / 1e9;
+    json!([r(ll.lon_deg), r(ll.lat_deg)])
+}
+
+fn ring(frame: &EnuFrame, pts: &[Vec2]) -> Value {
+    let mut v: Vec<Value> = pts.iter().map(|p| position(frame, p)).collect();
+    if let Some(first) = v.first().cloned() {
+        v.push(first);
+    }
+    Value::Array(v)
+}
+
+fn polygon_feature(frame: &EnuFrame, outer: &[Vec2], holes: &[Vec<Vec2>], props: Value) -> Value {
+    let mut rings = vec![ring(frame, outer)];
+    rings.extend(holes.iter().map(|h| {
+        // RFC 7946: holes clockwise.
+        let mut h = h.clone();
+        h.reverse();
+        ring(frame, &h)
+    }));
+    json!({"type": "Feature", "properties": props,
+           "geometry": {"type": "Polygon", "coordinates": rings}})
+}
+
+/// `plan.geojson`: a FeatureCollection in WGS-84 holding the field (`role` "field", with the
+/// ENU origin), obstacles, working area and headland polygons, then every plan segment as a
+/// LineString in driving order with `kind`, `direction`, `index` and `cell`. The origin is
+/// also a top-level member `origin`.
+pub fn plan_geojson(
+    field: &Field,
+    plan: &FieldPlan,
+    origin: LatLon,
+    metrics: Option<&PlanMetrics>,
+) -> String {
+    let frame = EnuFrame::new(origin);
+    let origin_json = json!({"lat_deg": origin.lat_deg, "lon_deg": origin.lon_deg});
+    let mut features = vec![polygon_feature(
+        &frame,
+        &field.boundary,
+        &field.obstacles,
+        json!({"role": "field", "origin": origin_json}),
+    )];
+    for (i, o) in field.obstacles.iter().enumerate() {
+        features.push(polygon_feature(
+            &frame,
+            o,
+            &[],
+            json!({"role": "obstacle", "obstacle": true, "index": i}),
+        ));
+    }
+    for (i, (outer, holes)) in plan.working_area.iter().enumerate() {
+        features.push(polygon_feature(
+            &frame,
+            outer,
+            holes,
+            json!({"role": "working_area", "index": i}),
+        ));
+    }
+    if !plan.headland_inner.is_empty() {
+        features.push(polygon_feature(
+            &frame,
+            &field.boundary,
+            &plan.headland_inner,
+            json!({"role": "headland_area"}),
+        ));
+    }
+    for s in &plan.segments {
+        let coords: Vec<Value> = s.points.iter().map(|p| position(&frame, p)).collect();
+        features.push(json!({
+            "type": "Feature",
+            "properties": {"kind": kind_name(s.kind), "direction": direction_name(s.direction),
+                           "index": s.index, "cell": s.cell},
+            "geometry": {"type": "LineString", "coordinates": coords},
+        }));
+    }
+    let mut doc = json!({"type": "FeatureCollection", "origin": origin_json, "features": features});
+    if let (Some(m), Some(obj)) = (metrics, doc.as_object_mut()) {
+        obj.insert("metrics".into(), json!(m));
+    }
+    serde_json::to_string_pretty(&doc).unwrap_or_default()
+}
+
+/// `plan.svg`: field, obstacles, headland area, working area, segments coloured by kind with
+/// their driving-order index at each segment start and an arrow dot at each work segment's
+/// end, a legend, key figures, a scale bar and a north arrow.
+pub fn plan_svg(
+    field: &Field,
+    plan: &FieldPlan,
+    origin: LatLon,
+    metrics: Option<&PlanMetrics>,
+    title: &str,
+) -> String {
+    let extent = field
+        .boundary
+        .iter()
+        .chain(plan.segments.iter().flat_map(|s| s.points.iter()));
+    let mut c = SvgCanvas::fit(extent, 1000.0);
+    c.polygon(
+        &field.boundary,
+        r##"fill="#f3efe0" stroke="#333" stroke-width="1.5""##,
+    );
+    for (outer, holes) in &plan.working_area {
+        c.polygon(outer, r##"fill="#e3f1dc" stroke="#7a7" stroke-width="0.8""##);
+        for h in holes {
+            c.polygon(h, r##"fill="#f3efe0" stroke="#7a7" stroke-width="0.8""##);
+        }
+    }
+    for o in &field.obstacles {
+        c.polygon(o, r##"fill="#8c6d46" stroke="#333" stroke-width="1""##);
+    }
+    let label_every = (plan.segments.len() / 150).max(1);
+    for s in &plan.segments {
+        let style = match s.kind {
+            SegmentKind::Transit | SegmentKind::Turn => format!(
+                r#"stroke="{}" stroke-width="1.2" stroke-dasharray="4 2""#,
+                kind_colour(s.kind)
+            ),
+            _ => format!(r#"stroke="{}" stroke-width="1.5""#, kind_colour(s.kind)),
+        };
+        c.polyline(&s.points, &style);
+        if matches!(s.kind, SegmentKind::Work | SegmentKind::Headland) {
+            if let Some(end) = s.points.last() {
+                c.dot(end, 2.0, "#000");
+            }
+            if s.index % label_every == 0 {
+                if let Some(start) = s.points.first() {
+                    c.label(start, &s.index.to_string(), 9.0);
+                }
+            }
+        }
+    }
+    let kinds = [
+        SegmentKind::Work,
+        SegmentKind::Headland,
+        SegmentKind::Turn,
+        SegmentKind::Detour,
+        SegmentKind::Transit,
+    ];
+    for (i, k) in kinds.iter().enumerate() {
+        c.footer_swatch(10.0 + 110.0 * i as f64, 20.0, kind_colour(*k), kind_name(*k));
+    }
+    c.footer_text(
+        10.0,
+        42.0,
+        "numbers: driving order at segment start; black dot: segment end",
+        11.0,
+        "#444",
+    );
+    let figures = match metrics {
+        Some(m) => format!(
+            "{} cells, {} swaths, covered {:.2} % (field {:.2} %), overlap {:.2} %, outside {:.3} m², total {:.0} m; origin {:.7}°, {:.7}°",
+            plan.cells,
+            plan.swaths,
+            100.0 * m.covered_fraction,
+            100.0 * m.field_covered_fraction,
+            100.0 * m.overlap_fraction,
+            m.outside_area_m2,
+            m.total_length_m,
+            origin.lat_deg,
+            origin.lon_deg
+        ),
+        None => format!(
+            "{} cells, {} swaths; origin {:.7}°, {:.7}°",
+            plan.cells, plan.swaths, origin.lat_deg, origin.lon_deg
+        ),
+    };
+    c.footer_text(10.0, 62.0, &figures, 12.0, "#000");
+    c.scale_bar_and_north();
+    c.finish(title)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::{load_geojson, LoadOptions};
+    use crate::geo::v2;
+    use crate::plan::coverage::PlanSegment;
+
+    fn sample() -> (Field, FieldPlan, LatLon) {
+        let origin = LatLon {
+            lat_deg: 52.0,
+            lon_deg: 5.0,
+        };
+        let field = Field {
+            boundary: vec![v2(0.0, 0.0), v2(100.0, 0.0), v2(100.0, 50.0), v2(0.0, 50.0)],
+            obstacles: vec![vec![v2(40.0, 20.0), v2(50.0, 20.0), v2(50.0, 30.0)]],
+        };
+        let seg = |kind, index, direction, pts: Vec<Vec2>| PlanSegment {
+            kind,
+            direction,
+            index,
+            cell: 0,
+            points: pts,
+        };
+        let plan = FieldPlan {
+            segments: vec![
+                seg(SegmentKind::Work, 0, Direction::Forward, vec![v2(5.0, 5.0), v2(95.0, 5.0)]),
+                seg(SegmentKind::Turn, 1, Direction::Reverse, vec![v2(95.0, 5.0), v2(95.0, 15.0)]),
+            ],
+            working_area: vec![(field.boundary.clone(), vec![])],
+            headland_inner: vec![],
+            cells: 1,
+            swath_angles: vec![0.0],
+            swaths: 1,
+            ..FieldPlan::default()
+        };
+        (field, plan, origin)
+    }
+
+    #[test]
+    fn geojson_round_trips_segments_and_origin() {
+        let (field, plan, origin) = sample();
+        let text = plan_geojson(&field, &plan, origin, None);
+        let doc: Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(doc["origin"]["lat_deg"], 52.0);
+        let feats = doc["features"].as_array().unwrap();
+        let lines: Vec<&Value> = feats
+            .iter()
+            .filter(|f| f["geometry"]["type"] == "LineString")
+            .collect();
+        assert_eq!(lines.len(), 2);
+        assert_eq!(lines[1]["properties"]["kind"], "turn");
+        assert_eq!(lines[1]["properties"]["direction"], "reverse");
+        assert_eq!(lines[1]["properties"]["index"], 1);
+        // Back to ENU: the first work point is where it was (0.1 mm rounding).
+        let frame = EnuFrame::new(origin);
+        let c = &lines[0]["geometry"]["coordinates"][0];
+        let p = frame.to_enu(LatLon {
+            lat_deg: c[1].as_f64().unwrap(),
+            lon_deg: c[0].as_f64().unwrap(),
+        });
+        assert!((p - v2(5.0, 5.0)).norm() < 1e-3);
+        // The field polygon (with the obstacle as a hole) reads back as the same field.
+        let field_only = json!({"type": "FeatureCollection", "features": [feats[0].clone()]});
+        let back = load_geojson(
+            &field_only.to_string(),
+            &LoadOptions {
+                origin: Some(origin),
+                boundary_tolerance_m: 0.0,
+            },
+        )
+        .unwrap();
+        assert_eq!(back.field.obstacles.len(), 1);
+        assert!((back.cleanup.area_after_m2 - (5000.0 - 50.0)).abs() < 0.01);
+    }
+
+    #[test]
+    fn svg_has_every_kind_colour_and_labels() {
+        let (field, plan, origin) = sample();
+        let svg = plan_svg(&field, &plan, origin, None, "t");
+        assert!(svg.starts_with("<svg"));
+        assert!(svg.contains(kind_colour(SegmentKind::Work)));
+        assert!(svg.contains(kind_colour(SegmentKind::Turn)));
+        assert!(svg.contains(">0</text>"));
+        assert!(svg.contains(" m</text>"));
+    }
+}

@@ -1,0 +1,135 @@
+use super::*;
+use crate::geo::{v2, Direction};
+
+fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
+    vec![v2(x0, y0), v2(x1, y0), v2(x1, y1), v2(x0, y1)]
+}
+
+fn seg(kind: SegmentKind, index: usize, points: Vec<Vec2>) -> PlanSegment {
+    PlanSegment {
+        kind,
+        direction: Direction::Forward,
+        index,
+        cell: 0,
+        points,
+    }
+}
+
+/// 100 × 60 m field, 10 m swaths at y = 5, 15, …, 55 sampled every metre, no headland.
+fn plan(swath_ys: &[f64]) -> (Field, FieldPlan) {
+    let field = Field {
+        boundary: rect(0.0, 0.0, 100.0, 60.0),
+        obstacles: Vec::new(),
+    };
+    let segments = swath_ys
+        .iter()
+        .enumerate()
+        .map(|(i, &y)| {
+            let pts = (0..=100).map(|k| v2(k as f64, y)).collect();
+            seg(SegmentKind::Work, i, pts)
+        })
+        .collect();
+    let plan = FieldPlan {
+        segments,
+        working_area: vec![(field.boundary.clone(), Vec::new())],
+        headland_inner: Vec::new(),
+        cells: 1,
+        swath_angles: vec![0.0],
+        swaths: swath_ys.len(),
+        ..FieldPlan::default()
+    };
+    (field, plan)
+}
+
+const YS: [f64; 6] = [5.0, 15.0, 25.0, 35.0, 45.0, 55.0];
+
+#[test]
+fn exact_cover_has_full_coverage_no_overlap_nothing_outside() {
+    let (field, p) = plan(&YS);
+    let m = plan_metrics(&field, &p, 10.0);
+    assert!((m.covered_fraction - 1.0).abs() < 1e-9, "{}", m.covered_fraction);
+    assert!((m.field_covered_fraction - 1.0).abs() < 1e-9);
+    assert!(m.overlap_fraction.abs() < 1e-9, "{}", m.overlap_fraction);
+    assert!(m.outside_area_m2 < 1e-6, "{}", m.outside_area_m2);
+    assert!((m.work_length_m - 600.0).abs() < 1e-9);
+    assert!(m.max_curvature < 1e-9);
+    assert_eq!(m.turns, 0);
+}
+
+#[test]
+fn missing_shifted_and_overlapping_swaths_are_measured() {
+    let (field, p) = plan(&YS[..5]);
+    let m = plan_metrics(&field, &p, 10.0);
+    assert!((m.covered_fraction - 5.0 / 6.0).abs() < 1e-9);
+
+    // Last swath moved to y = 60: half of it (100 × 5 m²) lies outside, 5 m strip uncovered.
+    let (field, p) = plan(&[5.0, 15.0, 25.0, 35.0, 45.0, 60.0]);
+    let m = plan_metrics(&field, &p, 10.0);
+    assert!((m.outside_area_m2 - 500.0).abs() < 1e-6, "{}", m.outside_area_m2);
+    assert!((m.covered_fraction - 55.0 / 60.0).abs() < 1e-9);
+
+    // Swath at y = 50 overlaps its neighbours at 45 and 55 by 5 m each over 100 m.
+    let (field, p) = plan(&[5.0, 15.0, 25.0, 35.0, 45.0, 50.0, 55.0]);
+    let m = plan_metrics(&field, &p, 10.0);
+    assert!((m.covered_fraction - 1.0).abs() < 1e-9);
+    let expected = 1000.0 / 6000.0;
+    assert!((m.overlap_fraction - expected).abs() < 1e-9, "{}", m.overlap_fraction);
+}
+
+#[test]
+fn turns_curvature_containment_and_obstacles() {
+    let (mut field, mut p) = plan(&YS);
+    // A semicircular turn of radius 5 m from (100, 5) to (100, 15), bulging east (outside).
+    let arc: Vec<Vec2> = (0..=36)
+        .map(|k| {
+            let a = -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * k as f64 / 36.0;
+            v2(100.0 + 5.0 * a.cos(), 10.0 + 5.0 * a.sin())
+        })
+        .collect();
+    p.segments.insert(1, seg(SegmentKind::Turn, 1, arc));
+    let m = plan_metrics(&field, &p, 10.0);
+    assert!((m.max_curvature - 0.2).abs() < 1e-6, "{}", m.max_curvature);
+    assert_eq!(m.turns, 1);
+    assert!(m.turn_points_outside >= 30, "{}", m.turn_points_outside);
+    // The turn's footprint: a half annulus of radii 0..10 m east of x = 100, minus the
+    // 16-gon shortfall: between 0.9 and 1.0 of π·10²/2.
+    let half_disc = std::f64::consts::PI * 100.0 / 2.0;
+    assert!(m.outside_area_m2 > 0.9 * half_disc && m.outside_area_m2 <= half_disc + 1e-6);
+
+    // An obstacle on the swath at y = 25; the planner's working area ignores it.
+    field.obstacles.push(rect(40.0, 28.0, 50.0, 32.0));
+    let m = plan_metrics(&field, &p, 10.0);
+    assert!(m.obstacle_intrusions > 0);
+    // The obstacle is 40 m² of field and working area; covered fractions exclude it.
+    assert!((m.working_area_m2 - (6000.0 - 40.0)).abs() < 1e-6);
+    assert!((m.covered_fraction - 1.0).abs() < 1e-9);
+    // Without the swath at y = 5, an obstacle at y 1..4 is ≥ 11 m from every path point.
+    let (f2, p2) = plan(&YS[1..]);
+    let f2 = Field {
+        obstacles: vec![rect(40.0, 1.0, 50.0, 4.0)],
+        ..f2
+    };
+    let m = plan_metrics(&f2, &p2, 10.0);
+    assert_eq!(m.obstacle_intrusions, 0);
+}
+
+#[test]
+fn reversals_count_direction_changes() {
+    let (field, mut p) = plan(&YS);
+    p.segments[2].direction = Direction::Reverse;
+    let m = plan_metrics(&field, &p, 10.0);
+    assert_eq!(m.reversals, 2);
+}
+
+#[test]
+fn three_point_curvature_of_circle_points() {
+    let r = 7.0;
+    let pts: Vec<Vec2> = (0..3)
+        .map(|k| {
+            let a = 0.3 * k as f64;
+            v2(r * a.cos(), r * a.sin())
+        })
+        .collect();
+    assert!((three_point_curvature(&pts[0], &pts[1], &pts[2]) - 1.0 / r).abs() < 1e-12);
+    assert_eq!(three_point_curvature(&v2(0.0, 0.0), &v2(1.0, 0.0), &v2(2.0, 0.0)), 0.0);
+}

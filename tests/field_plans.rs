@@ -1,0 +1,181 @@
+//! Every field in tools/fields: parse → (plan → independent metrics).
+//!
+//! Parsing checks, then end to end: plan every field and check it with independent geometry.
+//! Tolerances: `outside_area_m2 < 1e-6` m² (float noise of the polygon clipping), curvature
+//! ≤ 1/r_min · 1.02 + 1e-3 (three-point curvature on discretised arcs).
+
+use agsteer::field::{load_field, LoadOptions, LoadedField};
+use agsteer::geo::polygon::signed_area;
+use agsteer::geo::Vec2;
+use std::path::PathBuf;
+
+fn field_files() -> Vec<PathBuf> {
+    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/tools/fields"));
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("tools/fields exists")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let n = p.to_string_lossy().to_lowercase();
+            n.ends_with(".geojson") || n.ends_with(".xml")
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+fn load(path: &PathBuf) -> LoadedField {
+    let text = std::fs::read_to_string(path).expect("readable");
+    load_field(&text, &LoadOptions::default())
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+fn is_convex(ring: &[Vec2]) -> bool {
+    let n = ring.len();
+    (0..n).all(|i| {
+        let (a, b, c) = (ring[i], ring[(i + 1) % n], ring[(i + 2) % n]);
+        agsteer::geo::cross(&(b - a), &(c - b)) >= -1e-9
+    })
+}
+
+/// Direction (mod π) minimising the width of `ring` across it, by brute force over the
+/// directions of its edges (the optimum of a convex polygon is parallel to an edge).
+fn min_span_direction(ring: &[Vec2]) -> f64 {
+    let n = ring.len();
+    let mut best = (f64::INFINITY, 0.0);
+    for i in 0..n {
+        let d = (ring[(i + 1) % n] - ring[i]).normalize();
+        let normal = Vec2::new(-d.y, d.x);
+        let proj: Vec<f64> = ring.iter().map(|p| p.dot(&normal)).collect();
+        let span = proj.iter().cloned().fold(f64::MIN, f64::max)
+            - proj.iter().cloned().fold(f64::MAX, f64::min);
+        if span < best.0 - 1e-9 {
+            best = (span, d.y.atan2(d.x).rem_euclid(std::f64::consts::PI));
+        }
+    }
+    best.1
+}
+
+#[test]
+fn there_are_enough_fields() {
+    let files = field_files();
+    assert!(files.len() >= 8, "{files:?}");
+    assert!(files.iter().any(|f| f.to_string_lossy().ends_with(".XML")));
+}
+
+#[test]
+fn every_field_parses_with_a_small_reported_clean_up_error() {
+    for path in field_files() {
+        let f = load(&path);
+        let c = &f.cleanup;
+        assert!(signed_area(&f.field.boundary) > 0.0, "{}", path.display());
+        assert!(
+            c.area_error_pct < 0.05,
+            "{}: clean-up area error {} %",
+            path.display(),
+            c.area_error_pct
+        );
+        assert!((c.area_after_m2 - c.area_before_m2).abs() <= c.area_error_m2 + 1e-6);
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        match name.as_str() {
+            "irregular_100ha.geojson" => {
+                assert_eq!(f.field.obstacles.len(), 2);
+                let outer = signed_area(&f.field.boundary);
+                assert!((outer - 1.0e6).abs() < 500.0, "{outer}");
+            }
+            "large_1000ha.geojson" => {
+                assert!((signed_area(&f.field.boundary) - 1.0e7).abs() < 5000.0);
+            }
+            "curved_edge.geojson" => {
+                assert!(c.fitted_removed > 100, "{c:?}");
+                assert!(f.field.boundary.len() < 40);
+            }
+            "pentagon_TASKDATA.XML" => {
+                assert_eq!(f.name.as_deref(), Some("pentagon"));
+                assert_eq!(f.field.obstacles.len(), 2);
+            }
+            _ => {}
+        }
+    }
+}
+
+#[test]
+fn min_span_brute_force_is_sane_on_a_rectangle() {
+    let r = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(400.0, 0.0),
+        Vec2::new(400.0, 250.0),
+        Vec2::new(0.0, 250.0),
+    ];
+    assert!(min_span_direction(&r).abs() < 1e-12);
+    assert!(is_convex(&r));
+}
+
+mod end_to_end {
+    use super::*;
+    use agsteer::config::Config;
+    use agsteer::geo::polygon::contains_point;
+    use agsteer::plan::coverage::metrics::plan_metrics;
+    use agsteer::plan::coverage::{plan_field, SegmentKind};
+
+    #[test]
+    fn every_field_is_covered_inside_the_boundary_and_clear_of_obstacles() {
+        let cfg = Config::default();
+        let mut params = cfg.coverage_params();
+        params.line_width = 6.0;
+        params.r_min = 5.0;
+        let mut failures = Vec::new();
+        for path in field_files() {
+            let name = path.display().to_string();
+            if name.contains("1000ha") {
+                continue; // scaling benchmark only
+            }
+            let f = load(&path);
+            let plan =
+                plan_field(&f.field, &params).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let m = plan_metrics(&f.field, &plan, params.line_width);
+            eprintln!(
+                "{name}: covered {:.5} outside {:.3e} m² intrusions {} turn points outside {} \
+                 max curvature {:.4}",
+                m.covered_fraction,
+                m.outside_area_m2,
+                m.obstacle_intrusions,
+                m.turn_points_outside,
+                m.max_curvature
+            );
+            let mut fail = |what: String| failures.push(format!("{name}: {what}"));
+            if m.covered_fraction < 0.995 {
+                fail(format!("covered {}", m.covered_fraction));
+            }
+            if m.outside_area_m2 >= 1e-6 {
+                fail(format!("outside {} m²", m.outside_area_m2));
+            }
+            if m.obstacle_intrusions != 0 {
+                fail(format!("{} obstacle intrusions", m.obstacle_intrusions));
+            }
+            if m.turn_points_outside != 0 {
+                fail(format!("{} turn points outside", m.turn_points_outside));
+            }
+            for s in plan.segments.iter().filter(|s| s.kind == SegmentKind::Turn) {
+                if s.points.iter().any(|p| !contains_point(&f.field.boundary, p)) {
+                    fail(format!("turn {} leaves the boundary", s.index));
+                }
+            }
+            let limit = 1.02 / params.r_min + 1e-3;
+            if m.max_curvature > limit {
+                fail(format!("curvature {} > {limit}", m.max_curvature));
+            }
+            if is_convex(&f.field.boundary) {
+                let want = min_span_direction(&f.field.boundary);
+                for a in &plan.swath_angles {
+                    let got = a.rem_euclid(std::f64::consts::PI);
+                    let diff = (got - want).abs();
+                    let diff = diff.min(std::f64::consts::PI - diff);
+                    if diff >= 1e-3 {
+                        fail(format!("swath angle {got} vs min-span {want}"));
+                    }
+                }
+            }
+        }
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
+    }
+}
