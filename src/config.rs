@@ -694,8 +694,18 @@ impl Config {
             );
         }
         c.range("field.swath_angle_deg", fc.swath_angle_deg, -360.0, 360.0);
-        c.range("field.small_obstacle_max_m", fc.small_obstacle_max_m, 0.0, 1000.0);
-        c.range("field.boundary_tolerance_m", fc.boundary_tolerance_m, 0.0, 10.0);
+        c.range(
+            "field.small_obstacle_max_m",
+            fc.small_obstacle_max_m,
+            0.0,
+            1000.0,
+        );
+        c.range(
+            "field.boundary_tolerance_m",
+            fc.boundary_tolerance_m,
+            0.0,
+            10.0,
+        );
 
         let g = &self.guidance;
         if g.a < 1 {
@@ -1094,12 +1104,20 @@ mod tests {
         )
         .unwrap();
         let p = cfg.coverage_params();
-        assert!(matches!(p.swath_angle, crate::plan::coverage::SwathAngle::Fixed { angle } if (angle - std::f64::consts::FRAC_PI_2).abs() < 1e-12));
+        assert!(
+            matches!(p.swath_angle, crate::plan::coverage::SwathAngle::Fixed { angle } if (angle - std::f64::consts::FRAC_PI_2).abs() < 1e-12)
+        );
         assert_eq!(p.route, crate::plan::coverage::RouteOrder::Skip);
         assert_eq!(p.line_width, cfg.job.line_width_m);
-        assert_eq!(cfg.field_load_options().origin.map(|o| o.lat_deg), Some(cfg.job.origin_lat_deg));
+        assert_eq!(
+            cfg.field_load_options().origin.map(|o| o.lat_deg),
+            Some(cfg.job.origin_lat_deg)
+        );
         let bad = Config::parse_with("[field]\nboundary_tolerance_m = -1\n", &[]).unwrap();
-        assert!(bad.validate().iter().any(|p| p.key == "field.boundary_tolerance_m"));
+        assert!(bad
+            .validate()
+            .iter()
+            .any(|p| p.key == "field.boundary_tolerance_m"));
         assert!(Config::parse_with("[field]\nswath_angle = \"diagonal\"\n", &[]).is_err());
     }
 

@@ -25,8 +25,7 @@ fn field_files() -> Vec<PathBuf> {
 
 fn load(path: &PathBuf) -> LoadedField {
     let text = std::fs::read_to_string(path).expect("readable");
-    load_field(&text, &LoadOptions::default())
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    load_field(&text, &LoadOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 fn is_convex(ring: &[Vec2]) -> bool {
@@ -120,58 +119,65 @@ mod end_to_end {
     #[test]
     fn every_field_is_covered_inside_the_boundary_and_clear_of_obstacles() {
         let cfg = Config::default();
-        let mut params = cfg.coverage_params();
-        params.line_width = 6.0;
-        params.r_min = 5.0;
         let mut failures = Vec::new();
-        for path in field_files() {
-            let name = path.display().to_string();
-            if name.contains("1000ha") {
-                continue; // scaling benchmark only
-            }
-            let f = load(&path);
-            let plan =
-                plan_field(&f.field, &params).unwrap_or_else(|e| panic!("{name}: {e}"));
-            let m = plan_metrics(&f.field, &plan, params.line_width);
-            eprintln!(
-                "{name}: covered {:.5} outside {:.3e} m² intrusions {} turn points outside {} \
-                 max curvature {:.4}",
-                m.covered_fraction,
-                m.outside_area_m2,
-                m.obstacle_intrusions,
-                m.turn_points_outside,
-                m.max_curvature
-            );
-            let mut fail = |what: String| failures.push(format!("{name}: {what}"));
-            if m.covered_fraction < 0.995 {
-                fail(format!("covered {}", m.covered_fraction));
-            }
-            if m.outside_area_m2 >= 1e-6 {
-                fail(format!("outside {} m²", m.outside_area_m2));
-            }
-            if m.obstacle_intrusions != 0 {
-                fail(format!("{} obstacle intrusions", m.obstacle_intrusions));
-            }
-            if m.turn_points_outside != 0 {
-                fail(format!("{} turn points outside", m.turn_points_outside));
-            }
-            for s in plan.segments.iter().filter(|s| s.kind == SegmentKind::Turn) {
-                if s.points.iter().any(|p| !contains_point(&f.field.boundary, p)) {
-                    fail(format!("turn {} leaves the boundary", s.index));
+        // (w, r_min, headland passes): skip order (w < 2r), the issue's 6/6/3 (18 m headland),
+        // and boustrophedon (w ≥ 2r).
+        for (w, r, passes) in [(6.0, 5.0, 2), (6.0, 6.0, 3), (12.0, 6.0, 2)] {
+            let mut params = cfg.coverage_params();
+            params.line_width = w;
+            params.r_min = r;
+            params.headland_passes = passes;
+            for path in field_files() {
+                let name = format!("{} (w {w}, r {r}, passes {passes})", path.display());
+                if name.contains("1000ha") {
+                    continue; // scaling benchmark only
                 }
-            }
-            let limit = 1.02 / params.r_min + 1e-3;
-            if m.max_curvature > limit {
-                fail(format!("curvature {} > {limit}", m.max_curvature));
-            }
-            if is_convex(&f.field.boundary) {
-                let want = min_span_direction(&f.field.boundary);
-                for a in &plan.swath_angles {
-                    let got = a.rem_euclid(std::f64::consts::PI);
-                    let diff = (got - want).abs();
-                    let diff = diff.min(std::f64::consts::PI - diff);
-                    if diff >= 1e-3 {
-                        fail(format!("swath angle {got} vs min-span {want}"));
+                let f = load(&path);
+                let plan = plan_field(&f.field, &params).unwrap_or_else(|e| panic!("{name}: {e}"));
+                let m = plan_metrics(&f.field, &plan, params.line_width);
+                eprintln!(
+                    "{name}: covered {:.5} outside {:.3e} m² intrusions {} turn points outside {} \
+                 max curvature {:.4}",
+                    m.covered_fraction,
+                    m.outside_area_m2,
+                    m.obstacle_intrusions,
+                    m.turn_points_outside,
+                    m.max_curvature
+                );
+                let mut fail = |what: String| failures.push(format!("{name}: {what}"));
+                if m.covered_fraction < 0.995 {
+                    fail(format!("covered {}", m.covered_fraction));
+                }
+                if m.outside_area_m2 >= 1e-6 {
+                    fail(format!("outside {} m²", m.outside_area_m2));
+                }
+                if m.obstacle_intrusions != 0 {
+                    fail(format!("{} obstacle intrusions", m.obstacle_intrusions));
+                }
+                if m.turn_points_outside != 0 {
+                    fail(format!("{} turn points outside", m.turn_points_outside));
+                }
+                for s in plan.segments.iter().filter(|s| s.kind == SegmentKind::Turn) {
+                    if s.points
+                        .iter()
+                        .any(|p| !contains_point(&f.field.boundary, p))
+                    {
+                        fail(format!("turn {} leaves the boundary", s.index));
+                    }
+                }
+                let limit = 1.02 / params.r_min + 1e-3;
+                if m.max_curvature > limit {
+                    fail(format!("curvature {} > {limit}", m.max_curvature));
+                }
+                if is_convex(&f.field.boundary) {
+                    let want = min_span_direction(&f.field.boundary);
+                    for a in &plan.swath_angles {
+                        let got = a.rem_euclid(std::f64::consts::PI);
+                        let diff = (got - want).abs();
+                        let diff = diff.min(std::f64::consts::PI - diff);
+                        if diff >= 1e-3 {
+                            fail(format!("swath angle {got} vs min-span {want}"));
+                        }
                     }
                 }
             }

@@ -139,7 +139,10 @@ pub fn plan_svg(
         r##"fill="#f3efe0" stroke="#333" stroke-width="1.5""##,
     );
     for (outer, holes) in &plan.working_area {
-        c.polygon(outer, r##"fill="#e3f1dc" stroke="#7a7" stroke-width="0.8""##);
+        c.polygon(
+            outer,
+            r##"fill="#e3f1dc" stroke="#7a7" stroke-width="0.8""##,
+        );
         for h in holes {
             c.polygon(h, r##"fill="#f3efe0" stroke="#7a7" stroke-width="0.8""##);
         }
@@ -176,7 +179,12 @@ pub fn plan_svg(
         SegmentKind::Transit,
     ];
     for (i, k) in kinds.iter().enumerate() {
-        c.footer_swatch(10.0 + 110.0 * i as f64, 20.0, kind_colour(*k), kind_name(*k));
+        c.footer_swatch(
+            10.0 + 110.0 * i as f64,
+            20.0,
+            kind_colour(*k),
+            kind_name(*k),
+        );
     }
     c.footer_text(
         10.0,
@@ -233,8 +241,18 @@ mod tests {
         };
         let plan = FieldPlan {
             segments: vec![
-                seg(SegmentKind::Work, 0, Direction::Forward, vec![v2(5.0, 5.0), v2(95.0, 5.0)]),
-                seg(SegmentKind::Turn, 1, Direction::Reverse, vec![v2(95.0, 5.0), v2(95.0, 15.0)]),
+                seg(
+                    SegmentKind::Work,
+                    0,
+                    Direction::Forward,
+                    vec![v2(5.0, 5.0), v2(95.0, 5.0)],
+                ),
+                seg(
+                    SegmentKind::Turn,
+                    1,
+                    Direction::Reverse,
+                    vec![v2(95.0, 5.0), v2(95.0, 15.0)],
+                ),
             ],
             working_area: vec![(field.boundary.clone(), vec![])],
             headland_inner: vec![],

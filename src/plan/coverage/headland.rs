@@ -10,6 +10,12 @@ use geo::BooleanOps;
 /// which cut up to 0.3 mm inside a 6 m arc.
 pub const CHORD_MARGIN: f64 = 0.005;
 
+/// How far a path's chords may cut inside its arcs, m: points `point_spacing` apart on an arc
+/// of radius ≥ r_min sag by at most spacing²/(8·r_min), plus [`CHORD_MARGIN`].
+pub fn chord_margin(p: &CoverageParams) -> f64 {
+    CHORD_MARGIN + p.point_spacing * p.point_spacing / (8.0 * p.r_min)
+}
+
 /// Does the ring have a reflex (interior angle > 180°) vertex? Rings are counter-clockwise.
 pub fn has_reflex_vertex(ring: &[Vec2]) -> bool {
     let n = ring.len();
@@ -22,11 +28,60 @@ pub fn has_reflex_vertex(ring: &[Vec2]) -> bool {
 }
 
 /// The area inside which swath centre lines stay: the boundary shrunk by
-/// w/2 + headland_passes·w, minus every obstacle grown by w/2.
+/// w/2 + headland_passes·w, minus the obstacles with their own headland
+/// ([`obstacle_headland_width`], smoothed by a closing of radius r_min).
 pub fn working_area(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Vec<Area> {
     let inset = p.line_width / 2.0 + p.headland_passes as f64 * p.line_width;
     let outer = offset(&[(boundary.to_vec(), vec![])], -inset);
-    subtract_obstacles(&outer, obstacles, p.line_width / 2.0)
+    if obstacles.is_empty() {
+        return outer;
+    }
+    let holes = closing(obstacles, obstacle_headland_width(p), p.r_min);
+    let a = geo::MultiPolygon::new(outer.iter().map(super::geometry::to_geo).collect());
+    let b = geo::MultiPolygon::new(holes.iter().map(super::geometry::to_geo).collect());
+    super::geometry::from_geo(&a.difference(&b))
+}
+
+/// Offset of obstacle pass `k` (0 = nearest the obstacle) from the obstacle's edge, m:
+/// w/2 + k·w, but at least `r_min`: the pass rounds the obstacle's corners on arcs of that
+/// radius about them.
+pub fn obstacle_pass_offset(p: &CoverageParams, k: usize) -> f64 {
+    (p.line_width / 2.0 + k as f64 * p.line_width).max(p.r_min) + chord_margin(p)
+}
+
+/// Width of the headland around every obstacle, m: out to the outer edge of the outermost
+/// obstacle pass (w/2 when there are no headland passes).
+pub fn obstacle_headland_width(p: &CoverageParams) -> f64 {
+    match p.headland_passes {
+        0 => p.line_width / 2.0,
+        n => obstacle_pass_offset(p, n - 1) + p.line_width / 2.0,
+    }
+}
+
+/// The obstacles grown by `distance` m and closed with radius `r` (grown by `distance + r`,
+/// shrunk by `r`): every point is at least `distance` from the obstacles, convex corners are
+/// arcs of radius `distance`, concave ones arcs of radius ≥ `r`, and near obstacles merge.
+pub fn closing(obstacles: &[Vec<Vec2>], distance: f64, r: f64) -> Vec<Area> {
+    let rings: Vec<Area> = obstacles.iter().map(|o| (o.clone(), vec![])).collect();
+    offset(&offset(&rings, distance + r), -r)
+}
+
+/// Headland passes around the obstacles, nearest the obstacle first: closed tracks (first point
+/// repeated last) at [`obstacle_pass_offset`] from them, every corner an arc of radius ≥ r_min,
+/// resampled to `point_spacing`. Obstacles whose passes meet share them.
+pub fn obstacle_tracks(obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Vec<Vec<Vec2>> {
+    let mut tracks = Vec::new();
+    if obstacles.is_empty() {
+        return tracks;
+    }
+    for k in 0..p.headland_passes {
+        for (ring, _) in closing(obstacles, obstacle_pass_offset(p, k), p.r_min) {
+            let mut closed = ring.clone();
+            closed.push(ring[0]);
+            tracks.push(resample(&closed, p.point_spacing));
+        }
+    }
+    tracks
 }
 
 /// `areas` minus every obstacle grown by `margin` m.
@@ -50,11 +105,11 @@ pub fn subtract_obstacles(areas: &[Area], obstacles: &[Vec<Vec2>], margin: f64) 
 /// the boundary has a reflex corner (there the pass follows an arc of that radius about the
 /// corner, and a tighter one could not be driven).
 pub fn pass_offset(boundary: &[Vec2], p: &CoverageParams, k: usize) -> f64 {
-    let d = p.line_width / 2.0 + k as f64 * p.line_width + CHORD_MARGIN;
+    let d = p.line_width / 2.0 + k as f64 * p.line_width;
     if has_reflex_vertex(boundary) {
-        d.max(p.r_min)
+        d.max(p.r_min) + chord_margin(p)
     } else {
-        d
+        d + CHORD_MARGIN
     }
 }
 

@@ -162,7 +162,9 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
         plan: &'a FieldPlan,
         kinds: &'a [SegmentKind],
     ) -> impl Iterator<Item = &'a PlanSegment> + 'a {
-        plan.segments.iter().filter(move |s| kinds.contains(&s.kind))
+        plan.segments
+            .iter()
+            .filter(move |s| kinds.contains(&s.kind))
     }
     let work_fp = footprint(of(plan, &[Work, Detour]), line_width);
     let passes_fp = footprint(of(plan, &[Work, Detour, Headland]), line_width);
@@ -203,8 +205,11 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
             }
         }
     }
-    let segment_max_curvature: Vec<f64> =
-        plan.segments.iter().map(|s| max_curvature(&s.points)).collect();
+    let segment_max_curvature: Vec<f64> = plan
+        .segments
+        .iter()
+        .map(|s| max_curvature(&s.points))
+        .collect();
     let len_of = |k: SegmentKind| -> f64 {
         plan.segments
             .iter()

@@ -229,6 +229,9 @@ impl CoverageParams {
     }
 }
 
+/// States a transit's waypoint search may expand before giving up.
+const ROUTE_MAX_EXPANSIONS: usize = 20_000;
+
 /// Plan the whole field: headland passes (outermost first), then the cells in a short order,
 /// each swept by its runs of swaths with turns, joined by transits.
 pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> {
@@ -249,32 +252,21 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         margin,
     );
     let working = headland::working_area(&field.boundary, &field.obstacles, p);
-    let clear_map = ClearMap::new(field, half);
+    // Points are checked; the chords between them may cut a little inside the arcs.
+    let clear_map = ClearMap::new(
+        field,
+        half + headland::chord_margin(p) - headland::CHORD_MARGIN,
+    );
     let clear = |q: &Vec2| clear_map.clear(q);
-    // Waypoints for transits that cannot go direct: a grid over the working area.
-    let waypoints: Vec<Vec2> = {
-        let step = 2.0 * p.r_min;
-        let mut v = Vec::new();
-        for area in &working {
-            if let Some((lo, hi)) = crate::geo::polygon::bbox(area.0.iter()) {
-                let (nx, ny) = (
-                    ((hi.x - lo.x) / step) as usize,
-                    ((hi.y - lo.y) / step) as usize,
-                );
-                if nx * ny > 20_000 {
-                    continue;
-                }
-                for i in 0..=nx {
-                    for j in 0..=ny {
-                        let q = v2(lo.x + i as f64 * step, lo.y + j as f64 * step);
-                        if clear(&q) && crate::geo::polygon::contains_point(&area.0, &q) {
-                            v.push(q);
-                        }
-                    }
-                }
-            }
-        }
-        v
+    // Waypoints for transits that cannot go direct: a grid of clear points over the field.
+    // (Built on first need: most plans never need it.)
+    let waypoint_grid = std::cell::OnceCell::new();
+    let waypoint_grid = || {
+        waypoint_grid.get_or_init(|| {
+            let (lo, hi) = crate::geo::polygon::bbox(field.boundary.iter())
+                .unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
+            transit::WaypointGrid::new(lo, hi, 2.0 * p.r_min, 20_000, &clear)
+        })
     };
 
     // Cells and their swath directions.
@@ -380,27 +372,41 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
                 heading_at(target, cut_next),
             )
         };
+        // Without shortening any work first (direct, then through waypoints), then pulling
+        // the ends back metre by metre, then the waypoints again.
+        #[derive(Clone, Copy)]
+        enum Way {
+            Direct,
+            Waypoints,
+        }
+        let mut attempts = vec![(0, Way::Direct), (0, Way::Waypoints)];
+        attempts.extend((1..=max_cut).map(|t| (t, Way::Direct)));
+        attempts.push((max_cut, Way::Waypoints));
         let mut found = None;
-        for t in 0..=max_cut {
+        for (t, way) in attempts {
             let (cp, cn, f, hf, q, hq) = poses(t);
             if t > 0 && cp == 0 && cn == 0 {
-                break;
+                continue;
             }
-            if let Some((pts, true)) =
-                transit::transit(f, hf, q, hq, p.r_min, p.point_spacing, &clear)
-            {
+            let (r, step) = (p.r_min, p.point_spacing);
+            let pts = match way {
+                Way::Direct => transit::transit(f, hf, q, hq, r, step, &clear)
+                    .and_then(|(pts, ok)| ok.then_some(pts)),
+                Way::Waypoints => transit::route_graph(
+                    f,
+                    hf,
+                    q,
+                    hq,
+                    r,
+                    step,
+                    &clear,
+                    waypoint_grid(),
+                    ROUTE_MAX_EXPANSIONS,
+                ),
+            };
+            if let Some(pts) = pts {
                 found = Some((pts, cp, cn));
                 break;
-            }
-        }
-        if found.is_none() {
-            for t in [0, max_cut / 2, max_cut] {
-                let (cp, cn, f, hf, q, hq) = poses(t);
-                let r = transit::route(f, hf, q, hq, p.r_min, p.point_spacing, &clear, &waypoints);
-                if let Some((pts, true)) = r {
-                    found = Some((pts, cp, cn));
-                    break;
-                }
             }
         }
         let (pts, cut_prev, cut_next) = match found {
@@ -427,7 +433,39 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         cut_next
     };
 
-    for ring in headland::headland_tracks(&field.boundary, p) {
+    // Headland passes: the field's (outermost first), then the obstacles' (nearest first),
+    // those that keep clear of the field edge and the other obstacles.
+    let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
+        headland::headland_tracks(&field.boundary, p).into();
+    let mut obstacle_tracks: Vec<Vec<Vec2>> = headland::obstacle_tracks(&field.obstacles, p)
+        .into_iter()
+        .filter(|t| {
+            let ok = t.iter().all(&clear);
+            if !ok {
+                tracing::debug!("an obstacle headland pass would leave the field; skipped");
+            }
+            ok
+        })
+        .collect();
+    loop {
+        let ring = match field_tracks.pop_front() {
+            Some(r) => r,
+            None if !obstacle_tracks.is_empty() => {
+                let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
+                let dist = |t: &Vec<Vec2>| {
+                    t.iter()
+                        .map(|q| (q - here).norm())
+                        .fold(f64::INFINITY, f64::min)
+                };
+                let k = (0..obstacle_tracks.len())
+                    .min_by(|&i, &j| {
+                        dist(&obstacle_tracks[i]).total_cmp(&dist(&obstacle_tracks[j]))
+                    })
+                    .unwrap_or(0);
+                obstacle_tracks.swap_remove(k)
+            }
+            None => break,
+        };
         let n = ring.len();
         if n < 4 {
             continue;
@@ -459,7 +497,8 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         let m = open.len();
         let mut start = nearest;
         if let Some((q, h)) = at {
-            for k in 0..m {
+            // At most about 48 candidate starts around the track (each try is a whole curve).
+            for k in (0..m).step_by((m / 48).max(1)) {
                 let i = (nearest + k) % m;
                 let hi = vec_heading(&(open[(i + 1) % m] - open[i]));
                 if let Some((_, true)) =

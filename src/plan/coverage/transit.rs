@@ -6,8 +6,8 @@ use crate::geo::{heading_vec, left_normal, wrap_angle, Vec2};
 use std::f64::consts::TAU;
 
 /// Points of the Dubins CSC path from (`p1`, heading `h1`) to (`p2`, heading `h2`) with turn
-/// senses `s1`, `s2` (+1 left, −1 right), about `step` m apart; `None` when the word has no
-/// solution. Returns (length m, points).
+/// senses `s1`, `s2` (+1 left, −1 right), about `step` m apart (none unless `points`); `None`
+/// when the word has no solution. Returns (length m, points).
 #[allow(clippy::too_many_arguments)]
 fn csc(
     p1: Vec2,
@@ -18,6 +18,7 @@ fn csc(
     s2: f64,
     r: f64,
     step: f64,
+    points: bool,
 ) -> Option<(f64, Vec<Vec2>)> {
     let c1 = p1 + left_normal(&heading_vec(h1)) * (s1 * r);
     let c2 = p2 + left_normal(&heading_vec(h2)) * (s2 * r);
@@ -53,6 +54,10 @@ fn csc(
     if (t2 - t1).dot(&heading_vec(theta)) < -1e-6 {
         return None;
     }
+    let length = r * (a1 + a2) + straight;
+    if !points {
+        return Some((length, Vec::new()));
+    }
     let mut pts = Vec::new();
     let arc = |c: Vec2, h0: f64, sweep: f64, s: f64, pts: &mut Vec<Vec2>| {
         let n = ((sweep * r) / step).ceil().max(1.0) as usize;
@@ -70,7 +75,7 @@ fn csc(
     if let Some(last) = pts.last_mut() {
         *last = p2;
     }
-    Some((r * (a1 + a2) + straight, pts))
+    Some((length, pts))
 }
 
 /// The shortest CSC transit for which `clear` holds at every point, else the shortest one
@@ -84,24 +89,149 @@ pub fn transit(
     step: f64,
     clear: &dyn Fn(&Vec2) -> bool,
 ) -> Option<(Vec<Vec2>, bool)> {
-    let mut cands: Vec<(f64, Vec<Vec2>)> = [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)]
+    const WORDS: [(f64, f64); 4] = [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)];
+    // Lengths first; points only for the words tried, shortest first.
+    let mut words: Vec<(f64, (f64, f64))> = WORDS
         .iter()
-        .filter_map(|&(a, b)| csc(p1, h1, p2, h2, a, b, r, step))
+        .filter_map(|&(a, b)| csc(p1, h1, p2, h2, a, b, r, step, false).map(|c| (c.0, (a, b))))
         .collect();
-    cands.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let first = cands.first().map(|c| c.1.clone())?;
-    for (_, pts) in &cands {
+    words.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let points = |(a, b): (f64, f64)| csc(p1, h1, p2, h2, a, b, r, step, true).map(|c| c.1);
+    for &(_, word) in &words {
+        let pts = points(word)?;
         if pts.iter().all(clear) {
-            return Some((pts.clone(), true));
+            return Some((pts, true));
         }
     }
-    Some((first, false))
+    Some((points(words.first()?.1)?, false))
 }
 
-/// Like [`transit`], but when no direct curve is clear, through one of `waypoints` (tried
-/// nearest the way first, each with eight headings): two clear curves back to back.
+/// Clear waypoints on a square grid: the nodes of [`route_graph`].
+#[derive(Debug, Clone)]
+pub struct WaypointGrid {
+    /// Position of node (0, 0), m.
+    pub origin: Vec2,
+    /// Node spacing, m.
+    pub step: f64,
+    pub nx: usize,
+    pub ny: usize,
+    /// Node (i, j) at `j * nx + i` is usable.
+    pub usable: Vec<bool>,
+}
+
+impl WaypointGrid {
+    /// Nodes every `step` m over the box `lo`–`hi` where `usable` holds; at most `max_nodes`
+    /// (the step grows to fit).
+    pub fn new(
+        lo: Vec2,
+        hi: Vec2,
+        step: f64,
+        max_nodes: usize,
+        usable: &dyn Fn(&Vec2) -> bool,
+    ) -> Self {
+        let span = hi - lo;
+        let step = step.max((span.x.max(0.0) * span.y.max(0.0) / max_nodes.max(1) as f64).sqrt());
+        let nx = (span.x / step).floor().max(0.0) as usize + 1;
+        let ny = (span.y / step).floor().max(0.0) as usize + 1;
+        let mut grid = WaypointGrid {
+            origin: lo,
+            step,
+            nx,
+            ny,
+            usable: vec![false; nx * ny],
+        };
+        for j in 0..ny {
+            for i in 0..nx {
+                grid.usable[j * nx + i] = usable(&grid.node(i, j));
+            }
+        }
+        grid
+    }
+
+    /// Distance from every node to `goal` through usable nodes (8-neighbour moves), m;
+    /// infinite where the goal cannot be reached. Nodes within `radius` of the goal start at
+    /// their straight distance.
+    fn distances_to(&self, goal: &Vec2, radius: f64) -> Vec<f64> {
+        use std::cmp::Reverse;
+        let mut dist = vec![f64::INFINITY; self.usable.len()];
+        let mut heap = std::collections::BinaryHeap::new();
+        let key = |d: f64| Reverse((d * 1000.0) as u64);
+        for (k, q) in self.near(goal, radius) {
+            dist[k] = (q - goal).norm();
+            heap.push((key(dist[k]), k));
+        }
+        while let Some((Reverse(d), k)) = heap.pop() {
+            if (d as f64) > dist[k] * 1000.0 + 1.0 {
+                continue;
+            }
+            let (i, j) = ((k % self.nx) as i64, (k / self.nx) as i64);
+            for (di, dj) in [
+                (-1, -1),
+                (-1, 0),
+                (-1, 1),
+                (0, -1),
+                (0, 1),
+                (1, -1),
+                (1, 0),
+                (1, 1),
+            ] {
+                let (a, b) = (i + di, j + dj);
+                if a < 0 || b < 0 || a >= self.nx as i64 || b >= self.ny as i64 {
+                    continue;
+                }
+                let n = b as usize * self.nx + a as usize;
+                if !self.usable[n] {
+                    continue;
+                }
+                let nd = dist[k] + self.step * ((di * di + dj * dj) as f64).sqrt();
+                if nd < dist[n] {
+                    dist[n] = nd;
+                    heap.push((key(nd), n));
+                }
+            }
+        }
+        dist
+    }
+
+    fn node(&self, i: usize, j: usize) -> Vec2 {
+        self.origin + Vec2::new(i as f64 * self.step, j as f64 * self.step)
+    }
+
+    /// Usable nodes within `radius` m of `p`: (index, position).
+    fn near(&self, p: &Vec2, radius: f64) -> Vec<(usize, Vec2)> {
+        let rel = (p - self.origin) / self.step;
+        let reach = (radius / self.step).ceil() as i64;
+        let (ci, cj) = (rel.x.round() as i64, rel.y.round() as i64);
+        let mut out = Vec::new();
+        for j in (cj - reach).max(0)..=(cj + reach).min(self.ny as i64 - 1) {
+            for i in (ci - reach).max(0)..=(ci + reach).min(self.nx as i64 - 1) {
+                let k = j as usize * self.nx + i as usize;
+                let q = self.node(i as usize, j as usize);
+                if self.usable[k] && (q - p).norm() <= radius {
+                    out.push((k, q));
+                }
+            }
+        }
+        out
+    }
+}
+
+fn polyline_length(points: &[Vec2]) -> f64 {
+    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+/// Weight of the distance to go (through the grid) in the search's priority (> 1: fewer
+/// states expanded, a transit at most about this factor longer than the best).
+const HEURISTIC_WEIGHT: f64 = 1.5;
+
+/// Headings tried at every waypoint.
+const GRAPH_HEADINGS: usize = 8;
+
+/// A clear transit through several waypoints: A* over (waypoint, heading) states joined by
+/// clear CSC curves to the waypoints within two grid steps, from the start pose to the goal
+/// pose; at most `max_expansions` states are expanded. `None` when no clear way was found.
 #[allow(clippy::too_many_arguments)]
-pub fn route(
+pub fn route_graph(
     p1: Vec2,
     h1: f64,
     p2: Vec2,
@@ -109,33 +239,108 @@ pub fn route(
     r: f64,
     step: f64,
     clear: &dyn Fn(&Vec2) -> bool,
-    waypoints: &[Vec2],
-) -> Option<(Vec<Vec2>, bool)> {
-    let direct = transit(p1, h1, p2, h2, r, step, clear)?;
-    if direct.1 {
-        return Some(direct);
-    }
-    let mut order: Vec<&Vec2> = waypoints.iter().collect();
-    order.sort_by(|a, b| {
-        let da = (*a - p1).norm() + (p2 - *a).norm();
-        let db = (*b - p1).norm() + (p2 - *b).norm();
-        da.total_cmp(&db)
-    });
-    for w in order.into_iter().take(60) {
-        for k in 0..8 {
-            let hw = k as f64 * std::f64::consts::FRAC_PI_4;
-            let Some((a, true)) = transit(p1, h1, *w, hw, r, step, clear) else {
-                continue;
-            };
-            let Some((b, true)) = transit(*w, hw, p2, h2, r, step, clear) else {
-                continue;
-            };
-            let mut pts = a;
-            pts.extend(b.into_iter().skip(1));
-            return Some((pts, true));
+    grid: &WaypointGrid,
+    max_expansions: usize,
+) -> Option<Vec<Vec2>> {
+    use std::cmp::Reverse;
+    use std::collections::{BinaryHeap, HashMap};
+    let heading = |k: usize| k as f64 * TAU / GRAPH_HEADINGS as f64;
+    let reach = 2.0 * grid.step * std::f64::consts::SQRT_2 + 1e-6;
+    // The heuristic: the distance to go through the grid (it knows the way around bays).
+    let to_goal = grid.distances_to(&p2, 3.0 * grid.step);
+    let pose = |s: usize| {
+        (
+            grid.node(s / GRAPH_HEADINGS % grid.nx, s / GRAPH_HEADINGS / grid.nx),
+            heading(s % GRAPH_HEADINGS),
+        )
+    };
+    let edge = |a: (Vec2, f64), b: (Vec2, f64)| -> Option<(f64, Vec<Vec2>)> {
+        match transit(a.0, a.1, b.0, b.1, r, step, clear) {
+            Some((pts, true)) => Some((polyline_length(&pts), pts)),
+            _ => None,
         }
+    };
+    // States: waypoint index · GRAPH_HEADINGS + heading index; START is the start pose.
+    const START: usize = usize::MAX;
+    let key = |f: f64| Reverse((f * 1000.0) as u64);
+    let mut best: HashMap<usize, (f64, usize)> = HashMap::new();
+    let mut heap: BinaryHeap<(Reverse<u64>, usize)> = BinaryHeap::new();
+    let relax = |from: usize,
+                 from_cost: f64,
+                 at: (Vec2, f64),
+                 best: &mut HashMap<usize, (f64, usize)>,
+                 heap: &mut BinaryHeap<(Reverse<u64>, usize)>| {
+        for (k, q) in grid.near(&at.0, reach) {
+            let dir = q - at.0;
+            for hk in 0..GRAPH_HEADINGS {
+                let h = heading(hk);
+                // Only headings roughly along the way there.
+                if dir.norm() > 1e-9 && wrap_angle(h - dir.y.atan2(dir.x)).abs() > 0.8 {
+                    continue;
+                }
+                let s = k * GRAPH_HEADINGS + hk;
+                if s == from {
+                    continue;
+                }
+                let Some((len, _)) = edge(at, (q, h)) else {
+                    continue;
+                };
+                let g = from_cost + len;
+                if best.get(&s).is_none_or(|b| g < b.0) {
+                    best.insert(s, (g, from));
+                    let to_go = to_goal[k];
+                    if to_go.is_finite() {
+                        heap.push((key(g + HEURISTIC_WEIGHT * to_go), s));
+                    }
+                }
+            }
+        }
+    };
+    relax(START, 0.0, (p1, h1), &mut best, &mut heap);
+    let mut done: HashMap<usize, ()> = HashMap::new();
+    let mut expansions = 0;
+    while let Some((_, s)) = heap.pop() {
+        if done.insert(s, ()).is_some() {
+            continue;
+        }
+        expansions += 1;
+        if expansions > max_expansions {
+            tracing::debug!(expansions, "no clear transit found through the waypoints");
+            return None;
+        }
+        let g = best.get(&s).map(|b| b.0)?;
+        let at = pose(s);
+        if (p2 - at.0).norm() <= 3.0 * grid.step {
+            if let Some((_, last)) = edge(at, (p2, h2)) {
+                // Rebuild the chain of poses back to the start, then its curves.
+                let mut chain = vec![s];
+                while let Some(&(_, parent)) = best.get(chain.last()?) {
+                    if parent == START {
+                        break;
+                    }
+                    chain.push(parent);
+                }
+                chain.reverse();
+                let mut pts = vec![p1];
+                let mut from = (p1, h1);
+                for &c in &chain {
+                    let to = pose(c);
+                    let (_, piece) = edge(from, to)?;
+                    pts.extend(piece.into_iter().skip(1));
+                    from = to;
+                }
+                pts.extend(last.into_iter().skip(1));
+                tracing::debug!(
+                    expansions,
+                    waypoints = chain.len(),
+                    "transit through waypoints"
+                );
+                return Some(pts);
+            }
+        }
+        relax(s, g, at, &mut best, &mut heap);
     }
-    Some(direct)
+    None
 }
 
 /// A straight from `a` to `b` as points about `step` m apart.

@@ -47,7 +47,11 @@ const YS: [f64; 6] = [5.0, 15.0, 25.0, 35.0, 45.0, 55.0];
 fn exact_cover_has_full_coverage_no_overlap_nothing_outside() {
     let (field, p) = plan(&YS);
     let m = plan_metrics(&field, &p, 10.0);
-    assert!((m.covered_fraction - 1.0).abs() < 1e-9, "{}", m.covered_fraction);
+    assert!(
+        (m.covered_fraction - 1.0).abs() < 1e-9,
+        "{}",
+        m.covered_fraction
+    );
     assert!((m.field_covered_fraction - 1.0).abs() < 1e-9);
     assert!(m.overlap_fraction.abs() < 1e-9, "{}", m.overlap_fraction);
     assert!(m.outside_area_m2 < 1e-6, "{}", m.outside_area_m2);
@@ -65,7 +69,11 @@ fn missing_shifted_and_overlapping_swaths_are_measured() {
     // Last swath moved to y = 60: half of it (100 × 5 m²) lies outside, 5 m strip uncovered.
     let (field, p) = plan(&[5.0, 15.0, 25.0, 35.0, 45.0, 60.0]);
     let m = plan_metrics(&field, &p, 10.0);
-    assert!((m.outside_area_m2 - 500.0).abs() < 1e-6, "{}", m.outside_area_m2);
+    assert!(
+        (m.outside_area_m2 - 500.0).abs() < 1e-6,
+        "{}",
+        m.outside_area_m2
+    );
     assert!((m.covered_fraction - 55.0 / 60.0).abs() < 1e-9);
 
     // Swath at y = 50 overlaps its neighbours at 45 and 55 by 5 m each over 100 m.
@@ -73,7 +81,11 @@ fn missing_shifted_and_overlapping_swaths_are_measured() {
     let m = plan_metrics(&field, &p, 10.0);
     assert!((m.covered_fraction - 1.0).abs() < 1e-9);
     let expected = 1000.0 / 6000.0;
-    assert!((m.overlap_fraction - expected).abs() < 1e-9, "{}", m.overlap_fraction);
+    assert!(
+        (m.overlap_fraction - expected).abs() < 1e-9,
+        "{}",
+        m.overlap_fraction
+    );
 }
 
 #[test]
@@ -131,5 +143,8 @@ fn three_point_curvature_of_circle_points() {
         })
         .collect();
     assert!((three_point_curvature(&pts[0], &pts[1], &pts[2]) - 1.0 / r).abs() < 1e-12);
-    assert_eq!(three_point_curvature(&v2(0.0, 0.0), &v2(1.0, 0.0), &v2(2.0, 0.0)), 0.0);
+    assert_eq!(
+        three_point_curvature(&v2(0.0, 0.0), &v2(1.0, 0.0), &v2(2.0, 0.0)),
+        0.0
+    );
 }
