@@ -32,7 +32,10 @@ fn square_plan(side: f64, width: f64) -> (Field, FieldPlan) {
             let arc = (0..=16)
                 .map(|k| {
                     let a = -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * k as f64 / 16.0;
-                    v2(cx + sign * 0.5 * width * a.cos(), y + 0.5 * width + 0.5 * width * a.sin())
+                    v2(
+                        cx + sign * 0.5 * width * a.cos(),
+                        y + 0.5 * width + 0.5 * width * a.sin(),
+                    )
                 })
                 .collect();
             segments.push(PlanSegment {

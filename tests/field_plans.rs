@@ -25,8 +25,7 @@ fn field_files() -> Vec<PathBuf> {
 
 fn load(path: &PathBuf) -> LoadedField {
     let text = std::fs::read_to_string(path).expect("readable");
-    load_field(&text, &LoadOptions::default())
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    load_field(&text, &LoadOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 fn is_convex(ring: &[Vec2]) -> bool {
@@ -130,8 +129,7 @@ mod end_to_end {
                 continue; // scaling benchmark only
             }
             let f = load(&path);
-            let plan =
-                plan_field(&f.field, &params).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let plan = plan_field(&f.field, &params).unwrap_or_else(|e| panic!("{name}: {e}"));
             let m = plan_metrics(&f.field, &plan, params.line_width);
             eprintln!(
                 "{name}: covered {:.5} outside {:.3e} m² intrusions {} turn points outside {} \
@@ -156,7 +154,10 @@ mod end_to_end {
                 fail(format!("{} turn points outside", m.turn_points_outside));
             }
             for s in plan.segments.iter().filter(|s| s.kind == SegmentKind::Turn) {
-                if s.points.iter().any(|p| !contains_point(&f.field.boundary, p)) {
+                if s.points
+                    .iter()
+                    .any(|p| !contains_point(&f.field.boundary, p))
+                {
                     fail(format!("turn {} leaves the boundary", s.index));
                 }
             }

@@ -111,9 +111,7 @@ fn fit_line(points: &[Vec2]) -> (Vec2, Vec2) {
     let mut seg_start = 0.0;
     for k in 0..=FIT_SAMPLES {
         let s = step * k as f64;
-        while seg + 1 < points.len() - 1
-            && seg_start + (points[seg + 1] - points[seg]).norm() < s
-        {
+        while seg + 1 < points.len() - 1 && seg_start + (points[seg + 1] - points[seg]).norm() < s {
             seg_start += (points[seg + 1] - points[seg]).norm();
             seg += 1;
         }
@@ -240,6 +238,9 @@ pub(crate) mod tests_support {
     /// The Douglas–Peucker ring alone (chords, no regression fit).
     pub fn dp(ring: &[Vec2], tolerance: f64) -> Vec<Vec2> {
         let keep = douglas_peucker(ring, tolerance);
-        (0..ring.len()).filter(|&i| keep[i]).map(|i| ring[i]).collect()
+        (0..ring.len())
+            .filter(|&i| keep[i])
+            .map(|i| ring[i])
+            .collect()
     }
 }

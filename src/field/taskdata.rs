@@ -83,11 +83,7 @@ pub(crate) fn parse(text: &str) -> Result<Parsed, FieldError> {
         let pfd_label = node_label(&pfd, "PFD", i);
         let mut boundaries = Vec::new();
         let mut obstacles = Vec::new();
-        for (j, pln) in pfd
-            .children()
-            .filter(|n| n.has_tag_name("PLN"))
-            .enumerate()
-        {
+        for (j, pln) in pfd.children().filter(|n| n.has_tag_name("PLN")).enumerate() {
             let label = format!("{pfd_label} {}", node_label(&pln, "PLN", j));
             match pln.attribute("A") {
                 Some(PLN_BOUNDARY) => boundaries.push(polygon(&label, &pln)?),

@@ -164,9 +164,17 @@ fn err(text: &str) -> String {
 
 #[test]
 fn invalid_input_gives_errors_naming_the_feature() {
-    let bow = vec![v2(0.0, 0.0), v2(100.0, 100.0), v2(100.0, 0.0), v2(0.0, 100.0)];
+    let bow = vec![
+        v2(0.0, 0.0),
+        v2(100.0, 100.0),
+        v2(100.0, 0.0),
+        v2(0.0, 100.0),
+    ];
     let e = err(&collection(&[feature(&[&bow], r#""name":"bow""#)]));
-    assert!(e.contains("feature 0 \"bow\"") && e.contains("intersects itself"), "{e}");
+    assert!(
+        e.contains("feature 0 \"bow\"") && e.contains("intersects itself"),
+        "{e}"
+    );
 
     let two = vec![v2(0.0, 0.0), v2(100.0, 0.0), v2(0.0, 0.0)];
     let e = err(&collection(&[feature(&[&two], "")]));
@@ -178,11 +186,17 @@ fn invalid_input_gives_errors_naming_the_feature() {
         feature(&[&outer], ""),
         feature(&[&outside], r#""obstacle":true,"name":"barn""#),
     ]));
-    assert!(e.contains("feature 1 \"barn\"") && e.contains("not inside"), "{e}");
+    assert!(
+        e.contains("feature 1 \"barn\"") && e.contains("not inside"),
+        "{e}"
+    );
 
     let line = r#"{"type":"FeatureCollection","features":[{"type":"Feature","id":7,"properties":{},"geometry":{"type":"LineString","coordinates":[[5,52],[5.1,52]]}}]}"#;
     let e = err(line);
-    assert!(e.contains("feature 0 (id 7)") && e.contains("LineString"), "{e}");
+    assert!(
+        e.contains("feature 0 (id 7)") && e.contains("LineString"),
+        "{e}"
+    );
 
     let bad = r#"{"type":"Polygon","coordinates":[[[5,52],[5.1,952],[5.1,52.1],[5,52]]]}"#;
     let e = err(bad);
@@ -205,7 +219,10 @@ fn pnts(points: &[Vec2]) -> String {
         .iter()
         .map(|p| {
             let ll = frame.to_latlon(*p);
-            format!(r#"<PNT A="2" C="{:.9}" D="{:.9}"/>"#, ll.lat_deg, ll.lon_deg)
+            format!(
+                r#"<PNT A="2" C="{:.9}" D="{:.9}"/>"#,
+                ll.lat_deg, ll.lon_deg
+            )
         })
         .collect()
 }
@@ -241,7 +258,9 @@ fn taskdata_boundary_interior_ring_and_obstacle_polygon() {
     let area = signed_area(&outer) - 600.0 - 900.0;
     assert!((f.cleanup.area_after_m2 - area).abs() < 1.0);
 
-    let broken = xml.replace(r#"C="Pentagon""#, r#"C="P""#).replacen("C=\"5", "C=\"x5", 1);
+    let broken = xml
+        .replace(r#"C="Pentagon""#, r#"C="P""#)
+        .replacen("C=\"5", "C=\"x5", 1);
     let e = load_field(&broken, &opts()).unwrap_err().to_string();
     assert!(e.contains("PFD 0 (id PFD1)") && e.contains("PNT 0"), "{e}");
 }
