@@ -222,16 +222,24 @@ pub struct Trace {
 /// The work path being scored against the true pose, with its cumulative lengths.
 #[derive(Debug, Default)]
 struct ScoredPath {
+    /// (block, rank) of the guidance path this is.
+    key: Option<(u64, usize)>,
     points: Vec<Vec2>,
     cumulative: Vec<f64>,
 }
 
 impl ScoredPath {
-    fn first_point(&self) -> Option<Vec2> {
-        self.points.first().copied()
+    /// Whether this is the guidance's current path: the same (block, rank) and the same first
+    /// point. The first point alone is not enough: a field plan's transit starts exactly where
+    /// the closed headland pass before it started and ended.
+    fn is_current(&self, g: &crate::guidance::Guidance) -> bool {
+        self.key == Some((g.index_block(), g.index_rank()))
+            && self.points.first().copied() == g.global_path().first().map(|p| p.pos)
     }
 
-    fn set(&mut self, path: &[crate::geo::PathPoint]) {
+    fn set(&mut self, g: &crate::guidance::Guidance) {
+        self.key = Some((g.index_block(), g.index_rank()));
+        let path = g.global_path();
         self.points.clear();
         self.points.extend(path.iter().map(|p| p.pos));
         self.cumulative.clear();
@@ -527,9 +535,8 @@ pub fn run(
         let g = node.controller().guidance();
         let mut xte_abs = None;
         if let Some(score) = segment_scores.get_mut(g.index_rank()) {
-            let path = g.global_path();
-            if segment_path.first_point() != path.first().map(|p| p.pos) {
-                segment_path.set(path);
+            if !segment_path.is_current(g) {
+                segment_path.set(g);
             }
             if let Some((_, xte)) = segment_path.locate(&truth.pose.pos, g.index_global()) {
                 score.count += 1;
@@ -538,9 +545,8 @@ pub fn run(
             }
         }
         if g.phase() == Phase::Work {
-            let path = g.global_path();
-            if scored_path.first_point() != path.first().map(|p| p.pos) {
-                scored_path.set(path);
+            if !scored_path.is_current(g) {
+                scored_path.set(g);
                 if opts.record_trace {
                     trace.lines.push(scored_path.points.clone());
                 }
