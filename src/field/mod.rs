@@ -17,11 +17,13 @@
 //! change is reported in [`CleanupReport`].
 
 mod clean;
-pub mod output;
 mod geojson;
+pub mod job;
+pub mod output;
 mod taskdata;
 
 pub use clean::{clean_ring, RingCleanup};
+pub use job::{FieldJob, FieldJobError};
 
 use crate::geo::polygon::{contains_point, segments_intersect, signed_area};
 use crate::geo::wgs84::{EnuFrame, LatLon};
@@ -238,7 +240,12 @@ fn ring_inside(inner: &[Vec2], outer: &[Vec2]) -> bool {
     let m = outer.len();
     for i in 0..n {
         for j in 0..m {
-            if segments_intersect(&inner[i], &inner[(i + 1) % n], &outer[j], &outer[(j + 1) % m]) {
+            if segments_intersect(
+                &inner[i],
+                &inner[(i + 1) % n],
+                &outer[j],
+                &outer[(j + 1) % m],
+            ) {
                 return false;
             }
         }
@@ -254,7 +261,10 @@ fn assemble(
 ) -> Result<LoadedField, FieldError> {
     let boundary = match boundaries.len() {
         0 => return Err(FieldError::NoBoundary),
-        1 => boundaries.into_iter().next().ok_or(FieldError::NoBoundary)?,
+        1 => boundaries
+            .into_iter()
+            .next()
+            .ok_or(FieldError::NoBoundary)?,
         count => {
             return Err(FieldError::SeveralBoundaries {
                 count,
@@ -277,8 +287,13 @@ fn assemble(
             ..Default::default()
         },
     };
-    let (outer, a_before, a_after) =
-        acc.ring(&frame, &boundary.exterior, &boundary.label, "exterior ring", tol)?;
+    let (outer, a_before, a_after) = acc.ring(
+        &frame,
+        &boundary.exterior,
+        &boundary.label,
+        "exterior ring",
+        tol,
+    )?;
     let (mut area_before, mut area_after) = (a_before, a_after);
     // Holes of the boundary become obstacles, labelled after the boundary feature.
     for (k, hole) in boundary.holes.iter().enumerate() {
@@ -290,8 +305,13 @@ fn assemble(
     }
     let mut field_obstacles = Vec::new();
     for obstacle in &obstacles {
-        let (ring, before, after) =
-            acc.ring(&frame, &obstacle.exterior, &obstacle.label, "exterior ring", tol)?;
+        let (ring, before, after) = acc.ring(
+            &frame,
+            &obstacle.exterior,
+            &obstacle.label,
+            "exterior ring",
+            tol,
+        )?;
         if !ring_inside(&ring, &outer) {
             return Err(FieldError::ObstacleOutside {
                 feature: obstacle.label.clone(),
