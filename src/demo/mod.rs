@@ -158,6 +158,10 @@ pub struct Report {
     /// Segment jobs: true heading at the finish against the last segment's, degrees.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub goal_heading_error_deg: Option<f64>,
+    /// Field jobs: the plan that was driven (metrics and planning time). Filled in by the
+    /// caller, which planned it; `run` leaves it empty.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plan: Option<crate::field::output::PlanSummary>,
 }
 
 /// Tracking on one segment of a segment job, from the simulator's true pose over the whole
@@ -198,6 +202,9 @@ pub struct DemoOptions {
     pub job: Option<JobPlan>,
     /// Outlines drawn under the trace in the SVG (field boundary, obstacles, headland).
     pub outlines: Vec<Vec<Vec2>>,
+    /// ENU origin of the job's coordinates when it is not `job.origin_*` (a field plan:
+    /// [`FieldJob::origin`](crate::field::job::FieldJob::origin)).
+    pub origin: Option<crate::geo::wgs84::LatLon>,
 }
 
 /// A recorded point of the true trajectory.
@@ -343,6 +350,9 @@ pub fn run(
         Some(job) => ControllerNode::with_job(cfg, job.clone(), opts.resume.as_ref())?,
         None => ControllerNode::new(cfg, opts.resume.as_ref())?,
     };
+    if let Some(origin) = opts.origin {
+        node = node.with_origin(origin);
+    }
     let speed = cfg.speed();
     let start = match (&opts.resume, &opts.job) {
         (None, Some(JobPlan::Segments(_))) => node.controller().path_start_pose().map(|p| {
@@ -636,6 +646,7 @@ pub fn run(
         segments,
         goal_position_error_m,
         goal_heading_error_deg,
+        plan: None,
     };
     Ok(DemoRun {
         report,
