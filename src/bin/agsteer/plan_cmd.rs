@@ -26,10 +26,12 @@ pub fn timed<T>(what: &str, f: impl FnOnce() -> T) -> (T, Duration) {
             }
         });
         let out = f();
+        // Timed here: leaving the scope waits for the watcher's current sleep (up to 100 ms).
+        let elapsed = start.elapsed();
         done.store(true, std::sync::atomic::Ordering::Relaxed);
-        out
+        (out, elapsed)
     });
-    (out, start.elapsed())
+    out
 }
 
 /// `agsteer plan`, with the coverage planner passed in.
