@@ -79,7 +79,9 @@ pub struct JobConfig {
     /// at `field_path`).
     pub kind: JobKind,
     /// For `kind = "field"`: the field, a GeoJSON (WGS-84) or ISO 11783-10 TASKDATA.XML file.
-    /// A relative path is taken from the working directory.
+    /// A relative path is taken from the working directory (as every path in the
+    /// configuration), not from the configuration file's directory. Read and planned once
+    /// when agsteerd or `agsteer demo` starts.
     pub field_path: String,
     /// Point A of the first work line, local ENU [east, north], m.
     pub point_a_m: [f64; 2],
@@ -895,8 +897,9 @@ impl Config {
         c.problems
     }
 
-    /// The keys that cannot change while the daemon runs a job: those defining the job, the
-    /// bus identity and the control period. Returns the ones that differ in `new`.
+    /// The keys that cannot change while the daemon runs a job: those defining the job (the
+    /// field planning of `[field]` included), the bus identity and the control period.
+    /// Returns the ones that differ in `new`.
     pub fn fixed_key_changes(&self, new: &Config) -> Vec<&'static str> {
         let mut v = Vec::new();
         let mut check = |key: &'static str, same: bool| {
@@ -905,6 +908,7 @@ impl Config {
             }
         };
         check("job", self.job == new.job);
+        check("field", self.field == new.field);
         check("guidance", self.guidance == new.guidance);
         check(
             "vehicle.r_min_m",
@@ -1094,6 +1098,9 @@ mod tests {
             Config::parse_with("[job]\nline_width_m = 4.0\n[vehicle]\nr_min_m = 6.0\n", &[])
                 .unwrap();
         assert_eq!(a.fixed_key_changes(&moved), vec!["job", "vehicle.r_min_m"]);
+        // [field] shapes the running field plan: a SIGHUP cannot change it either.
+        let replanned = Config::parse_with("[field]\nheadland_passes = 1\n", &[]).unwrap();
+        assert_eq!(a.fixed_key_changes(&replanned), vec!["field"]);
     }
 
     #[test]

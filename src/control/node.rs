@@ -125,6 +125,14 @@ impl ControllerNode {
         Self::with_controller(cfg, Controller::with_job(cfg, plan, resume)?)
     }
 
+    /// Convert GNSS positions about `origin` instead of `job.origin_*`: the origin of the job's
+    /// local coordinates (a field plan is in its field's frame, see
+    /// [`FieldJob::origin`](crate::field::job::FieldJob::origin)).
+    pub fn with_origin(mut self, origin: LatLon) -> Self {
+        self.enu = EnuFrame::new(origin);
+        self
+    }
+
     fn with_controller(cfg: &Config, ctrl: Controller) -> Result<Self, ControlError> {
         Ok(ControllerNode {
             ctrl,

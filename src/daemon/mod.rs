@@ -1,5 +1,7 @@
-//! The daemon's I/O: the agsteerd runtime, progress files, systemd notifications.
+//! The daemon's I/O: the agsteerd runtime, progress files, the field file, systemd
+//! notifications.
 
+pub mod field_file;
 pub mod notify;
 pub mod progress_file;
 pub mod run;

@@ -7,12 +7,16 @@
 //! non-blocking write, and progress is handed to a writer thread through a bounded channel
 //! (a full channel skips a save rather than stall the loop; the next line change saves again).
 
-use super::progress_file;
+use super::{field_file, progress_file};
 use crate::can::bus::{monotonic_s, AsyncSocketCan, BusError, Filter};
 use crate::can::{Frame, TimedFrame};
-use crate::config::Config;
+use crate::config::{Config, JobKind};
 use crate::control::node::{ControllerNode, NodeStatus};
-use crate::guidance::progress::Progress;
+use crate::control::ControlError;
+use crate::geo::wgs84::LatLon;
+use crate::guidance::progress::{JobDefinition, Progress};
+use crate::guidance::JobPlan;
+use crate::plan::abline::AbPlan;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
@@ -31,7 +35,9 @@ pub enum DaemonError {
         source: std::io::Error,
     },
     #[error(transparent)]
-    Control(#[from] crate::control::ControlError),
+    Control(#[from] ControlError),
+    #[error("job.kind = \"field\": cannot prepare the field job")]
+    Field(#[source] crate::field::job::FieldJobError),
     #[error("runtime: {0}")]
     Runtime(std::io::Error),
 }
@@ -94,12 +100,69 @@ fn spawn_progress_writer(path: PathBuf) -> mpsc::SyncSender<Progress> {
     tx
 }
 
-/// Load saved progress for this job: `None` when there is none, it is corrupt (moved aside)
-/// or it belongs to another job.
-pub fn load_progress(cfg: &Config, path: &Path) -> Option<Progress> {
+/// The job agsteerd drives, prepared before the control loop starts.
+#[derive(Debug, Clone)]
+pub struct DaemonJob {
+    /// What the guidance drives: the configuration's AB lines or the field's coverage plan.
+    pub plan: JobPlan,
+    /// Its definition, saved with progress; progress saved under another one is not resumed.
+    pub definition: JobDefinition,
+    /// ENU origin of the plan's coordinates when it is not `job.origin_*` (a field plan).
+    pub origin: Option<LatLon>,
+}
+
+/// Prepare the configured job. For `job.kind = "field"` this reads `job.field_path` and plans
+/// its coverage: blocking work, done once at start-up, never in the control loop.
+pub fn prepare_job(cfg: &Config) -> Result<DaemonJob, DaemonError> {
+    let (plan, origin) = match cfg.job.kind {
+        JobKind::Ab => {
+            let plan = AbPlan::new(crate::control::ab_params(cfg)).map_err(ControlError::from)?;
+            (JobPlan::from(plan), None)
+        }
+        JobKind::Field => {
+            let start = std::time::Instant::now();
+            let fj = field_file::load(cfg).map_err(DaemonError::Field)?;
+            tracing::info!(
+                field = %fj.title(),
+                origin_lat_deg = fj.origin().lat_deg,
+                origin_lon_deg = fj.origin().lon_deg,
+                cells = fj.plan.cells,
+                swaths = fj.plan.swaths,
+                segments = fj.job.len(),
+                checksum = format_args!("{:08x}", fj.job.checksum()),
+                plan_ms = format_args!("{:.0}", start.elapsed().as_secs_f64() * 1e3),
+                "field job planned from {}",
+                fj.path.display()
+            );
+            (fj.job_plan(), Some(fj.origin()))
+        }
+    };
+    Ok(DaemonJob {
+        definition: JobDefinition::for_job(cfg, &plan),
+        plan,
+        origin,
+    })
+}
+
+/// The controller node for `job`, continuing `resume` (which must belong to it).
+pub fn build_node(
+    cfg: &Config,
+    job: &DaemonJob,
+    resume: Option<&Progress>,
+) -> Result<ControllerNode, ControlError> {
+    let node = ControllerNode::with_job(cfg, job.plan.clone(), resume)?;
+    Ok(match job.origin {
+        Some(origin) => node.with_origin(origin),
+        None => node,
+    })
+}
+
+/// Load saved progress for the job `expected`: `None` when there is none, it is corrupt (moved
+/// aside) or it belongs to another job (other parameters, or another field plan).
+pub fn load_progress(expected: &JobDefinition, path: &Path) -> Option<Progress> {
     match progress_file::load(path) {
         Ok(Some(p)) => {
-            if p.job == crate::guidance::progress::JobDefinition::from_config(cfg) {
+            if p.job == *expected {
                 tracing::info!(
                     lines_done = p.lines_done,
                     block = p.index_block,
@@ -108,6 +171,14 @@ pub fn load_progress(cfg: &Config, path: &Path) -> Option<Progress> {
                     path.display()
                 );
                 Some(p)
+            } else if p.job.plan_checksum != expected.plan_checksum {
+                tracing::warn!(
+                    "{} belongs to another field plan (checksum {}, this plan {}); starting this job from the beginning",
+                    path.display(),
+                    checksum_text(p.job.plan_checksum),
+                    checksum_text(expected.plan_checksum)
+                );
+                None
             } else {
                 tracing::warn!(
                     "{} belongs to another job (its parameters differ); starting this job from the beginning",
@@ -122,6 +193,10 @@ pub fn load_progress(cfg: &Config, path: &Path) -> Option<Progress> {
             None
         }
     }
+}
+
+fn checksum_text(c: Option<u32>) -> String {
+    c.map_or_else(|| "none (AB job)".into(), |c| format!("{c:08x}"))
 }
 
 /// Run this thread under SCHED_FIFO at `priority` (0 = leave it alone).
@@ -210,6 +285,8 @@ pub fn run(cfg: Config, source: ConfigSource) -> Result<(), DaemonError> {
 
 async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonError> {
     use tokio::signal::unix::{signal, SignalKind};
+    // The field is read and planned here, before the bus is opened and the loop starts.
+    let job = prepare_job(&cfg)?;
     let iface = cfg.bus.interface.clone();
     let bus = std::rc::Rc::new(AsyncSocketCan::open(&iface, &receive_filters()).map_err(
         |source| DaemonError::Open {
@@ -219,8 +296,9 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
     )?);
     let state_dir = PathBuf::from(&cfg.progress.state_dir);
     let progress_path = progress_file::progress_path(&state_dir);
-    let resume = load_progress(&cfg, &progress_path);
-    let mut node = ControllerNode::new(&cfg, resume.as_ref())?;
+    let resume = load_progress(&job.definition, &progress_path);
+    // The node is built once; a SIGHUP only retunes it (apply_reload), so the plan is kept.
+    let mut node = build_node(&cfg, &job, resume.as_ref())?;
     let progress_tx = spawn_progress_writer(progress_path.clone());
     // Helper threads exist now; only the control loop's thread gets real-time priority.
     set_realtime_priority(cfg.daemon.realtime_priority);
@@ -411,4 +489,93 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
         let _ = std::fs::remove_file(&cfg.bus.status_socket);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::guidance::progress::{Phase, PROGRESS_VERSION};
+
+    /// config/demo-field.toml; `job.field_path` is relative to the working directory, which
+    /// is the package root under `cargo test`.
+    fn demo_field_config(overrides: &[&str]) -> Config {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.toml");
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        Config::load(Path::new(path), &overrides).expect("config/demo-field.toml is valid")
+    }
+
+    fn progress(job: &JobDefinition) -> Progress {
+        Progress {
+            version: PROGRESS_VERSION,
+            job: job.clone(),
+            index_block: 0,
+            index_rank: 3,
+            phase: Phase::Work,
+            lines_done: 3,
+        }
+    }
+
+    #[test]
+    fn field_job_is_planned_and_its_progress_resumed() {
+        let cfg = demo_field_config(&[]);
+        let job = prepare_job(&cfg).expect("the demo field plans");
+        assert!(matches!(job.plan, JobPlan::Segments(_)));
+        assert!(job.definition.plan_checksum.is_some());
+        let dir = tempfile::tempdir().unwrap();
+        let path = progress_file::progress_path(dir.path());
+        progress_file::save(&path, &progress(&job.definition)).unwrap();
+        let resume = load_progress(&job.definition, &path).expect("same plan resumes");
+        let node = build_node(&cfg, &job, Some(&resume)).expect("node resumes");
+        assert_eq!(node.controller().guidance().lines_done(), 3);
+        // GNSS positions are converted about the field's origin, not job.origin_*.
+        let fj = field_file::load(&cfg).unwrap();
+        assert_eq!(*node.enu(), crate::geo::wgs84::EnuFrame::new(fj.origin()));
+        assert_ne!(fj.origin().lat_deg, cfg.job.origin_lat_deg);
+    }
+
+    #[test]
+    fn progress_saved_with_another_plan_checksum_is_not_resumed() {
+        let cfg = demo_field_config(&[]);
+        let job = prepare_job(&cfg).unwrap();
+        // One headland pass instead of two: every job key is the same, only the plan differs.
+        let other_cfg = demo_field_config(&["field.headland_passes=1"]);
+        let other = prepare_job(&other_cfg).unwrap();
+        assert_ne!(other.definition.plan_checksum, job.definition.plan_checksum);
+        let mut same_keys = other.definition.clone();
+        same_keys.plan_checksum = job.definition.plan_checksum;
+        assert_eq!(same_keys, job.definition, "only the checksum differs");
+
+        let dir = tempfile::tempdir().unwrap();
+        let path = progress_file::progress_path(dir.path());
+        progress_file::save(&path, &progress(&other.definition)).unwrap();
+        assert_eq!(load_progress(&job.definition, &path), None);
+        // The file is left alone (not corrupt), and is still good for its own plan.
+        assert!(load_progress(&other.definition, &path).is_some());
+        // Progress of an AB job (no checksum) does not resume a field job either.
+        progress_file::save(&path, &progress(&JobDefinition::from_config(&cfg))).unwrap();
+        assert_eq!(load_progress(&job.definition, &path), None);
+        // And the controller itself refuses it too.
+        let saved = progress(&other.definition);
+        assert!(build_node(&cfg, &job, Some(&saved)).is_err());
+    }
+
+    #[test]
+    fn ab_job_definition_is_the_configured_one() {
+        let cfg = Config::default();
+        let job = prepare_job(&cfg).unwrap();
+        assert!(job.origin.is_none());
+        assert_eq!(job.definition, JobDefinition::from_config(&cfg));
+    }
+
+    #[test]
+    fn an_unreadable_field_stops_the_daemon_naming_the_file() {
+        let cfg = demo_field_config(&["job.field_path=\"/nonexistent/agsteer/field.geojson\""]);
+        let e = prepare_job(&cfg).unwrap_err();
+        let text = format!("{:#}", anyhow::Error::new(e));
+        assert!(
+            text.contains("/nonexistent/agsteer/field.geojson"),
+            "{text}"
+        );
+        assert!(text.contains("job.field_path"), "{text}");
+    }
 }

@@ -158,6 +158,10 @@ pub struct Report {
     /// Segment jobs: true heading at the finish against the last segment's, degrees.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub goal_heading_error_deg: Option<f64>,
+    /// Field jobs: the plan that was driven (metrics and planning time). Filled in by the
+    /// caller, which planned it; `run` leaves it empty.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plan: Option<crate::field::output::PlanSummary>,
 }
 
 /// Tracking on one segment of a segment job, from the simulator's true pose over the whole
@@ -198,6 +202,9 @@ pub struct DemoOptions {
     pub job: Option<JobPlan>,
     /// Outlines drawn under the trace in the SVG (field boundary, obstacles, headland).
     pub outlines: Vec<Vec<Vec2>>,
+    /// ENU origin of the job's coordinates when it is not `job.origin_*` (a field plan:
+    /// [`FieldJob::origin`](crate::field::job::FieldJob::origin)).
+    pub origin: Option<crate::geo::wgs84::LatLon>,
 }
 
 /// A recorded point of the true trajectory.
@@ -222,16 +229,24 @@ pub struct Trace {
 /// The work path being scored against the true pose, with its cumulative lengths.
 #[derive(Debug, Default)]
 struct ScoredPath {
+    /// (block, rank) of the guidance path this is.
+    key: Option<(u64, usize)>,
     points: Vec<Vec2>,
     cumulative: Vec<f64>,
 }
 
 impl ScoredPath {
-    fn first_point(&self) -> Option<Vec2> {
-        self.points.first().copied()
+    /// Whether this is the guidance's current path: the same (block, rank) and the same first
+    /// point. The first point alone is not enough: a field plan's transit starts exactly where
+    /// the closed headland pass before it started and ended.
+    fn is_current(&self, g: &crate::guidance::Guidance) -> bool {
+        self.key == Some((g.index_block(), g.index_rank()))
+            && self.points.first().copied() == g.global_path().first().map(|p| p.pos)
     }
 
-    fn set(&mut self, path: &[crate::geo::PathPoint]) {
+    fn set(&mut self, g: &crate::guidance::Guidance) {
+        self.key = Some((g.index_block(), g.index_rank()));
+        let path = g.global_path();
         self.points.clear();
         self.points.extend(path.iter().map(|p| p.pos));
         self.cumulative.clear();
@@ -335,6 +350,9 @@ pub fn run(
         Some(job) => ControllerNode::with_job(cfg, job.clone(), opts.resume.as_ref())?,
         None => ControllerNode::new(cfg, opts.resume.as_ref())?,
     };
+    if let Some(origin) = opts.origin {
+        node = node.with_origin(origin);
+    }
     let speed = cfg.speed();
     let start = match (&opts.resume, &opts.job) {
         (None, Some(JobPlan::Segments(_))) => node.controller().path_start_pose().map(|p| {
@@ -527,9 +545,8 @@ pub fn run(
         let g = node.controller().guidance();
         let mut xte_abs = None;
         if let Some(score) = segment_scores.get_mut(g.index_rank()) {
-            let path = g.global_path();
-            if segment_path.first_point() != path.first().map(|p| p.pos) {
-                segment_path.set(path);
+            if !segment_path.is_current(g) {
+                segment_path.set(g);
             }
             if let Some((_, xte)) = segment_path.locate(&truth.pose.pos, g.index_global()) {
                 score.count += 1;
@@ -538,9 +555,8 @@ pub fn run(
             }
         }
         if g.phase() == Phase::Work {
-            let path = g.global_path();
-            if scored_path.first_point() != path.first().map(|p| p.pos) {
-                scored_path.set(path);
+            if !scored_path.is_current(g) {
+                scored_path.set(g);
                 if opts.record_trace {
                     trace.lines.push(scored_path.points.clone());
                 }
@@ -630,6 +646,7 @@ pub fn run(
         segments,
         goal_position_error_m,
         goal_heading_error_deg,
+        plan: None,
     };
     Ok(DemoRun {
         report,

@@ -18,10 +18,12 @@
 
 mod clean;
 mod geojson;
+pub mod job;
 pub mod output;
 mod taskdata;
 
 pub use clean::{clean_ring, RingCleanup};
+pub use job::{FieldJob, FieldJobError};
 
 use crate::geo::polygon::{contains_point, segments_intersect, signed_area};
 use crate::geo::wgs84::{EnuFrame, LatLon};

@@ -1,11 +1,76 @@
-//! Plan writers (pure, return strings): `plan.geojson` in WGS-84 and `plan.svg`.
+//! Plan writers (pure, return strings): `plan.geojson` in WGS-84 and `plan.svg`; the plan
+//! summary of `metrics.json` and of the demo report.
 
+use super::{CleanupReport, LoadedField};
 use crate::demo::svg::SvgCanvas;
 use crate::geo::wgs84::{EnuFrame, LatLon};
 use crate::geo::{Direction, Vec2};
 use crate::plan::coverage::metrics::PlanMetrics;
 use crate::plan::coverage::{Field, FieldPlan, SegmentKind};
+use serde::Serialize;
 use serde_json::{json, Value};
+use std::time::Duration;
+
+/// A plan's summary: `agsteer plan`'s `metrics.json` and the `plan` object of the demo
+/// report. Lengths m, areas m², fractions 0–1, times ms (measured by the caller).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlanSummary {
+    pub field: Option<String>,
+    pub origin: LatLon,
+    pub cleanup: CleanupReport,
+    pub cells: usize,
+    pub swaths: usize,
+    pub swath_angles_deg: Vec<f64>,
+    pub work_length_m: f64,
+    pub turn_length_m: f64,
+    pub transit_length_m: f64,
+    pub total_length_m: f64,
+    pub turns: usize,
+    pub reversals: usize,
+    pub covered_fraction: f64,
+    pub field_covered_fraction: f64,
+    pub overlap_fraction: f64,
+    pub outside_area_m2: f64,
+    pub obstacle_intrusions: usize,
+    pub max_curvature: f64,
+    pub turn_points_outside: usize,
+    pub plan_time_ms: f64,
+    pub metrics_time_ms: f64,
+}
+
+impl PlanSummary {
+    pub fn new(
+        loaded: &LoadedField,
+        plan: &FieldPlan,
+        m: &PlanMetrics,
+        plan_time: Duration,
+        metrics_time: Duration,
+    ) -> PlanSummary {
+        PlanSummary {
+            field: loaded.name.clone(),
+            origin: loaded.origin,
+            cleanup: loaded.cleanup,
+            cells: plan.cells,
+            swaths: plan.swaths,
+            swath_angles_deg: plan.swath_angles.iter().map(|a| a.to_degrees()).collect(),
+            work_length_m: m.work_length_m,
+            turn_length_m: m.turn_length_m,
+            transit_length_m: m.transit_length_m,
+            total_length_m: m.total_length_m,
+            turns: m.turns,
+            reversals: m.reversals,
+            covered_fraction: m.covered_fraction,
+            field_covered_fraction: m.field_covered_fraction,
+            overlap_fraction: m.overlap_fraction,
+            outside_area_m2: m.outside_area_m2,
+            obstacle_intrusions: m.obstacle_intrusions,
+            max_curvature: m.max_curvature,
+            turn_points_outside: m.turn_points_outside,
+            plan_time_ms: plan_time.as_secs_f64() * 1e3,
+            metrics_time_ms: metrics_time.as_secs_f64() * 1e3,
+        }
+    }
+}
 
 fn kind_name(k: SegmentKind) -> &'static str {
     match k {

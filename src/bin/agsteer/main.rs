@@ -4,9 +4,12 @@ mod dbc_cmd;
 mod plan_cmd;
 mod sim_cmd;
 
-use agsteer::config::Config;
-use agsteer::daemon::progress_file;
+use agsteer::config::{Config, JobKind};
+use agsteer::daemon::{field_file, progress_file};
 use agsteer::demo::{self, DemoOptions};
+use agsteer::field::job::{load_configured, FieldJob};
+use agsteer::field::output::PlanSummary;
+use agsteer::guidance::progress::JobDefinition;
 use agsteer::guidance::Event;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
@@ -218,6 +221,22 @@ fn log_event(t: f64, ev: &Event) {
     tracing::info!(t_s = format_args!("{t:.2}"), "{ev}");
 }
 
+/// A field job for the demo: `job.field_path` read, loaded and planned (timed), with the plan's
+/// summary for the report.
+fn prepare_field_job(cfg: &Config) -> Result<(FieldJob, PlanSummary)> {
+    let (path, text) = field_file::read_text(cfg)?;
+    let loaded = load_configured(cfg, &path, &text)?;
+    let (job, plan_time) = plan_cmd::timed("planning", || FieldJob::plan(cfg, &path, loaded));
+    let job = job?;
+    let (metrics, metrics_time) = plan_cmd::timed("metrics", || job.metrics());
+    let summary = PlanSummary::new(&job.loaded, &job.plan, &metrics, plan_time, metrics_time);
+    Ok((job, summary))
+}
+
+fn checksum_text(c: Option<u32>) -> String {
+    c.map_or_else(|| "none (AB job)".into(), |c| format!("{c:08x}"))
+}
+
 fn run_demo(
     config: &Path,
     out: &Path,
@@ -227,10 +246,37 @@ fn run_demo(
     set: &[String],
 ) -> Result<u8> {
     let cfg = load_config(config, set)?;
+    let field = match cfg.job.kind {
+        JobKind::Field => Some(
+            prepare_field_job(&cfg)
+                .with_context(|| format!("job.kind = \"field\" in {}", config.display()))?,
+        ),
+        JobKind::Ab => None,
+    };
+    let job = field.as_ref().map(|(fj, _)| fj.job_plan());
+    let expected = match &job {
+        Some(plan) => JobDefinition::for_job(&cfg, plan),
+        None => JobDefinition::from_config(&cfg),
+    };
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let progress_path = out.join(progress_file::PROGRESS_FILE_NAME);
     let resume_from = if resume {
         match progress_file::load(&progress_path) {
+            Ok(Some(p)) if p.job != expected => {
+                if p.job.plan_checksum != expected.plan_checksum {
+                    anyhow::bail!(
+                        "--resume: {} was saved for another field plan (checksum {}, this plan {}); run without --resume to start afresh",
+                        progress_path.display(),
+                        checksum_text(p.job.plan_checksum),
+                        checksum_text(expected.plan_checksum)
+                    );
+                }
+                anyhow::bail!(
+                    "--resume: {} belongs to another job (its job parameters differ from {}); run without --resume to start afresh",
+                    progress_path.display(),
+                    config.display()
+                );
+            }
             Ok(Some(p)) => {
                 tracing::info!(
                     lines_done = p.lines_done,
@@ -251,6 +297,12 @@ fn run_demo(
         resume: resume_from,
         stop_after_lines: stop_after,
         record_trace: true,
+        job,
+        outlines: field
+            .as_ref()
+            .map(|(fj, _)| fj.outlines())
+            .unwrap_or_default(),
+        origin: field.as_ref().map(|(fj, _)| fj.origin()),
         ..Default::default()
     };
     let mut save_error = None;
@@ -259,11 +311,12 @@ fn run_demo(
             save_error.get_or_insert(e);
         }
     };
-    let run =
+    let mut run =
         demo::run(&cfg, &opts, &mut on_progress, &mut log_event).context("running the demo job")?;
     if let Some(e) = save_error {
         tracing::error!("could not save progress: {e}");
     }
+    run.report.plan = field.as_ref().map(|(_, s)| s.clone());
     let report_json = serde_json::to_string_pretty(&run.report)?;
     std::fs::write(out.join("report.json"), format!("{report_json}\n"))
         .with_context(|| format!("writing {}/report.json", out.display()))?;
@@ -276,6 +329,22 @@ fn run_demo(
         println!("{report_json}");
     } else {
         let r = &run.report;
+        if let Some((fj, p)) = &field {
+            println!(
+                "plan of {}: {} cells, {} swaths, {} segments, {:.0} m ({:.0} m work, {:.0} m turns, {:.0} m transit); covered {:.2} % of the working area, outside {:.3} m²; planned in {:.0} ms",
+                fj.title(),
+                p.cells,
+                p.swaths,
+                fj.job.len(),
+                p.total_length_m,
+                p.work_length_m,
+                p.turn_length_m,
+                p.transit_length_m,
+                100.0 * p.covered_fraction,
+                p.outside_area_m2,
+                p.plan_time_ms
+            );
+        }
         println!(
             "{}: {}/{} lines, {} turns, {:.0} m in {:.0} s simulated ({:.2} s wall)",
             if r.finished {
@@ -300,6 +369,28 @@ fn run_demo(
             r.acquisition_xte_max_m * 100.0,
             r.tracker
         );
+        let worst = |by: fn(&demo::SegmentReport) -> f64| {
+            r.segments
+                .iter()
+                .max_by(|a, b| by(a).total_cmp(&by(b)))
+                .map(|s| {
+                    format!(
+                        "segment {} ({:?}, {:?}, {:.0} m): RMS {:.1} cm, max {:.1} cm",
+                        s.index,
+                        s.kind,
+                        s.direction,
+                        s.length_m,
+                        s.xte_rms_m * 100.0,
+                        s.xte_max_m * 100.0
+                    )
+                })
+        };
+        if let (Some(rms), Some(max)) = (worst(|s| s.xte_rms_m), worst(|s| s.xte_max_m)) {
+            println!("worst RMS on {rms}; worst max on {max}");
+        }
+        if let (Some(pos), Some(hdg)) = (r.goal_position_error_m, r.goal_heading_error_deg) {
+            println!("goal error: {:.1} cm, {:.2}°", pos * 100.0, hdg);
+        }
         println!("wrote {}/trace.svg and report.json", out.display());
     }
     Ok(0)

@@ -2,76 +2,16 @@
 //! `plan.geojson`, `plan.svg` and `metrics.json` into the output directory.
 
 use agsteer::config::Config;
-use agsteer::field::output::{plan_geojson, plan_svg};
-use agsteer::field::{load_field, CleanupReport, LoadedField};
-use agsteer::geo::wgs84::LatLon;
-use agsteer::plan::coverage::metrics::{plan_metrics, PlanMetrics};
+use agsteer::field::load_field;
+use agsteer::field::output::{plan_geojson, plan_svg, PlanSummary};
+use agsteer::plan::coverage::metrics::plan_metrics;
 use agsteer::plan::coverage::{CoverageParams, Field, FieldPlan};
 use anyhow::{Context, Result};
-use serde::Serialize;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-/// What `--json` prints (and `metrics.json` holds).
-#[derive(Serialize)]
-struct PlanSummary<'a> {
-    field: Option<&'a str>,
-    origin: LatLon,
-    cleanup: CleanupReport,
-    cells: usize,
-    swaths: usize,
-    swath_angles_deg: Vec<f64>,
-    work_length_m: f64,
-    turn_length_m: f64,
-    transit_length_m: f64,
-    total_length_m: f64,
-    turns: usize,
-    reversals: usize,
-    covered_fraction: f64,
-    field_covered_fraction: f64,
-    overlap_fraction: f64,
-    outside_area_m2: f64,
-    obstacle_intrusions: usize,
-    max_curvature: f64,
-    turn_points_outside: usize,
-    plan_time_ms: f64,
-    metrics_time_ms: f64,
-}
-
-fn summary<'a>(
-    loaded: &'a LoadedField,
-    plan: &FieldPlan,
-    m: &PlanMetrics,
-    plan_time: Duration,
-    metrics_time: Duration,
-) -> PlanSummary<'a> {
-    PlanSummary {
-        field: loaded.name.as_deref(),
-        origin: loaded.origin,
-        cleanup: loaded.cleanup,
-        cells: plan.cells,
-        swaths: plan.swaths,
-        swath_angles_deg: plan.swath_angles.iter().map(|a| a.to_degrees()).collect(),
-        work_length_m: m.work_length_m,
-        turn_length_m: m.turn_length_m,
-        transit_length_m: m.transit_length_m,
-        total_length_m: m.total_length_m,
-        turns: m.turns,
-        reversals: m.reversals,
-        covered_fraction: m.covered_fraction,
-        field_covered_fraction: m.field_covered_fraction,
-        overlap_fraction: m.overlap_fraction,
-        outside_area_m2: m.outside_area_m2,
-        obstacle_intrusions: m.obstacle_intrusions,
-        max_curvature: m.max_curvature,
-        turn_points_outside: m.turn_points_outside,
-        plan_time_ms: plan_time.as_secs_f64() * 1e3,
-        metrics_time_ms: metrics_time.as_secs_f64() * 1e3,
-    }
-}
-
 /// Run a step, reporting on stderr if it takes more than a second.
-fn timed<T>(what: &str, f: impl FnOnce() -> T) -> (T, Duration) {
+pub fn timed<T>(what: &str, f: impl FnOnce() -> T) -> (T, Duration) {
     let start = Instant::now();
     let done = std::sync::atomic::AtomicBool::new(false);
     let out = std::thread::scope(|s| {
@@ -86,10 +26,12 @@ fn timed<T>(what: &str, f: impl FnOnce() -> T) -> (T, Duration) {
             }
         });
         let out = f();
+        // Timed here: leaving the scope waits for the watcher's current sleep (up to 100 ms).
+        let elapsed = start.elapsed();
         done.store(true, std::sync::atomic::Ordering::Relaxed);
-        out
+        (out, elapsed)
     });
-    (out, start.elapsed())
+    out
 }
 
 /// `agsteer plan`, with the coverage planner passed in.
@@ -130,7 +72,7 @@ where
         "plan.svg",
         plan_svg(&loaded.field, &plan, loaded.origin, Some(&metrics), &title),
     )?;
-    let s = summary(&loaded, &plan, &metrics, plan_time, metrics_time);
+    let s = PlanSummary::new(&loaded, &plan, &metrics, plan_time, metrics_time);
     let summary_json = serde_json::to_string_pretty(&s)?;
     write("metrics.json", format!("{summary_json}\n"))?;
     if json {

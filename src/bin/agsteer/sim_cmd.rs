@@ -2,7 +2,7 @@
 
 use agsteer::can::bus::{monotonic_s, CanBus, SocketCanBus};
 use agsteer::can::Frame;
-use agsteer::config::Config;
+use agsteer::config::{Config, JobKind};
 use agsteer::demo::sim_params;
 use agsteer::geo::wgs84::{EnuFrame, LatLon};
 use agsteer::geo::{left_normal, v2, Pose};
@@ -34,8 +34,21 @@ pub fn run(
         }
         None => Scenario::default(),
     };
-    let a = v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]);
-    let b = v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]);
+    // A field job (as agsteerd drives it): the plan's frame, starting on its first segment.
+    let field = match cfg.job.kind {
+        JobKind::Field => {
+            Some(agsteer::daemon::field_file::load(cfg).context("job.kind = \"field\"")?)
+        }
+        JobKind::Ab => None,
+    };
+    let first = field.as_ref().and_then(|f| f.job.segments().first());
+    let (a, b) = match first.map(|s| s.points.as_slice()) {
+        Some([a, b, ..]) => (*a, *b),
+        _ => (
+            v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]),
+            v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]),
+        ),
+    };
     let dir = (b - a).normalize();
     let p = a + left_normal(&dir) * cfg.sim.start_offset_m;
     let start = Pose::new(
@@ -43,10 +56,13 @@ pub fn run(
         p.y,
         dir.y.atan2(dir.x) + cfg.sim.start_heading_deg.to_radians(),
     );
-    let enu = EnuFrame::new(LatLon {
-        lat_deg: cfg.job.origin_lat_deg,
-        lon_deg: cfg.job.origin_lon_deg,
-    });
+    let enu = EnuFrame::new(field.as_ref().map_or(
+        LatLon {
+            lat_deg: cfg.job.origin_lat_deg,
+            lon_deg: cfg.job.origin_lon_deg,
+        },
+        |f| f.origin(),
+    ));
     let mut node = SimNode::new(
         Simulator::new(sim_params(cfg), start, cfg.speed()),
         enu,

@@ -41,6 +41,22 @@ fn main() -> ExitCode {
         }
     };
     if args.check {
+        if cfg.job.kind == agsteer::config::JobKind::Field {
+            // The field must load and plan too, or the daemon would not start.
+            match agsteer::daemon::field_file::load(&cfg) {
+                Ok(fj) => println!(
+                    "{}: field {} plans into {} segments (checksum {:08x})",
+                    args.config.display(),
+                    fj.path.display(),
+                    fj.job.len(),
+                    fj.job.checksum()
+                ),
+                Err(e) => {
+                    eprintln!("{}: {:#}", args.config.display(), anyhow::Error::new(e));
+                    return ExitCode::from(2);
+                }
+            }
+        }
         println!("{}: valid", args.config.display());
         return ExitCode::SUCCESS;
     }

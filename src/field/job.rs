@@ -1,0 +1,205 @@
+//! A field job (`job.kind = "field"`): the configured field loaded, its coverage planned and
+//! the plan turned into the segment job the guidance drives. Shared by `agsteerd`,
+//! `agsteer demo` and `agsteer plan`.
+//!
+//! Works on text, like the rest of [`crate::field`]; reading `job.field_path` is done by
+//! [`crate::daemon::field_file`]. No clocks here: callers time the planning themselves.
+
+use super::{load_field, FieldError, LoadedField};
+use crate::config::Config;
+use crate::geo::wgs84::LatLon;
+use crate::geo::Vec2;
+use crate::guidance::progress::JobDefinition;
+use crate::guidance::segments::SegmentJob;
+use crate::guidance::JobPlan;
+use crate::plan::coverage::metrics::{plan_metrics, PlanMetrics};
+use crate::plan::coverage::{plan_field, CoverageParams, FieldPlan};
+use crate::plan::PlanError;
+use std::path::{Path, PathBuf};
+
+/// Why the field job could not be prepared. Every variant names the field file; the detail is
+/// the error's source.
+#[derive(Debug, thiserror::Error)]
+pub enum FieldJobError {
+    #[error("job.kind is not \"field\": there is no field to load")]
+    NotAFieldJob,
+    #[error("cannot read the field file {} (job.field_path)", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("field file {} (job.field_path)", path.display())]
+    Field {
+        path: PathBuf,
+        #[source]
+        source: FieldError,
+    },
+    #[error("cannot plan the coverage of {} ([field], job.line_width_m, vehicle.r_min_m)", path.display())]
+    Plan {
+        path: PathBuf,
+        #[source]
+        source: PlanError,
+    },
+    #[error("the coverage plan of {} cannot be driven as a segment job", path.display())]
+    Job {
+        path: PathBuf,
+        #[source]
+        source: PlanError,
+    },
+}
+
+/// Load the field text read from `path` with the configuration's `[field]` options.
+pub fn load_configured(
+    cfg: &Config,
+    path: &Path,
+    text: &str,
+) -> Result<LoadedField, FieldJobError> {
+    load_field(text, &cfg.field_load_options()).map_err(|source| FieldJobError::Field {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// A planned field job.
+#[derive(Debug, Clone)]
+pub struct FieldJob {
+    /// The field file it was read from.
+    pub path: PathBuf,
+    /// The field in local ENU metres about [`LoadedField::origin`].
+    pub loaded: LoadedField,
+    /// The planner's parameters (from the configuration).
+    pub params: CoverageParams,
+    pub plan: FieldPlan,
+    /// `plan` as the guidance drives it.
+    pub job: SegmentJob,
+}
+
+impl FieldJob {
+    /// Load the field text read from `path` and plan it, all from the configuration.
+    pub fn from_text(cfg: &Config, path: &Path, text: &str) -> Result<FieldJob, FieldJobError> {
+        let loaded = load_configured(cfg, path, text)?;
+        FieldJob::plan(cfg, path, loaded)
+    }
+
+    /// Plan a loaded field with the configuration's coverage parameters.
+    pub fn plan(cfg: &Config, path: &Path, loaded: LoadedField) -> Result<FieldJob, FieldJobError> {
+        let params = cfg.coverage_params();
+        let plan = plan_field(&loaded.field, &params).map_err(|source| FieldJobError::Plan {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        FieldJob::from_plan(path, loaded, params, plan)
+    }
+
+    /// A job from a plan made elsewhere (for example timed by the caller).
+    pub fn from_plan(
+        path: &Path,
+        loaded: LoadedField,
+        params: CoverageParams,
+        plan: FieldPlan,
+    ) -> Result<FieldJob, FieldJobError> {
+        let job = SegmentJob::from_field_plan(&plan).map_err(|source| FieldJobError::Job {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(FieldJob {
+            path: path.to_path_buf(),
+            loaded,
+            params,
+            plan,
+            job,
+        })
+    }
+
+    /// The plan for [`ControllerNode::with_job`](crate::control::node::ControllerNode::with_job).
+    pub fn job_plan(&self) -> JobPlan {
+        JobPlan::Segments(self.job.clone())
+    }
+
+    /// The job definition saved with progress: the configuration's job keys and this plan's
+    /// checksum. Progress saved under another definition must not be resumed.
+    pub fn job_definition(&self, cfg: &Config) -> JobDefinition {
+        JobDefinition::for_job(cfg, &self.job_plan())
+    }
+
+    /// The ENU origin of the plan's coordinates. GNSS positions must be converted about this
+    /// origin (it is `job.origin_*` only when `field.origin = "config"`).
+    pub fn origin(&self) -> LatLon {
+        self.loaded.origin
+    }
+
+    /// Outlines for drawing under a trace: the field boundary, the obstacles, then the
+    /// working area's rings (outer rings and holes), local m.
+    pub fn outlines(&self) -> Vec<Vec<Vec2>> {
+        let field = &self.loaded.field;
+        let mut out = vec![field.boundary.clone()];
+        out.extend(field.obstacles.iter().cloned());
+        for (outer, holes) in &self.plan.working_area {
+            out.push(outer.clone());
+            out.extend(holes.iter().cloned());
+        }
+        out
+    }
+
+    /// The plan's metrics (coverage from the implement footprint, lengths, curvature).
+    pub fn metrics(&self) -> PlanMetrics {
+        plan_metrics(&self.loaded.field, &self.plan, self.params.line_width)
+    }
+
+    /// A title for outputs: the field's name, else its file.
+    pub fn title(&self) -> String {
+        self.loaded
+            .name
+            .clone()
+            .unwrap_or_else(|| self.path.display().to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn demo_field_config() -> Config {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.toml");
+        Config::load(Path::new(path), &[]).expect("config/demo-field.toml is valid")
+    }
+
+    fn demo_field_text() -> String {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.geojson");
+        std::fs::read_to_string(path).expect("config/demo-field.geojson")
+    }
+
+    #[test]
+    fn demo_field_config_loads_plans_and_builds_a_segment_job() {
+        let cfg = demo_field_config();
+        assert_eq!(cfg.job.kind, crate::config::JobKind::Field);
+        let path = Path::new("demo-field.geojson");
+        let fj = FieldJob::from_text(&cfg, path, &demo_field_text()).expect("demo field plans");
+        assert_eq!(fj.loaded.field.obstacles.len(), 1, "one power pole");
+        assert!(
+            fj.plan.swaths > 0 && fj.plan.cells > 0,
+            "{:?}",
+            fj.plan.cells
+        );
+        assert_eq!(fj.job.len(), fj.plan.segments.len());
+        assert!(fj.job.len() > 10, "{} segments", fj.job.len());
+        // Boundary, obstacle and at least one working-area ring.
+        assert!(fj.outlines().len() >= 3);
+        // The job definition carries this plan's checksum, and a controller accepts the job.
+        let def = fj.job_definition(&cfg);
+        assert_eq!(def.plan_checksum, Some(fj.job.checksum()));
+        crate::control::node::ControllerNode::with_job(&cfg, fj.job_plan(), None)
+            .expect("the controller takes the field job");
+    }
+
+    #[test]
+    fn errors_name_the_file() {
+        let cfg = demo_field_config();
+        let path = Path::new("fields/broken.geojson");
+        let e = FieldJob::from_text(&cfg, path, "not a field").unwrap_err();
+        assert!(matches!(e, FieldJobError::Field { .. }), "{e:?}");
+        assert!(e.to_string().contains("fields/broken.geojson"), "{e}");
+        assert!(e.to_string().contains("job.field_path"), "{e}");
+    }
+}

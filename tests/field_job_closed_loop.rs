@@ -1,0 +1,152 @@
+//! The demo field job (config/demo-field.toml: an L-shaped field with a power pole, 12 m
+//! implement, r_min 6 m) planned and driven to the end in the in-process demo, scored against
+//! the simulator's ground truth.
+//!
+//! Bounds are about twice what the run measured when they were set (in brackets), so a real
+//! regression fails while noise does not.
+
+use agsteer::config::Config;
+use agsteer::daemon::{field_file, progress_file};
+use agsteer::demo::{run, DemoOptions, Report};
+use agsteer::field::job::FieldJob;
+use agsteer::guidance::progress::Progress;
+use agsteer::plan::coverage::SegmentKind;
+
+/// The demo-field configuration. `job.field_path` is relative to the working directory, the
+/// package root under `cargo test`.
+fn field_job() -> (Config, FieldJob) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.toml");
+    let cfg = Config::load(std::path::Path::new(path), &[]).expect("config/demo-field.toml");
+    let job = field_file::load(&cfg).expect("the demo field loads and plans");
+    (cfg, job)
+}
+
+fn options(job: &FieldJob) -> DemoOptions {
+    DemoOptions {
+        job: Some(job.job_plan()),
+        outlines: job.outlines(),
+        origin: Some(job.origin()),
+        ..Default::default()
+    }
+}
+
+fn check_tracking(r: &Report, segments: usize) {
+    assert!(r.finished, "not finished: {r:?}");
+    assert_eq!(r.lines_planned, Some(segments as u64));
+    assert_eq!(r.lines_completed, segments as u64);
+    assert_eq!(
+        r.segments.len(),
+        segments,
+        "every segment is driven and scored"
+    );
+    // Work phases (headland passes and swaths, first 10 m of each skipped).
+    assert!(r.xte_rms_m < 0.05, "work XTE RMS {} m [0.023]", r.xte_rms_m);
+    assert!(r.xte_p95_m < 0.08, "work XTE p95 {} m [0.038]", r.xte_p95_m);
+    assert!(r.xte_max_m < 0.35, "work XTE max {} m [0.16]", r.xte_max_m);
+    assert!(
+        r.acquisition_xte_max_m < 0.10,
+        "acquisition {} m [0.017]",
+        r.acquisition_xte_max_m
+    );
+    // Every segment over its whole length (acquisition included). Turns are planned at
+    // r_min, where the wheels saturate: they are followed less tightly than the lines.
+    for s in &r.segments {
+        let (rms_bound, max_bound) = match s.kind {
+            SegmentKind::Work | SegmentKind::Headland => (0.2, 0.8), // [0.095, 0.36]
+            _ => (0.75, 1.2),                                        // [0.37, 0.61]
+        };
+        assert!(
+            s.xte_rms_m < rms_bound && s.xte_max_m < max_bound,
+            "segment {} ({:?}, {:.1} m): RMS {} m, max {} m",
+            s.index,
+            s.kind,
+            s.length_m,
+            s.xte_rms_m,
+            s.xte_max_m
+        );
+    }
+    let pos = r.goal_position_error_m.expect("goal error");
+    let heading = r.goal_heading_error_deg.expect("goal heading error");
+    assert!(pos < 0.15, "goal position error {pos} m [0.039]");
+    assert!(heading < 2.0, "goal heading error {heading}° [0.06]");
+    assert!(
+        r.engaged_fraction > 0.99,
+        "engaged {} [0.9993]",
+        r.engaged_fraction
+    );
+}
+
+#[test]
+fn demo_field_job_is_driven_to_the_end() {
+    let (cfg, job) = field_job();
+    let r = run(&cfg, &options(&job), &mut |_| {}, &mut |_, _| {})
+        .expect("the demo runs")
+        .report;
+    check_tracking(&r, job.job.len());
+}
+
+#[test]
+fn demo_field_job_resumes_its_own_plan_and_refuses_another() {
+    let (cfg, job) = field_job();
+    let dir = tempfile::tempdir().unwrap();
+    let path = progress_file::progress_path(dir.path());
+    let mut save = |p: &Progress| progress_file::save(&path, p).unwrap();
+    let half = run(
+        &cfg,
+        &DemoOptions {
+            stop_after_lines: Some(20),
+            ..options(&job)
+        },
+        &mut save,
+        &mut |_, _| {},
+    )
+    .unwrap();
+    assert!(!half.report.finished);
+    assert_eq!(half.finished_lines.len(), 20);
+    let saved = progress_file::load(&path).unwrap().expect("progress saved");
+    // A segment job counts every segment (turns and transits too) as a line done.
+    assert_eq!(saved.lines_done, half.report.lines_completed);
+    assert!(saved.lines_done >= 20);
+    assert_eq!(saved.job, job.job_definition(&cfg));
+
+    // Another plan of the same field (one headland pass) must not take this progress.
+    let overrides = ["field.headland_passes=1".to_string()];
+    let other_cfg = Config::load(
+        std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/config/demo-field.toml"
+        )),
+        &overrides,
+    )
+    .unwrap();
+    let other = field_file::load(&other_cfg).unwrap();
+    assert_ne!(other.job.checksum(), job.job.checksum());
+    let refused = run(
+        &other_cfg,
+        &DemoOptions {
+            resume: Some(saved.clone()),
+            ..options(&other)
+        },
+        &mut |_| {},
+        &mut |_, _| {},
+    );
+    assert!(refused.is_err(), "progress of another plan was resumed");
+
+    let rest = run(
+        &cfg,
+        &DemoOptions {
+            resume: Some(saved),
+            ..options(&job)
+        },
+        &mut |_| {},
+        &mut |_, _| {},
+    )
+    .unwrap();
+    assert!(rest.report.finished, "{:?}", rest.report);
+    assert_eq!(rest.report.lines_completed, job.job.len() as u64);
+    // The work segments finished across both runs are those of an uninterrupted run, once.
+    let full = run(&cfg, &options(&job), &mut |_| {}, &mut |_, _| {}).unwrap();
+    let mut both = half.finished_lines.clone();
+    both.extend(&rest.finished_lines);
+    assert_eq!(both, full.finished_lines);
+}
