@@ -473,7 +473,8 @@ pub struct FieldConfig {
     pub swath_angle_deg: f64,
     /// Swath order in a cell: "auto", "sequential" or "skip".
     pub route: crate::plan::coverage::RouteOrder,
-    /// Obstacles at most this wide across the swaths get a detour; larger ones split cells, m.
+    /// Obstacles whose largest dimension is at most this are passed on detours; larger ones get
+    /// headland passes and split the swaths, m.
     pub small_obstacle_max_m: f64,
     /// Boundary clean-up tolerance (largest distance of a dropped point), m; 0 = no fitting.
     pub boundary_tolerance_m: f64,
@@ -488,7 +489,7 @@ impl Default for FieldConfig {
             swath_angle: SwathAngleChoice::MinSpan,
             swath_angle_deg: 0.0,
             route: crate::plan::coverage::RouteOrder::Auto,
-            small_obstacle_max_m: 12.0,
+            small_obstacle_max_m: 15.0,
             boundary_tolerance_m: 0.1,
             origin: FieldOrigin::Auto,
         }

@@ -40,14 +40,17 @@ fn check_tracking(r: &Report, segments: usize) {
         "every segment is driven and scored"
     );
     // Work phases (headland passes and swaths, first 10 m of each skipped).
-    // Measured figures in brackets; the obstacle's headland passes are circles of 12 and
-    // 24 m radius entered from a transit.
-    assert!(r.xte_rms_m < 0.05, "work XTE RMS {} m [0.027]", r.xte_rms_m);
-    assert!(r.xte_p95_m < 0.10, "work XTE p95 {} m [0.058]", r.xte_p95_m);
+    assert!(
+        r.segments.iter().any(|s| s.kind == SegmentKind::Detour),
+        "the pole is passed on a detour"
+    );
+    // Measured figures in brackets (the detour round the pole counts as work).
+    assert!(r.xte_rms_m < 0.05, "work XTE RMS {} m [0.024]", r.xte_rms_m);
+    assert!(r.xte_p95_m < 0.10, "work XTE p95 {} m [0.044]", r.xte_p95_m);
     assert!(r.xte_max_m < 0.35, "work XTE max {} m [0.16]", r.xte_max_m);
     assert!(
         r.acquisition_xte_max_m < 0.30,
-        "acquisition {} m [0.156]",
+        "acquisition {} m [0.131]",
         r.acquisition_xte_max_m
     );
     // Every segment over its whole length (acquisition included). Turns are planned at
@@ -69,8 +72,8 @@ fn check_tracking(r: &Report, segments: usize) {
     }
     let pos = r.goal_position_error_m.expect("goal error");
     let heading = r.goal_heading_error_deg.expect("goal heading error");
-    assert!(pos < 0.15, "goal position error {pos} m [0.026]");
-    assert!(heading < 2.0, "goal heading error {heading}° [0.05]");
+    assert!(pos < 0.15, "goal position error {pos} m [0.028]");
+    assert!(heading < 2.0, "goal heading error {heading}° [0.10]");
     assert!(
         r.engaged_fraction > 0.99,
         "engaged {} [0.9993]",

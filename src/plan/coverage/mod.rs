@@ -99,8 +99,9 @@ pub struct CoverageParams {
     pub swath_angle: SwathAngle,
     /// Swath order inside each cell.
     pub route: RouteOrder,
-    /// Obstacles whose inflated extent across the swaths is at most this get an A* detour;
-    /// larger ones split the swaths, m.
+    /// Obstacles whose largest dimension ([`obstacle_size`]) is at most this are passed on
+    /// detours (the swaths run through them; each blocked stretch becomes a smooth path round
+    /// the obstacle); larger ones get headland passes and split the swaths, m.
     pub small_obstacle_max_m: f64,
 }
 
@@ -246,12 +247,24 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     let w = p.line_width;
     let half = w / 2.0;
     let margin = half + headland::CHORD_MARGIN;
+    // Small obstacles (seed 001) stay in the working area: the swaths run through them and
+    // each blocked stretch becomes a detour. Large ones get a headland and split the swaths.
+    let (small, large): (Vec<Vec<Vec2>>, Vec<Vec<Vec2>>) = field
+        .obstacles
+        .iter()
+        .cloned()
+        .partition(|o| obstacle_size(o) <= p.small_obstacle_max_m);
+    tracing::debug!(
+        small = small.len(),
+        large = large.len(),
+        "obstacles: small ones are passed on detours, large ones split the swaths"
+    );
     let safe = headland::subtract_obstacles(
         &geometry::offset(&[(field.boundary.clone(), vec![])], -margin),
-        &field.obstacles,
+        &large,
         margin,
     );
-    let working = headland::working_area(&field.boundary, &field.obstacles, p);
+    let working = headland::working_area(&field.boundary, &large, p);
     // Points are checked; the chords between them may cut a little inside the arcs.
     let clear_map = ClearMap::new(
         field,
@@ -433,11 +446,45 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         cut_next
     };
 
+    // A clear way from one pose on a swath to another past a small obstacle: A* over the
+    // clear waypoints, every edge a Dubins curve of radius r_min.
+    // First a single waypoint beside the obstacle (a smooth swerve), on either side, further
+    // out step by step; then the waypoint grid.
+    let detour = |from: Vec2, h0: f64, to: Vec2, h1: f64| -> Option<Vec<Vec2>> {
+        let mid = 0.5 * (from + to);
+        let side = crate::geo::left_normal(&crate::geo::heading_vec(h0));
+        for k in 1..=8 {
+            for sign in [1.0, -1.0] {
+                let via = mid + side * (sign * k as f64 * 0.5 * p.line_width);
+                if !clear(&via) {
+                    continue;
+                }
+                let a = transit::transit(from, h0, via, h0, p.r_min, p.point_spacing, &clear);
+                let b = transit::transit(via, h0, to, h1, p.r_min, p.point_spacing, &clear);
+                if let (Some((mut a, true)), Some((b, true))) = (a, b) {
+                    a.extend(b.into_iter().skip(1));
+                    return Some(a);
+                }
+            }
+        }
+        transit::route_graph(
+            from,
+            h0,
+            to,
+            h1,
+            p.r_min,
+            p.point_spacing,
+            &clear,
+            waypoint_grid(),
+            ROUTE_MAX_EXPANSIONS,
+        )
+    };
+
     // Headland passes: the field's (outermost first), then the obstacles' (nearest first),
     // those that keep clear of the field edge and the other obstacles.
     let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
         headland::headland_tracks(&field.boundary, p).into();
-    let mut obstacle_tracks: Vec<Vec<Vec2>> = headland::obstacle_tracks(&field.obstacles, p)
+    let mut obstacle_tracks: Vec<Vec<Vec2>> = headland::obstacle_tracks(&large, p)
         .into_iter()
         .filter(|t| {
             let ok = t.iter().all(&clear);
@@ -582,6 +629,7 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
             &mut segments,
             &mut at,
             &mut go_to,
+            &detour,
         )?;
     }
 
@@ -601,6 +649,85 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
 /// cell) → points cut from the path's start.
 type GoTo<'a> =
     dyn FnMut(&mut Vec<PlanSegment>, &mut Option<(Vec2, f64)>, &[Vec2], usize) -> usize + 'a;
+
+/// A clear path between two poses (position, heading) around a small obstacle.
+type Detour<'a> = dyn Fn(Vec2, f64, Vec2, f64) -> Option<Vec<Vec2>> + 'a;
+
+/// Largest dimension of an obstacle (greatest distance between two of its vertices), m.
+pub fn obstacle_size(ring: &[Vec2]) -> f64 {
+    let mut size: f64 = 0.0;
+    for (i, a) in ring.iter().enumerate() {
+        for b in &ring[i + 1..] {
+            size = size.max((b - a).norm());
+        }
+    }
+    size
+}
+
+/// Split a straight work piece where the implement would touch a small obstacle: the work
+/// stops `lead` points before the blocked stretch, a detour goes round it and the work resumes
+/// `lead` points after. Pieces that cannot be split are returned whole.
+fn split_for_detours(
+    pts: Vec<Vec2>,
+    lead: usize,
+    r_min: f64,
+    clear: &dyn Fn(&Vec2) -> bool,
+    detour: &Detour<'_>,
+) -> Vec<(SegmentKind, Vec<Vec2>)> {
+    let n = pts.len();
+    let blocked: Vec<usize> = (0..n).filter(|&i| !clear(&pts[i])).collect();
+    let (Some(&first), Some(&last)) = (blocked.first(), blocked.last()) else {
+        return vec![(SegmentKind::Work, pts)];
+    };
+    // Blocked stretches, merged when their leads would overlap.
+    let mut stretches: Vec<(usize, usize)> = Vec::new();
+    for &i in &blocked {
+        match stretches.last_mut() {
+            Some(s) if i <= s.1 + 2 * lead + 1 => s.1 = i,
+            _ => stretches.push((i, i)),
+        }
+    }
+    if first < lead || last + lead >= n {
+        return vec![(SegmentKind::Work, pts)];
+    }
+    let heading = vec_heading(&(pts[n - 1] - pts[0]));
+    let mut out = Vec::new();
+    let mut start = 0;
+    for (b0, b1) in stretches {
+        // The shortest lead (a quarter of `lead` first, to leave least unworked) whose clear
+        // detour has no loop (adds less than π·r_min to the straight it replaces); else the
+        // detour that adds least.
+        let candidates: Vec<(f64, usize, usize, Vec<Vec2>)> = (1..=4)
+            .filter_map(|q| {
+                let l = (lead * q).div_ceil(4);
+                let (a, b) = (b0.checked_sub(l)?, b1 + l);
+                if b >= n || a <= start {
+                    return None;
+                }
+                let way = detour(pts[a], heading, pts[b], heading)?;
+                let extra = transit::polyline_length(&way) - (pts[b] - pts[a]).norm();
+                Some((extra, a, b, way))
+            })
+            .collect();
+        let no_loop = candidates
+            .iter()
+            .position(|c| c.0 < std::f64::consts::PI * r_min);
+        let best = no_loop.or_else(|| {
+            (0..candidates.len()).min_by(|&i, &j| candidates[i].0.total_cmp(&candidates[j].0))
+        });
+        let found = best
+            .and_then(|i| candidates.into_iter().nth(i))
+            .map(|(_, a, b, way)| (a, b, way));
+        let Some((a, b, way)) = found else {
+            return vec![(SegmentKind::Work, pts)];
+        };
+        out.push((SegmentKind::Work, pts[start..=a].to_vec()));
+        out.push((SegmentKind::Detour, way));
+        start = b;
+    }
+    out.push((SegmentKind::Work, pts[start..].to_vec()));
+    out
+}
 
 /// The driving order of a run's swaths (indices into the run): adjacent ones in turn when the
 /// spacing allows a U-turn (or the operator chose sequential lines, with fishtails); otherwise
@@ -640,6 +767,7 @@ fn drive_run(
     segments: &mut Vec<PlanSegment>,
     at: &mut Option<(Vec2, f64)>,
     go_to: &mut GoTo<'_>,
+    detour: &Detour<'_>,
 ) -> Result<(), PlanError> {
     let order = run_order(run.len(), lines.spacing, p);
     let here = at.map(|a| a.0);
@@ -726,6 +854,18 @@ fn drive_run(
         }
         forward = !forward;
     }
+    // Detours round the small obstacles on the swaths.
+    let lead = ((2.0 * p.r_min + p.line_width) / p.point_spacing).ceil() as usize;
+    let pieces: Vec<(SegmentKind, Direction, Vec<Vec2>)> = pieces
+        .into_iter()
+        .flat_map(|(kind, direction, pts)| match kind {
+            SegmentKind::Work => split_for_detours(pts, lead, p.r_min, clear, detour)
+                .into_iter()
+                .map(|(k, pts)| (k, direction, pts))
+                .collect(),
+            _ => vec![(kind, direction, pts)],
+        })
+        .collect();
     // Drive: transit to the first swath, then the pieces in order.
     let mut first = true;
     for (kind, direction, mut pts) in pieces {
@@ -827,6 +967,55 @@ mod tests {
             );
         }
         plan
+    }
+
+    #[test]
+    fn small_obstacles_are_passed_on_detours_large_ones_split_the_swaths() {
+        let pole = vec![
+            v2(140.0, 70.0),
+            v2(148.0, 70.0),
+            v2(148.0, 78.0),
+            v2(140.0, 78.0),
+        ];
+        let field = Field {
+            boundary: vec![
+                v2(0.0, 0.0),
+                v2(300.0, 0.0),
+                v2(300.0, 150.0),
+                v2(0.0, 150.0),
+            ],
+            obstacles: vec![pole],
+        };
+        let mut p = params(6.0, 5.0, 2);
+        p.small_obstacle_max_m = 15.0;
+        let plan = check(&field, &p);
+        let detours: Vec<&PlanSegment> = plan
+            .segments
+            .iter()
+            .filter(|s| s.kind == SegmentKind::Detour)
+            .collect();
+        assert!(!detours.is_empty(), "the 8 m pole is passed on detours");
+        // Each detour leaves its swath and comes back to it: same line, same heading.
+        for d in &detours {
+            let (a, b) = (d.points[0], *d.points.last().unwrap());
+            assert!(
+                (a.y - b.y).abs() < 1e-6,
+                "detour {} ends on its line",
+                d.index
+            );
+        }
+        // Below the threshold, the same pole gets headland passes and no detour.
+        p.small_obstacle_max_m = 5.0;
+        let plan = check(&field, &p);
+        assert!(plan.segments.iter().all(|s| s.kind != SegmentKind::Detour));
+        assert!(
+            plan.segments
+                .iter()
+                .filter(|s| s.kind == SegmentKind::Headland)
+                .count()
+                > 2,
+            "field passes and obstacle passes"
+        );
     }
 
     #[test]

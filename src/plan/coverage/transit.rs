@@ -216,7 +216,8 @@ impl WaypointGrid {
     }
 }
 
-fn polyline_length(points: &[Vec2]) -> f64 {
+/// Length of a polyline, m.
+pub fn polyline_length(points: &[Vec2]) -> f64 {
     points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
 
