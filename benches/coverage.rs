@@ -60,6 +60,9 @@ fn stages(c: &mut Criterion) {
     g.bench_function("headland_tracks", |b| {
         b.iter(|| headland::headland_tracks(black_box(&field.boundary), &p))
     });
+    g.bench_function("obstacle_tracks", |b| {
+        b.iter(|| headland::obstacle_tracks(black_box(&field.obstacles), &p))
+    });
     let working = headland::working_area(&field.boundary, &field.obstacles, &p);
     g.bench_function("working_area", |b| {
         b.iter(|| headland::working_area(black_box(&field.boundary), &field.obstacles, &p))
@@ -78,6 +81,14 @@ fn stages(c: &mut Criterion) {
     });
     g.bench_function("whole_plan", |b| {
         b.iter(|| plan_field(black_box(&field), &p))
+    });
+    // The same field with its 20 × 14 m obstacle passed on detours instead.
+    let detour_params = CoverageParams {
+        small_obstacle_max_m: 30.0,
+        ..p.clone()
+    };
+    g.bench_function("whole_plan_obstacle_detoured", |b| {
+        b.iter(|| plan_field(black_box(&field), &detour_params))
     });
     g.finish();
 }

@@ -254,6 +254,16 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         .iter()
         .cloned()
         .partition(|o| obstacle_size(o) <= p.small_obstacle_max_m);
+    // Each small obstacle as a disc (centre, radius + w/2 + 1 m), to find the swaths that pass
+    // near one without checking every point of every swath.
+    let small_discs: Vec<(Vec2, f64)> = small
+        .iter()
+        .map(|o| {
+            let c = o.iter().fold(v2(0.0, 0.0), |a, q| a + q) / o.len().max(1) as f64;
+            let r = o.iter().map(|q| (q - c).norm()).fold(0.0, f64::max);
+            (c, r + half + 1.0)
+        })
+        .collect();
     tracing::debug!(
         small = small.len(),
         large = large.len(),
@@ -630,6 +640,7 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
             &mut at,
             &mut go_to,
             &detour,
+            &small_discs,
         )?;
     }
 
@@ -768,6 +779,7 @@ fn drive_run(
     at: &mut Option<(Vec2, f64)>,
     go_to: &mut GoTo<'_>,
     detour: &Detour<'_>,
+    small_discs: &[(Vec2, f64)],
 ) -> Result<(), PlanError> {
     let order = run_order(run.len(), lines.spacing, p);
     let here = at.map(|a| a.0);
@@ -859,10 +871,18 @@ fn drive_run(
     let pieces: Vec<(SegmentKind, Direction, Vec<Vec2>)> = pieces
         .into_iter()
         .flat_map(|(kind, direction, pts)| match kind {
-            SegmentKind::Work => split_for_detours(pts, lead, p.r_min, clear, detour)
-                .into_iter()
-                .map(|(k, pts)| (k, direction, pts))
-                .collect(),
+            SegmentKind::Work
+                if pts.len() >= 2
+                    && small_discs.iter().any(|(c, r)| {
+                        crate::geo::polygon::point_segment_distance(c, &pts[0], &pts[pts.len() - 1])
+                            <= *r
+                    }) =>
+            {
+                split_for_detours(pts, lead, p.r_min, clear, detour)
+                    .into_iter()
+                    .map(|(k, pts)| (k, direction, pts))
+                    .collect()
+            }
             _ => vec![(kind, direction, pts)],
         })
         .collect();
