@@ -69,6 +69,8 @@ pub enum TrackerChoice {
     Predictive,
     /// Plain seed-000 pure pursuit on the latest fix: the reference.
     PurePursuit,
+    /// Stanley steering on the same latency-compensated, dead-reckoned pose.
+    Stanley,
 }
 
 /// `[job]`: what to drive.
@@ -228,6 +230,18 @@ pub struct TrackConfig {
     pub gnss_latency_s: f64,
     /// Extra prediction horizon (about the actuator dead time), s. Predictive only.
     pub lead_time_s: f64,
+    /// Stanley cross-track gain k, 1/s: δ = ψ + atan(k·e / (v + stanley_soft_speed_mps)).
+    pub stanley_gain_per_s: f64,
+    /// Stanley softening speed, m/s.
+    pub stanley_soft_speed_mps: f64,
+    /// Integral action on the XTE, rad of wheel angle per (m · s); 0 = off.
+    pub integral_gain_rad_per_m_s: f64,
+    /// Largest wheel-angle offset the integral action may learn, degrees.
+    pub integral_limit_deg: f64,
+    /// The integral action learns only while |XTE| is below this, m.
+    pub integral_capture_m: f64,
+    /// The integral action learns only above this speed, m/s.
+    pub integral_min_speed_mps: f64,
 }
 
 impl Default for TrackConfig {
@@ -242,6 +256,12 @@ impl Default for TrackConfig {
             local_spacing_m: 0.1,
             gnss_latency_s: 0.05,
             lead_time_s: 0.05,
+            stanley_gain_per_s: 2.5,
+            stanley_soft_speed_mps: 1.0,
+            integral_gain_rad_per_m_s: 0.0,
+            integral_limit_deg: 3.0,
+            integral_capture_m: 0.3,
+            integral_min_speed_mps: 0.5,
         }
     }
 }
@@ -793,6 +813,27 @@ impl Config {
         c.range("track.local_spacing_m", t.local_spacing_m, 0.01, 1.0);
         c.range("track.gnss_latency_s", t.gnss_latency_s, 0.0, 1.0);
         c.range("track.lead_time_s", t.lead_time_s, 0.0, 1.0);
+        c.range("track.stanley_gain_per_s", t.stanley_gain_per_s, 0.0, 50.0);
+        c.range(
+            "track.stanley_soft_speed_mps",
+            t.stanley_soft_speed_mps,
+            0.01,
+            10.0,
+        );
+        c.range(
+            "track.integral_gain_rad_per_m_s",
+            t.integral_gain_rad_per_m_s,
+            0.0,
+            1.0,
+        );
+        c.range("track.integral_limit_deg", t.integral_limit_deg, 0.0, 10.0);
+        c.range("track.integral_capture_m", t.integral_capture_m, 0.01, 5.0);
+        c.range(
+            "track.integral_min_speed_mps",
+            t.integral_min_speed_mps,
+            0.0,
+            10.0,
+        );
 
         let s = &self.sim;
         c.range("sim.step_s", s.step_s, 0.0001, 0.01);

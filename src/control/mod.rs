@@ -13,7 +13,10 @@ use crate::guidance::{Guidance, GuidanceError, GuidanceParams, JobPlan};
 use crate::plan::abline::{AbParams, AbPlan, Side};
 use crate::plan::turns::TurnParams;
 use crate::track::local_path::LocalPathParams;
-use crate::track::{pure_pursuit, steering_from_travel, travel_pose, TrackOutput, TrackerParams};
+use crate::track::{
+    pure_pursuit, stanley, steering_from_travel, travel_pose, IntegralAction, TrackOutput,
+    TrackerParams,
+};
 
 pub mod node;
 
@@ -68,7 +71,7 @@ pub fn tracker_params(cfg: &Config) -> TrackerParams {
 /// The estimator's parameters: the predictive tracker compensates latency and dead-reckons,
 /// plain pure pursuit uses the latest fix as it is.
 pub fn estimator_params(cfg: &Config) -> EstimatorParams {
-    let predictive = cfg.track.kind == TrackerChoice::Predictive;
+    let predictive = cfg.track.kind != TrackerChoice::PurePursuit;
     EstimatorParams {
         wheelbase: cfg.vehicle.wheelbase_m,
         antenna: AntennaOffset {
@@ -118,11 +121,51 @@ pub enum ControlError {
     NoPlan,
 }
 
+/// The steering law and its gains from `[track]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LawParams {
+    pub kind: TrackerChoice,
+    pub stanley_gain: f64,
+    pub stanley_soft_speed: f64,
+}
+
+/// The steering law from the configuration.
+pub fn law_params(cfg: &Config) -> LawParams {
+    LawParams {
+        kind: cfg.track.kind,
+        stanley_gain: cfg.track.stanley_gain_per_s,
+        stanley_soft_speed: cfg.track.stanley_soft_speed_mps,
+    }
+}
+
+/// The integral action from the configuration (off for the plain pure-pursuit reference),
+/// keeping an offset already learnt.
+fn integral_action(cfg: &Config, learnt: f64) -> IntegralAction {
+    let t = &cfg.track;
+    let gain = if t.kind == TrackerChoice::PurePursuit {
+        0.0
+    } else {
+        t.integral_gain_rad_per_m_s
+    };
+    let limit = t.integral_limit_deg.to_radians();
+    IntegralAction {
+        gain,
+        limit,
+        capture: t.integral_capture_m,
+        min_speed: t.integral_min_speed_mps,
+        offset: learnt.clamp(-limit, limit),
+    }
+}
+
 /// Estimation, guidance and tracking for one job.
 pub struct Controller {
     estimator: Estimator,
     guidance: Guidance,
     tracker: TrackerParams,
+    law: LawParams,
+    integral: IntegralAction,
+    /// Time of the previous tick, s.
+    last_tick: Option<f64>,
 }
 
 impl Controller {
@@ -150,6 +193,9 @@ impl Controller {
             estimator: Estimator::new(estimator_params(cfg)),
             guidance,
             tracker: tracker_params(cfg),
+            law: law_params(cfg),
+            integral: integral_action(cfg, 0.0),
+            last_tick: None,
         })
     }
 
@@ -186,15 +232,35 @@ impl Controller {
         let direction = self.guidance.direction();
         out.direction = direction;
         // Reverse segments are tracked about the rear axle in the driving direction.
-        let tr = steering_from_travel(
-            pure_pursuit(
-                self.guidance.local_path(),
-                &travel_pose(&est.pose, direction),
+        let pose = travel_pose(&est.pose, direction);
+        let local = self.guidance.local_path();
+        let law = match self.law.kind {
+            TrackerChoice::Stanley => stanley(
+                local,
+                &pose,
                 est.speed.abs(),
                 &self.tracker,
+                self.law.stanley_gain,
+                self.law.stanley_soft_speed,
             ),
-            direction,
-        );
+            TrackerChoice::Predictive | TrackerChoice::PurePursuit => {
+                pure_pursuit(local, &pose, est.speed.abs(), &self.tracker)
+            }
+        };
+        let mut tr = steering_from_travel(law, direction);
+        // Integral action: learnt on work paths driven forward, applied on every path (the
+        // disturbances it cancels do not stop at a line's end).
+        let dt = self.last_tick.map_or(0.0, |last| t - last);
+        self.last_tick = Some(t);
+        let learning =
+            direction == Direction::Forward && self.guidance.tag() == crate::geo::Tag::Work;
+        let offset = self
+            .integral
+            .update(out.xte.unwrap_or(f64::NAN), est.speed, dt, learning);
+        if offset != 0.0 && tr.valid {
+            let max = self.tracker.max_wheel_angle;
+            tr.wheel_angle = (tr.wheel_angle + offset).clamp(-max, max);
+        }
         if tr.wheel_angle.is_finite() {
             out.wheel_angle = Some(tr.wheel_angle);
         }
@@ -205,6 +271,8 @@ impl Controller {
     /// Replace the tracker and estimator tuning (look-ahead, gains, latency) at once.
     pub fn set_tuning(&mut self, cfg: &Config) {
         self.tracker = tracker_params(cfg);
+        self.law = law_params(cfg);
+        self.integral = integral_action(cfg, self.integral.offset);
         self.estimator.set_params(estimator_params(cfg));
     }
 

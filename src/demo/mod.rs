@@ -318,6 +318,7 @@ fn tracker_name(kind: TrackerChoice) -> &'static str {
     match kind {
         TrackerChoice::Predictive => "predictive",
         TrackerChoice::PurePursuit => "pure_pursuit",
+        TrackerChoice::Stanley => "stanley",
     }
 }
 

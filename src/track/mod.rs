@@ -95,6 +95,106 @@ pub fn point_along(points: &[Vec2], start: usize, distance: f64) -> Vec2 {
     points.last().copied().unwrap_or_else(Vec2::zeros)
 }
 
+/// Stanley steering (Hoffmann et al. 2007) on the local path: with the front axle's signed
+/// distance `e` to the path (positive = path to its left) and the heading error ψ = path
+/// heading − vehicle heading at the front axle's nearest point,
+/// δ = ψ + atan(k·e / (v + v_soft)), clamped to ±max_wheel_angle. `gain` is k (1/s),
+/// `soft_speed` is v_soft (m/s).
+pub fn stanley(
+    local: &LocalPath,
+    pose: &Pose,
+    speed: f64,
+    params: &TrackerParams,
+    gain: f64,
+    soft_speed: f64,
+) -> TrackOutput {
+    let points = local.points();
+    let front = pose.pos + heading_vec(pose.heading) * params.wheelbase;
+    let invalid = TrackOutput {
+        wheel_angle: 0.0,
+        curvature: 0.0,
+        lookahead: 0.0,
+        target: front,
+        alpha: 0.0,
+        valid: false,
+    };
+    if points.len() < 2 || !front.x.is_finite() || !front.y.is_finite() || !speed.is_finite() {
+        return invalid;
+    }
+    // Nearest sample to the front axle, searching forward from the rear axle's.
+    let mut best = (f64::INFINITY, local.index_local().min(points.len() - 2));
+    for (i, q) in points.iter().enumerate().skip(local.index_local()) {
+        let d = (q - front).norm();
+        if d < best.0 {
+            best = (d, i);
+        } else if d > best.0 + 2.0 * params.wheelbase {
+            break;
+        }
+    }
+    let i = best.1.min(points.len() - 2);
+    let tangent = points[i + 1] - points[i];
+    if tangent.norm() <= 0.0 {
+        return invalid;
+    }
+    let path_heading = tangent.y.atan2(tangent.x);
+    let h = heading_vec(pose.heading);
+    let psi = crate::geo::wrap_angle(path_heading - pose.heading);
+    let e = -cross(&tangent.normalize(), &(points[i] - front));
+    // e > 0: the front axle is left of the path, steer right.
+    let delta = psi + (-gain * e).atan2(speed.abs() + soft_speed);
+    let max = params.max_wheel_angle;
+    let wheel_angle = delta.clamp(-max, max);
+    TrackOutput {
+        wheel_angle,
+        curvature: wheel_angle.tan() / params.wheelbase,
+        lookahead: (points[i] - pose.pos).norm(),
+        target: points[i],
+        alpha: cross(&h, &(points[i] - pose.pos)).atan2(h.dot(&(points[i] - pose.pos))),
+        valid: true,
+    }
+}
+
+/// Integral action on the cross-track error: a slowly learnt wheel-angle offset that cancels
+/// steady disturbances a pure geometric law leaves as a standing error (a wheel-angle sensor
+/// bias, side-slope slip). It learns only on work paths, driving forward, above a speed and
+/// within a capture band of the line, and is clamped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IntegralAction {
+    /// Gain, rad of wheel angle per (m of XTE · s).
+    pub gain: f64,
+    /// Largest offset, rad.
+    pub limit: f64,
+    /// Learns only while |XTE| is below this, m.
+    pub capture: f64,
+    /// Learns only above this speed, m/s.
+    pub min_speed: f64,
+    /// The learnt offset, rad (positive = left).
+    pub offset: f64,
+}
+
+impl IntegralAction {
+    /// Learn from one period of `dt` s with cross-track error `xte` (m, positive = left of
+    /// the path) when `learning`, and return the offset to add to the wheel angle, rad.
+    pub fn update(&mut self, xte: f64, speed: f64, dt: f64, learning: bool) -> f64 {
+        if self.gain > 0.0
+            && learning
+            && xte.is_finite()
+            && dt.is_finite()
+            && dt > 0.0
+            && dt < 1.0
+            && xte.abs() < self.capture
+            && speed.abs() >= self.min_speed
+        {
+            self.offset = (self.offset - self.gain * xte * dt).clamp(-self.limit, self.limit);
+        }
+        if self.gain > 0.0 {
+            self.offset
+        } else {
+            0.0
+        }
+    }
+}
+
 /// Seed-000 pure pursuit: from the nearest local point integrate the look-ahead along the
 /// local path to the preview point; α is the angle from the heading to it;
 /// κ = 2·sin α / Ld and δ = atan(L·κ).
@@ -183,6 +283,57 @@ mod tests {
         let on = Pose::new(10.0, 0.0, 0.0);
         let out = pure_pursuit(&straight_local(&on.pos), &on, 2.0, &params());
         assert!(out.wheel_angle.abs() < 1e-9);
+    }
+
+    #[test]
+    fn stanley_steers_back_and_corrects_heading() {
+        let p = params();
+        let left = Pose::new(10.0, 0.5, 0.0);
+        let out = stanley(&straight_local(&left.pos), &left, 2.0, &p, 2.5, 1.0);
+        assert!(
+            out.valid && out.wheel_angle < 0.0,
+            "left steers right: {out:?}"
+        );
+        // atan(2.5·0.5 / 3) exactly, on a straight with no heading error.
+        assert!((out.wheel_angle + (2.5f64 * 0.5 / 3.0).atan()).abs() < 1e-6);
+        let right = Pose::new(10.0, -0.5, 0.0);
+        let out = stanley(&straight_local(&right.pos), &right, 2.0, &p, 2.5, 1.0);
+        assert!(out.wheel_angle > 0.0, "right steers left");
+        // On the line, heading 0.1 rad to the left: steer right by about that much.
+        let skew = Pose::new(10.0, -0.3, 0.1);
+        let on_front = stanley(&straight_local(&skew.pos), &skew, 2.0, &p, 0.0, 1.0);
+        assert!((on_front.wheel_angle + 0.1).abs() < 1e-6, "{on_front:?}");
+        let bad = Pose::new(f64::NAN, 0.0, 0.0);
+        assert!(!stanley(&straight_local(&left.pos), &bad, 2.0, &p, 2.5, 1.0).valid);
+    }
+
+    #[test]
+    fn integral_action_learns_only_when_allowed_and_is_clamped() {
+        let mut i = IntegralAction {
+            gain: 0.1,
+            limit: 0.02,
+            capture: 0.3,
+            min_speed: 0.5,
+            offset: 0.0,
+        };
+        // Left of the line (positive XTE): the offset turns right, 0.1 · 0.05 · 1 s.
+        let o = i.update(0.05, 3.0, 1.0 / 3.0, true);
+        assert!(o < 0.0);
+        i.update(0.05, 3.0, 1.0 / 3.0, true);
+        i.update(0.05, 3.0, 1.0 / 3.0, true);
+        assert!((i.offset + 0.1 * 0.05).abs() < 1e-12, "{}", i.offset);
+        let before = i.offset;
+        i.update(0.05, 3.0, 0.1, false); // not learning (a turn)
+        i.update(0.5, 3.0, 0.1, true); // outside the capture band
+        i.update(0.05, 0.1, 0.1, true); // too slow
+        i.update(f64::NAN, 3.0, 0.1, true);
+        assert_eq!(i.offset, before);
+        for _ in 0..10_000 {
+            i.update(-0.2, 3.0, 0.1, true);
+        }
+        assert_eq!(i.offset, 0.02, "clamped");
+        i.gain = 0.0;
+        assert_eq!(i.update(-0.2, 3.0, 0.1, true), 0.0, "off");
     }
 
     #[test]
