@@ -281,6 +281,40 @@ pub struct SimConfig {
     /// The simulated tractor's acceleration and braking when a direction request changes its
     /// speed, m/s².
     pub accel_mps2: f64,
+    // Disturbances, all off by default.
+    /// Correlated GNSS position error per axis (first-order Gauss-Markov): stationary σ, m
+    /// (0 = off), and time constant, s.
+    pub gnss_markov_sigma_m: f64,
+    pub gnss_markov_tau_s: f64,
+    /// Multipath jumps: mean rate per hour (0 = off), magnitude (random direction), m, and
+    /// duration, s.
+    pub gnss_multipath_rate_per_h: f64,
+    pub gnss_multipath_m: f64,
+    pub gnss_multipath_duration_s: f64,
+    /// RTK-float windows `[[start_s, duration_s], ...]` of simulated time: 129029 reports RTK
+    /// float and a Gauss-Markov error (σ m, τ s) per axis is added.
+    pub gnss_float_windows_s: Vec<[f64; 2]>,
+    pub gnss_float_sigma_m: f64,
+    pub gnss_float_tau_s: f64,
+    /// Terrain: slope, degrees (0 = flat), falling towards `terrain_downhill_deg` (CCW from
+    /// East), varying by ±`terrain_slope_amp_deg` sinusoidally with `terrain_wavelength_m`
+    /// along the contour direction.
+    pub terrain_slope_deg: f64,
+    pub terrain_downhill_deg: f64,
+    pub terrain_slope_amp_deg: f64,
+    pub terrain_wavelength_m: f64,
+    /// IMU roll/pitch frame rate, Hz (0 = no IMU), and noise σ, degrees.
+    pub imu_rate_hz: f64,
+    pub imu_noise_deg: f64,
+    /// Side-slope slip to the right (downhill for positive roll), m/s per degree of roll, and a
+    /// constant slip to the right, m/s.
+    pub slip_per_roll_mps_per_deg: f64,
+    pub slip_mps: f64,
+    /// Wheel-angle sensor bias, degrees.
+    pub was_bias_deg: f64,
+    /// Actuator deadband (half-width), degrees, and backlash (total play), degrees.
+    pub actuator_deadband_deg: f64,
+    pub actuator_backlash_deg: f64,
 }
 
 impl Default for SimConfig {
@@ -301,6 +335,25 @@ impl Default for SimConfig {
             start_heading_deg: 0.0,
             max_time_s: 0.0,
             accel_mps2: 0.5,
+            gnss_markov_sigma_m: 0.0,
+            gnss_markov_tau_s: 60.0,
+            gnss_multipath_rate_per_h: 0.0,
+            gnss_multipath_m: 0.1,
+            gnss_multipath_duration_s: 10.0,
+            gnss_float_windows_s: Vec::new(),
+            gnss_float_sigma_m: 0.2,
+            gnss_float_tau_s: 10.0,
+            terrain_slope_deg: 0.0,
+            terrain_downhill_deg: 0.0,
+            terrain_slope_amp_deg: 0.0,
+            terrain_wavelength_m: 100.0,
+            imu_rate_hz: 0.0,
+            imu_noise_deg: 0.0,
+            slip_per_roll_mps_per_deg: 0.0,
+            slip_mps: 0.0,
+            was_bias_deg: 0.0,
+            actuator_deadband_deg: 0.0,
+            actuator_backlash_deg: 0.0,
         }
     }
 }
@@ -809,6 +862,55 @@ impl Config {
         c.range("sim.start_heading_deg", s.start_heading_deg, -90.0, 90.0);
         c.range("sim.max_time_s", s.max_time_s, 0.0, 1e7);
         c.range("sim.accel_mps2", s.accel_mps2, 0.05, 10.0);
+        c.range("sim.gnss_markov_sigma_m", s.gnss_markov_sigma_m, 0.0, 1.0);
+        c.range("sim.gnss_markov_tau_s", s.gnss_markov_tau_s, 0.1, 3600.0);
+        c.range(
+            "sim.gnss_multipath_rate_per_h",
+            s.gnss_multipath_rate_per_h,
+            0.0,
+            3600.0,
+        );
+        c.range("sim.gnss_multipath_m", s.gnss_multipath_m, 0.0, 10.0);
+        c.range(
+            "sim.gnss_multipath_duration_s",
+            s.gnss_multipath_duration_s,
+            0.1,
+            600.0,
+        );
+        for (i, w) in s.gnss_float_windows_s.iter().enumerate() {
+            if !(w[0].is_finite() && w[0] >= 0.0 && w[1].is_finite() && w[1] > 0.0) {
+                c.push(
+                    &format!("sim.gnss_float_windows_s[{i}]"),
+                    format!("{w:?}"),
+                    "must be [start_s, duration_s] with start_s >= 0 and duration_s > 0",
+                );
+            }
+        }
+        c.range("sim.gnss_float_sigma_m", s.gnss_float_sigma_m, 0.0, 10.0);
+        c.range("sim.gnss_float_tau_s", s.gnss_float_tau_s, 0.1, 3600.0);
+        c.range("sim.terrain_slope_deg", s.terrain_slope_deg, -30.0, 30.0);
+        c.range("sim.terrain_downhill_deg", s.terrain_downhill_deg, -360.0, 360.0);
+        c.range("sim.terrain_slope_amp_deg", s.terrain_slope_amp_deg, 0.0, 30.0);
+        c.range("sim.terrain_wavelength_m", s.terrain_wavelength_m, 1.0, 100_000.0);
+        if s.terrain_slope_deg.abs() + s.terrain_slope_amp_deg > 30.0 {
+            c.push(
+                "sim.terrain_slope_amp_deg",
+                fmt_num(s.terrain_slope_amp_deg),
+                "|sim.terrain_slope_deg| + sim.terrain_slope_amp_deg must be at most 30",
+            );
+        }
+        c.range("sim.imu_rate_hz", s.imu_rate_hz, 0.0, 1000.0);
+        c.range("sim.imu_noise_deg", s.imu_noise_deg, 0.0, 5.0);
+        c.range(
+            "sim.slip_per_roll_mps_per_deg",
+            s.slip_per_roll_mps_per_deg,
+            -1.0,
+            1.0,
+        );
+        c.range("sim.slip_mps", s.slip_mps, -2.0, 2.0);
+        c.range("sim.was_bias_deg", s.was_bias_deg, -10.0, 10.0);
+        c.range("sim.actuator_deadband_deg", s.actuator_deadband_deg, 0.0, 5.0);
+        c.range("sim.actuator_backlash_deg", s.actuator_backlash_deg, 0.0, 10.0);
         let b = &self.bus;
         if b.interface.trim().is_empty() || b.interface.len() > 15 {
             c.push(

@@ -5,10 +5,13 @@
 //! counter and CRC, and the wheel-based speed. It receives steering commands and checks their
 //! CRC and counter as a real actuator would, ignoring bad ones; while not engaged (or without
 //! valid commands) the "driver" holds the wheels where they are. A scenario scripts faults.
+//! With an IMU configured it sends the roll and pitch (0xFF30) at the IMU rate with counter
+//! and CRC; during the simulator's RTK-float windows 129029 reports method 5 (RTK float).
 
 use super::{FixQuality, SimOutput, Simulator};
 use crate::can::codec::{
-    self, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, Packer, PositionRapid,
+    self, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, ImuAttitude, Packer,
+    PositionRapid,
     SteeringCommand, VesselHeading, WheelAngle, WheelSpeed,
 };
 use crate::can::direction_request::{REVERSE, STOP};
@@ -71,6 +74,7 @@ pub struct SimAddresses {
     pub gnss: u8,
     pub wheel_angle: u8,
     pub tractor: u8,
+    pub imu: u8,
 }
 
 impl Default for SimAddresses {
@@ -79,6 +83,7 @@ impl Default for SimAddresses {
             gnss: 0x1C,
             wheel_angle: 0x13,
             tractor: 0xF0,
+            imu: 0x14,
         }
     }
 }
@@ -90,6 +95,7 @@ pub struct SimNode {
     gnss: Packer,
     was: Packer,
     tractor: Packer,
+    imu: Packer,
     checks: CounterCheck,
     scenario: Scenario,
     outs: Vec<SimOutput>,
@@ -113,6 +119,7 @@ impl SimNode {
             gnss: Packer::new(addresses.gnss),
             was: Packer::new(addresses.wheel_angle),
             tractor: Packer::new(addresses.tractor),
+            imu: Packer::new(addresses.imu),
             checks: CounterCheck::default(),
             scenario,
             outs: Vec::with_capacity(64),
@@ -192,6 +199,18 @@ impl SimNode {
         for o in outs.drain(..) {
             match o {
                 SimOutput::WheelAngle { t: ts, angle } => self.wheel_frames(ts, angle, out),
+                SimOutput::Attitude {
+                    t: ts,
+                    roll,
+                    pitch,
+                } => {
+                    if let Ok(f) = self.imu.pack(&ImuAttitude {
+                        roll: Some(roll.to_degrees().clamp(-90.0, 90.0)),
+                        pitch: Some(pitch.to_degrees().clamp(-90.0, 90.0)),
+                    }) {
+                        out.push((ts, f));
+                    }
+                }
                 SimOutput::Gnss(m) => {
                     let ts = m.t_delivered;
                     if self.scenario.active(FaultKind::GnssDropout, ts) {

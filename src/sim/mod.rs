@@ -2,13 +2,19 @@
 //! a steering actuator with dead time, first-order lag, rate and angle limits, GNSS with
 //! noise, rate and latency, and a noisy wheel-angle sensor. Deterministic for a given seed.
 //!
+//! Disturbances, each off by default ([`Disturbances`]): correlated GNSS error (first-order
+//! Gauss-Markov), multipath jumps, RTK-float windows (larger error, float fix status),
+//! terrain roll and pitch (the antenna height moves the measured position, an IMU reports the
+//! attitude), side-slope slip, wheel-angle sensor bias, actuator deadband and backlash. They
+//! draw from their own random stream, so switching one on leaves the others' noise unchanged.
+//!
 //! Ground truth ([`Simulator::true_state`]) is the model's own state: scoring uses it, never an
 //! estimate. The same model drives the simulator on CAN.
 
 pub mod can_node;
 
 use crate::geo::{heading_vec, left_normal, wrap_angle, Pose, Vec2};
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
@@ -51,6 +57,53 @@ pub struct SimParams {
     pub seed: u64,
     /// Acceleration and braking towards a requested speed (direction requests), m/s².
     pub accel: f64,
+    /// Disturbances, all off by default.
+    pub dist: Disturbances,
+}
+
+/// Simulator disturbances, SI units. The default is none at all.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Disturbances {
+    /// Correlated GNSS position error per axis: first-order Gauss-Markov, stationary σ (m) and
+    /// time constant (s). Off when σ = 0.
+    pub gnss_markov_sigma: f64,
+    pub gnss_markov_tau: f64,
+    /// Multipath jumps: mean rate, 1/s; magnitude (random direction), m; duration, s.
+    pub multipath_rate: f64,
+    pub multipath_magnitude: f64,
+    pub multipath_duration: f64,
+    /// RTK-float windows (start, duration), s of simulated time. Inside one the fix is
+    /// reported as RTK float and a Gauss-Markov error (σ m, τ s) is added per axis.
+    pub float_windows: Vec<(f64, f64)>,
+    pub float_sigma: f64,
+    pub float_tau: f64,
+    /// Terrain: slope angle (rad) falling towards `terrain_downhill` (rad, CCW from East),
+    /// varying by `terrain_slope_amp` (rad) sinusoidally with `terrain_wavelength` (m) along the
+    /// contour direction (downhill turned 90° left).
+    pub terrain_slope: f64,
+    pub terrain_downhill: f64,
+    pub terrain_slope_amp: f64,
+    pub terrain_wavelength: f64,
+    /// IMU attitude output rate, Hz (0 = no IMU), and its noise σ, rad.
+    pub imu_rate_hz: f64,
+    pub imu_noise: f64,
+    /// Lateral slip to the right (downhill for positive roll), m/s per rad of roll, and a
+    /// constant lateral slip to the right, m/s. Applied while moving (full above 0.5 m/s).
+    pub slip_per_roll: f64,
+    pub slip: f64,
+    /// Wheel-angle sensor bias, rad (added to the reported angle).
+    pub was_bias: f64,
+    /// Actuator deadband: no motion while the lagged target is within this of the actuator
+    /// position, rad (half-width).
+    pub deadband: f64,
+    /// Backlash (total play) between the actuator and the wheels, rad.
+    pub backlash: f64,
+}
+
+impl Disturbances {
+    fn terrain_on(&self) -> bool {
+        self.terrain_slope != 0.0 || self.terrain_slope_amp != 0.0
+    }
 }
 
 impl Default for SimParams {
@@ -74,6 +127,7 @@ impl Default for SimParams {
             step: 0.001,
             seed: 1,
             accel: 0.5,
+            dist: Disturbances::default(),
         }
     }
 }
@@ -114,6 +168,12 @@ pub enum SimOutput {
         t: f64,
         angle: f64,
     },
+    /// Measured roll (rad, positive right side down) and pitch (rad, positive nose up) at `t`.
+    Attitude {
+        t: f64,
+        roll: f64,
+        pitch: f64,
+    },
 }
 
 /// The simulator's true state.
@@ -127,6 +187,9 @@ pub struct TrueState {
     pub wheel_angle: f64,
     /// Antenna position, local ENU, m.
     pub antenna: Vec2,
+    /// Roll (rad, positive right side down) and pitch (rad, positive nose up).
+    pub roll: f64,
+    pub pitch: f64,
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -160,6 +223,19 @@ pub struct Simulator {
     fix: FixQuality,
     /// Speed the driver (or the tractor's speed control) is heading for, m/s.
     speed_target: Option<f64>,
+    /// Actuator position before the backlash, rad (equal to `wheel` without backlash).
+    act: f64,
+    /// Random stream of the disturbances.
+    rng_dist: ChaCha8Rng,
+    /// Gauss-Markov GNSS error (E, N), m.
+    markov: Vec2,
+    /// RTK-float Gauss-Markov error (E, N), m.
+    float_err: Vec2,
+    /// Current multipath jump and when it ends, s.
+    multipath: Vec2,
+    multipath_until: f64,
+    next_imu: u64,
+    imu_every: u64,
 }
 
 impl Simulator {
@@ -210,8 +286,46 @@ impl Simulator {
             ("heading_sigma", p.heading_sigma),
             ("speed_sigma", p.speed_sigma),
             ("was_noise", p.was_noise),
+            ("gnss_markov_sigma", p.dist.gnss_markov_sigma),
+            ("multipath_rate", p.dist.multipath_rate),
+            ("multipath_magnitude", p.dist.multipath_magnitude),
+            ("multipath_duration", p.dist.multipath_duration),
+            ("float_sigma", p.dist.float_sigma),
+            ("imu_rate_hz", p.dist.imu_rate_hz),
+            ("imu_noise", p.dist.imu_noise),
+            ("deadband", p.dist.deadband),
+            ("backlash", p.dist.backlash),
         ] {
             check(n, v, v >= 0.0, "must be >= 0")?;
+        }
+        let d = &p.dist;
+        if d.gnss_markov_sigma > 0.0 {
+            check("gnss_markov_tau", d.gnss_markov_tau, d.gnss_markov_tau > 0.0, "must be > 0")?;
+        }
+        if !d.float_windows.is_empty() {
+            check("float_tau", d.float_tau, d.float_tau > 0.0, "must be > 0")?;
+        }
+        for &(start, duration) in &d.float_windows {
+            check("float_windows start", start, start >= 0.0, "must be >= 0")?;
+            check("float_windows duration", duration, duration > 0.0, "must be > 0")?;
+        }
+        if d.terrain_on() {
+            check(
+                "terrain_wavelength",
+                d.terrain_wavelength,
+                d.terrain_wavelength > 0.0,
+                "must be > 0",
+            )?;
+        }
+        for (n, v) in [
+            ("terrain_slope", d.terrain_slope),
+            ("terrain_downhill", d.terrain_downhill),
+            ("terrain_slope_amp", d.terrain_slope_amp),
+            ("slip_per_roll", d.slip_per_roll),
+            ("slip", d.slip),
+            ("was_bias", d.was_bias),
+        ] {
+            check(n, v, true, "must be finite")?;
         }
         Ok(())
     }
@@ -221,7 +335,7 @@ impl Simulator {
         Simulator::validate(&params)?;
         let delay_len = (params.dead_time / params.step).round() as usize;
         let every = |hz: f64| ((1.0 / hz / params.step).round() as u64).max(1);
-        Ok(Simulator {
+        let mut sim = Simulator {
             k: 0,
             x: initial.pos.x,
             y: initial.pos.y,
@@ -238,8 +352,38 @@ impl Simulator {
             rng: ChaCha8Rng::seed_from_u64(params.seed),
             fix: FixQuality::RtkFixed,
             speed_target: None,
+            act: 0.0,
+            rng_dist: {
+                let mut r = ChaCha8Rng::seed_from_u64(params.seed);
+                r.set_stream(1);
+                r
+            },
+            markov: Vec2::zeros(),
+            float_err: Vec2::zeros(),
+            multipath: Vec2::zeros(),
+            multipath_until: f64::NEG_INFINITY,
+            next_imu: if params.dist.imu_rate_hz > 0.0 {
+                0
+            } else {
+                u64::MAX
+            },
+            imu_every: if params.dist.imu_rate_hz > 0.0 {
+                every(params.dist.imu_rate_hz)
+            } else {
+                u64::MAX
+            },
             p: params,
-        })
+        };
+        // The correlated errors start from their stationary distributions.
+        if sim.p.dist.gnss_markov_sigma > 0.0 {
+            let sd = sim.p.dist.gnss_markov_sigma;
+            sim.markov = Vec2::new(sim.dist_noise(sd), sim.dist_noise(sd));
+        }
+        if !sim.p.dist.float_windows.is_empty() {
+            let sd = sim.p.dist.float_sigma;
+            sim.float_err = Vec2::new(sim.dist_noise(sd), sim.dist_noise(sd));
+        }
+        Ok(sim)
     }
 
     /// Like [`Simulator::try_new`]; invalid parameters fall back to the defaults (logged).
@@ -298,20 +442,106 @@ impl Simulator {
         z * sigma
     }
 
+    fn dist_noise(&mut self, sigma: f64) -> f64 {
+        if sigma == 0.0 {
+            return 0.0;
+        }
+        let z: f64 = StandardNormal.sample(&mut self.rng_dist);
+        z * sigma
+    }
+
+    /// Roll (rad, positive right side down) and pitch (rad, positive nose up) of the vehicle
+    /// on the terrain where it stands.
+    pub fn attitude(&self) -> (f64, f64) {
+        let d = &self.p.dist;
+        if !d.terrain_on() {
+            return (0.0, 0.0);
+        }
+        let down = heading_vec(d.terrain_downhill);
+        let contour = left_normal(&down);
+        let along = Vec2::new(self.x, self.y).dot(&contour);
+        let slope = d.terrain_slope
+            + d.terrain_slope_amp * (std::f64::consts::TAU * along / d.terrain_wavelength).sin();
+        let grade = slope.tan();
+        let f = heading_vec(self.heading);
+        let right = -left_normal(&f);
+        let roll = (grade * down.dot(&right)).atan();
+        let pitch = (-grade * down.dot(&f)).atan();
+        (roll, pitch)
+    }
+
     fn antenna(&self) -> Vec2 {
         let h = heading_vec(self.heading);
-        Vec2::new(self.x, self.y)
+        let base = Vec2::new(self.x, self.y)
             + h * self.p.antenna_forward
-            + left_normal(&h) * self.p.antenna_left
+            + left_normal(&h) * self.p.antenna_left;
+        if !self.p.dist.terrain_on() {
+            return base;
+        }
+        // The antenna mast leans with the vehicle: roll (right side down) moves it right,
+        // pitch (nose up) moves it back.
+        let (roll, pitch) = self.attitude();
+        base - left_normal(&h) * (self.p.antenna_up * roll.sin())
+            - h * (self.p.antenna_up * pitch.sin())
+    }
+
+    fn in_float_window(&self, t: f64) -> bool {
+        self.p
+            .dist
+            .float_windows
+            .iter()
+            .any(|&(start, duration)| t >= start && t < start + duration)
+    }
+
+    /// The disturbance part of the GNSS position error at a fix measured at `now`.
+    fn gnss_disturbance(&mut self, now: f64) -> Vec2 {
+        let dt = self.gnss_every as f64 * self.p.step;
+        let mut e = Vec2::zeros();
+        let d = self.p.dist.clone();
+        if d.gnss_markov_sigma > 0.0 {
+            // Exact discretisation of dx = -x/τ dt + σ·sqrt(2/τ) dW over one GNSS period.
+            let phi = (-dt / d.gnss_markov_tau).exp();
+            let q = d.gnss_markov_sigma * (1.0 - phi * phi).sqrt();
+            self.markov = self.markov * phi + Vec2::new(self.dist_noise(q), self.dist_noise(q));
+            e += self.markov;
+        }
+        if d.multipath_rate > 0.0 && d.multipath_magnitude > 0.0 {
+            if now >= self.multipath_until {
+                self.multipath = Vec2::zeros();
+                let p = 1.0 - (-d.multipath_rate * dt).exp();
+                let u: f64 = self.rng_dist.gen();
+                let dir: f64 = self.rng_dist.gen::<f64>() * std::f64::consts::TAU;
+                if u < p {
+                    self.multipath = heading_vec(dir) * d.multipath_magnitude;
+                    self.multipath_until = now + d.multipath_duration;
+                }
+            }
+            if now < self.multipath_until {
+                e += self.multipath;
+            }
+        }
+        if !d.float_windows.is_empty() {
+            let phi = (-dt / d.float_tau).exp();
+            let q = d.float_sigma * (1.0 - phi * phi).sqrt();
+            self.float_err =
+                self.float_err * phi + Vec2::new(self.dist_noise(q), self.dist_noise(q));
+            if self.in_float_window(now) {
+                e += self.float_err;
+            }
+        }
+        e
     }
 
     /// The true state now.
     pub fn true_state(&self) -> TrueState {
+        let (roll, pitch) = self.attitude();
         TrueState {
             pose: Pose::new(self.x, self.y, self.heading),
             speed: self.speed,
             wheel_angle: self.wheel,
             antenna: self.antenna(),
+            roll,
+            pitch,
         }
     }
 
@@ -326,13 +556,35 @@ impl Simulator {
             d
         };
         let target = delayed.clamp(-self.p.max_wheel_angle, self.p.max_wheel_angle);
+        let mut err = target - self.act;
+        let db = self.p.dist.deadband;
+        if db > 0.0 {
+            // The actuator does not act on errors inside its deadband.
+            err = if err.abs() <= db {
+                0.0
+            } else {
+                err - db * err.signum()
+            };
+        }
         let rate = if self.p.tau > 0.0 {
-            (target - self.wheel) / self.p.tau
+            err / self.p.tau
         } else {
-            (target - self.wheel) / h
+            err / h
         };
         let rate = rate.clamp(-self.p.max_rate, self.p.max_rate);
-        self.wheel = (self.wheel + rate * h).clamp(-self.p.max_wheel_angle, self.p.max_wheel_angle);
+        self.act = (self.act + rate * h).clamp(-self.p.max_wheel_angle, self.p.max_wheel_angle);
+        let play = self.p.dist.backlash;
+        if play > 0.0 {
+            // The wheels follow the actuator only once it has taken up the play.
+            let half = 0.5 * play;
+            if self.act - self.wheel > half {
+                self.wheel = self.act - half;
+            } else if self.act - self.wheel < -half {
+                self.wheel = self.act + half;
+            }
+        } else {
+            self.wheel = self.act;
+        }
         if let Some(target) = self.speed_target {
             let dv = self.p.accel * h;
             self.speed += (target - self.speed).clamp(-dv, dv);
@@ -343,6 +595,14 @@ impl Simulator {
         self.x += self.speed * mid.cos() * h;
         self.y += self.speed * mid.sin() * h;
         self.heading = wrap_angle(self.heading + yaw_rate * h);
+        let d = &self.p.dist;
+        if d.slip != 0.0 || d.slip_per_roll != 0.0 {
+            let (roll, _) = self.attitude();
+            let v_right = (d.slip + d.slip_per_roll * roll) * (self.speed.abs() / 0.5).min(1.0);
+            let right = -left_normal(&heading_vec(mid));
+            self.x += right.x * v_right * h;
+            self.y += right.y * v_right * h;
+        }
         self.k += 1;
     }
 
@@ -357,22 +617,44 @@ impl Simulator {
         loop {
             let now = self.time();
             if self.k >= self.next_was {
-                let angle = self.wheel + self.noise(self.p.was_noise);
+                let angle = self.wheel + self.noise(self.p.was_noise) + self.p.dist.was_bias;
                 out.push(SimOutput::WheelAngle { t: now, angle });
                 self.next_was += self.was_every;
             }
+            if self.k >= self.next_imu {
+                let (roll, pitch) = self.attitude();
+                let sd = self.p.dist.imu_noise;
+                let roll = roll + self.dist_noise(sd);
+                let pitch = pitch + self.dist_noise(sd);
+                out.push(SimOutput::Attitude { t: now, roll, pitch });
+                self.next_imu = self.next_imu.saturating_add(self.imu_every);
+            }
             if self.k >= self.next_gnss {
                 let ant = self.antenna();
+                let mut antenna = Vec2::new(
+                    ant.x + self.noise(self.p.gnss_sigma),
+                    ant.y + self.noise(self.p.gnss_sigma),
+                );
+                let heading = wrap_angle(self.heading + self.noise(self.p.heading_sigma));
+                let speed = self.speed + self.noise(self.p.speed_sigma);
+                let d = &self.p.dist;
+                if d.gnss_markov_sigma > 0.0
+                    || d.multipath_rate > 0.0
+                    || !d.float_windows.is_empty()
+                {
+                    antenna += self.gnss_disturbance(now);
+                }
                 let m = GnssMeasurement {
                     t_measured: now,
                     t_delivered: now + self.p.gnss_latency,
-                    antenna: Vec2::new(
-                        ant.x + self.noise(self.p.gnss_sigma),
-                        ant.y + self.noise(self.p.gnss_sigma),
-                    ),
-                    heading: wrap_angle(self.heading + self.noise(self.p.heading_sigma)),
-                    speed: self.speed + self.noise(self.p.speed_sigma),
-                    fix: self.fix,
+                    antenna,
+                    heading,
+                    speed,
+                    fix: if self.in_float_window(now) {
+                        FixQuality::RtkFloat
+                    } else {
+                        self.fix
+                    },
                 };
                 self.pending.push_back(m);
                 self.next_gnss += self.gnss_every;
