@@ -889,9 +889,24 @@ impl Config {
         c.range("sim.gnss_float_sigma_m", s.gnss_float_sigma_m, 0.0, 10.0);
         c.range("sim.gnss_float_tau_s", s.gnss_float_tau_s, 0.1, 3600.0);
         c.range("sim.terrain_slope_deg", s.terrain_slope_deg, -30.0, 30.0);
-        c.range("sim.terrain_downhill_deg", s.terrain_downhill_deg, -360.0, 360.0);
-        c.range("sim.terrain_slope_amp_deg", s.terrain_slope_amp_deg, 0.0, 30.0);
-        c.range("sim.terrain_wavelength_m", s.terrain_wavelength_m, 1.0, 100_000.0);
+        c.range(
+            "sim.terrain_downhill_deg",
+            s.terrain_downhill_deg,
+            -360.0,
+            360.0,
+        );
+        c.range(
+            "sim.terrain_slope_amp_deg",
+            s.terrain_slope_amp_deg,
+            0.0,
+            30.0,
+        );
+        c.range(
+            "sim.terrain_wavelength_m",
+            s.terrain_wavelength_m,
+            1.0,
+            100_000.0,
+        );
         if s.terrain_slope_deg.abs() + s.terrain_slope_amp_deg > 30.0 {
             c.push(
                 "sim.terrain_slope_amp_deg",
@@ -909,8 +924,18 @@ impl Config {
         );
         c.range("sim.slip_mps", s.slip_mps, -2.0, 2.0);
         c.range("sim.was_bias_deg", s.was_bias_deg, -10.0, 10.0);
-        c.range("sim.actuator_deadband_deg", s.actuator_deadband_deg, 0.0, 5.0);
-        c.range("sim.actuator_backlash_deg", s.actuator_backlash_deg, 0.0, 10.0);
+        c.range(
+            "sim.actuator_deadband_deg",
+            s.actuator_deadband_deg,
+            0.0,
+            5.0,
+        );
+        c.range(
+            "sim.actuator_backlash_deg",
+            s.actuator_backlash_deg,
+            0.0,
+            10.0,
+        );
         let b = &self.bus;
         if b.interface.trim().is_empty() || b.interface.len() > 15 {
             c.push(
@@ -1142,6 +1167,36 @@ mod tests {
             .iter()
             .any(|m| m.starts_with("vehicle.wheelbase_m = -1: must be in")));
         assert!(msgs.len() >= 3, "all problems at once: {msgs:?}");
+    }
+
+    #[test]
+    fn sim_disturbance_keys_parse_and_validate() {
+        let cfg = Config::parse_with(
+            "[sim]\ngnss_float_windows_s = [[60.0, 20.0], [-1.0, 5.0]]\nwas_bias_deg = 12\n\
+             actuator_backlash_deg = -1\nterrain_slope_deg = 25\nterrain_slope_amp_deg = 10\n",
+            &[],
+        )
+        .unwrap();
+        assert_eq!(cfg.sim.gnss_float_windows_s[0], [60.0, 20.0]);
+        let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
+        assert!(msgs.contains(
+            &"sim.gnss_float_windows_s[1] = [-1.0, 5.0]: must be [start_s, duration_s] with \
+              start_s >= 0 and duration_s > 0"
+                .to_string()
+        ));
+        assert!(msgs.contains(&"sim.was_bias_deg = 12: must be in -10..=10".to_string()));
+        assert!(msgs.contains(&"sim.actuator_backlash_deg = -1: must be in 0..=10".to_string()));
+        assert!(msgs
+            .iter()
+            .any(|m| m.starts_with("sim.terrain_slope_amp_deg = 10: |sim.terrain_slope_deg|")));
+        assert_eq!(msgs.len(), 4, "{msgs:?}");
+        // The defaults are all off.
+        let d = SimConfig::default();
+        assert!(d.gnss_markov_sigma_m == 0.0 && d.gnss_multipath_rate_per_h == 0.0);
+        assert!(d.gnss_float_windows_s.is_empty() && d.terrain_slope_deg == 0.0);
+        assert!(d.imu_rate_hz == 0.0 && d.slip_mps == 0.0 && d.slip_per_roll_mps_per_deg == 0.0);
+        assert!(d.was_bias_deg == 0.0);
+        assert!(d.actuator_deadband_deg == 0.0 && d.actuator_backlash_deg == 0.0);
     }
 
     #[test]

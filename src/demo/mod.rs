@@ -54,7 +54,11 @@ pub fn sim_params(cfg: &Config) -> SimParams {
             multipath_rate: s.gnss_multipath_rate_per_h / 3600.0,
             multipath_magnitude: s.gnss_multipath_m,
             multipath_duration: s.gnss_multipath_duration_s,
-            float_windows: s.gnss_float_windows_s.iter().map(|w| (w[0], w[1])).collect(),
+            float_windows: s
+                .gnss_float_windows_s
+                .iter()
+                .map(|w| (w[0], w[1]))
+                .collect(),
             float_sigma: s.gnss_float_sigma_m,
             float_tau: s.gnss_float_tau_s,
             terrain_slope: s.terrain_slope_deg.to_radians(),

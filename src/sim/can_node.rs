@@ -11,8 +11,7 @@
 use super::{FixQuality, SimOutput, Simulator};
 use crate::can::codec::{
     self, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, ImuAttitude, Packer,
-    PositionRapid,
-    SteeringCommand, VesselHeading, WheelAngle, WheelSpeed,
+    PositionRapid, SteeringCommand, VesselHeading, WheelAngle, WheelSpeed,
 };
 use crate::can::direction_request::{REVERSE, STOP};
 use crate::can::fastpacket::split;
@@ -199,11 +198,7 @@ impl SimNode {
         for o in outs.drain(..) {
             match o {
                 SimOutput::WheelAngle { t: ts, angle } => self.wheel_frames(ts, angle, out),
-                SimOutput::Attitude {
-                    t: ts,
-                    roll,
-                    pitch,
-                } => {
+                SimOutput::Attitude { t: ts, roll, pitch } => {
                     if let Ok(f) = self.imu.pack(&ImuAttitude {
                         roll: Some(roll.to_degrees().clamp(-90.0, 90.0)),
                         pitch: Some(pitch.to_degrees().clamp(-90.0, 90.0)),
@@ -317,5 +312,103 @@ impl SimNode {
             f.data[7] ^= 0x5A;
         }
         out.push((ts, f));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::can::fastpacket::Reassembler;
+    use crate::geo::wgs84::LatLon;
+    use crate::geo::Pose;
+    use crate::sim::{Disturbances, SimParams};
+
+    fn node(dist: Disturbances) -> SimNode {
+        let p = SimParams {
+            antenna_up: 3.0,
+            dist,
+            ..SimParams::default()
+        };
+        SimNode::new(
+            Simulator::new(p, Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2), 3.0),
+            EnuFrame::new(LatLon {
+                lat_deg: 52.0,
+                lon_deg: 5.0,
+            }),
+            SimAddresses::default(),
+            Scenario::default(),
+        )
+    }
+
+    /// (delivery time, 129029 method) of every GNSS Position Data message.
+    fn methods(frames: &[(f64, Frame)]) -> Vec<(f64, u8)> {
+        let mut fast = Reassembler::default();
+        let mut out = Vec::new();
+        for (t, f) in frames {
+            let Ok(d) = codec::decode(f.id, f.payload()) else {
+                continue;
+            };
+            if d.index == codec::GnssPositionData::INDEX {
+                if let Ok(Some(p)) = fast.push(d.source, f.payload()) {
+                    out.push((*t, GnssPosition::decode(p).unwrap().method));
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn rtk_float_window_sends_method_float() {
+        let mut n = node(Disturbances {
+            float_windows: vec![(5.0, 3.0)],
+            float_sigma: 0.2,
+            float_tau: 10.0,
+            ..Disturbances::default()
+        });
+        let mut frames = Vec::new();
+        n.advance_to(12.0, &mut frames);
+        let m = methods(&frames);
+        assert!(m.len() > 100);
+        for (t, method) in m {
+            // Delivered 0.05 s after it was measured.
+            let measured = t - 0.05;
+            let expect = if (5.0 - 1e-9..8.0 - 1e-9).contains(&measured) {
+                METHOD_RTK_FLOAT
+            } else {
+                METHOD_RTK_FIXED
+            };
+            assert_eq!(method, expect, "measured at {measured}");
+        }
+        // No IMU configured: no attitude frames.
+        assert!(!frames.iter().any(|(_, f)| codec::decode(f.id, f.payload())
+            .is_ok_and(|d| d.to::<ImuAttitude>().is_some())));
+    }
+
+    #[test]
+    fn imu_frames_carry_roll_and_pitch_at_the_rate() {
+        let mut n = node(Disturbances {
+            terrain_slope: 2f64.to_radians(),
+            terrain_wavelength: 100.0,
+            imu_rate_hz: 50.0,
+            ..Disturbances::default()
+        });
+        let mut frames = Vec::new();
+        n.advance_to(2.0, &mut frames);
+        let mut checks = CounterCheck::default();
+        let imu: Vec<ImuAttitude> = frames
+            .iter()
+            .filter_map(|(_, f)| codec::decode(f.id, f.payload()).ok())
+            .filter(|d| d.to::<ImuAttitude>().is_some())
+            .map(|d| {
+                assert!(checks.check(&d), "counter and CRC");
+                d.to::<ImuAttitude>().unwrap()
+            })
+            .collect();
+        assert_eq!(imu.len(), 101);
+        for a in imu {
+            // Driving north across a slope falling East: right side down, +2°.
+            assert!((a.roll.unwrap() - 2.0).abs() < 0.011, "{:?}", a.roll);
+            assert!(a.pitch.unwrap().abs() < 0.011);
+        }
     }
 }
