@@ -315,6 +315,13 @@ pub struct SimConfig {
     /// Actuator deadband (half-width), degrees, and backlash (total play), degrees.
     pub actuator_deadband_deg: f64,
     pub actuator_backlash_deg: f64,
+    /// Speed profile of the simulated driver going forward, km/h: `speed_max_kmh` on the
+    /// straight, slowing to `speed_min_kmh` in turns (|wheel angle| above
+    /// `speed_turn_angle_deg`), at `accel_mps2`. `speed_max_kmh` = 0: constant
+    /// `control.speed_kmh`.
+    pub speed_min_kmh: f64,
+    pub speed_max_kmh: f64,
+    pub speed_turn_angle_deg: f64,
 }
 
 impl Default for SimConfig {
@@ -354,6 +361,9 @@ impl Default for SimConfig {
             was_bias_deg: 0.0,
             actuator_deadband_deg: 0.0,
             actuator_backlash_deg: 0.0,
+            speed_min_kmh: 4.0,
+            speed_max_kmh: 0.0,
+            speed_turn_angle_deg: 5.0,
         }
     }
 }

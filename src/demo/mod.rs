@@ -16,7 +16,7 @@ use crate::geo::{left_normal, signed_offset, v2, Pose, Vec2};
 use crate::guidance::progress::{Phase, Progress};
 use crate::guidance::{Event, JobPlan};
 use crate::safety::SafetyState;
-use crate::sim::can_node::{Scenario, SimAddresses, SimNode};
+use crate::sim::can_node::{Scenario, SimAddresses, SimNode, SpeedProfile};
 use crate::sim::{Disturbances, SimParams, Simulator};
 use serde::Serialize;
 
@@ -76,6 +76,16 @@ pub fn sim_params(cfg: &Config) -> SimParams {
         },
         ..SimParams::default()
     }
+}
+
+/// The simulated driver's speed profile from the configuration, if one is set.
+pub fn speed_profile(cfg: &Config) -> Option<SpeedProfile> {
+    let s = &cfg.sim;
+    (s.speed_max_kmh > 0.0).then(|| SpeedProfile {
+        min: s.speed_min_kmh / 3.6,
+        max: s.speed_max_kmh / 3.6,
+        turn_angle: s.speed_turn_angle_deg.to_radians(),
+    })
 }
 
 /// |XTE| statistics in constant memory: a histogram of 0.1 mm bins up to 2 m.
@@ -409,7 +419,8 @@ pub fn run(
         *node.enu(),
         SimAddresses::default(),
         opts.scenario.clone(),
-    );
+    )
+    .with_speed_profile(speed_profile(cfg));
     // The controller and the simulator talk only through frames on an in-memory bus.
     let mut bus_ctrl = MemBus::new();
     let mut bus_sim = bus_ctrl.node();

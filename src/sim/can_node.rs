@@ -87,6 +87,19 @@ impl Default for SimAddresses {
     }
 }
 
+/// The driver's (or the tractor's speed control's) speed profile going forward: the maximum
+/// speed on the straight, slowing to the minimum in turns (at the line ends), at the
+/// simulator's acceleration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeedProfile {
+    /// Speed in turns, m/s.
+    pub min: f64,
+    /// Speed on the straight, m/s.
+    pub max: f64,
+    /// Wheel angles beyond this are a turn, rad.
+    pub turn_angle: f64,
+}
+
 /// The simulator node.
 pub struct SimNode {
     sim: Simulator,
@@ -107,6 +120,9 @@ pub struct SimNode {
     distance: f64,
     /// Speed magnitude at the start: what the tractor drives at either way, m/s.
     cruise: f64,
+    profile: Option<SpeedProfile>,
+    /// The last direction request was forward (or there was none).
+    forward: bool,
 }
 
 impl SimNode {
@@ -129,7 +145,15 @@ impl SimNode {
             rejected: 0,
             frozen_counter: None,
             distance: 0.0,
+            profile: None,
+            forward: true,
         }
+    }
+
+    /// Drive forward with a speed profile (see [`SpeedProfile`]).
+    pub fn with_speed_profile(mut self, profile: Option<SpeedProfile>) -> Self {
+        self.profile = profile;
+        self
     }
 
     pub fn sim(&self) -> &Simulator {
@@ -157,6 +181,7 @@ impl SimNode {
         };
         if let Some(r) = d.to::<DirectionRequest>() {
             // The tractor obeys: brake to a stop, or head for the cruise speed either way.
+            self.forward = r.direction != STOP && r.direction != REVERSE;
             let target = match r.direction {
                 x if x == STOP => 0.0,
                 x if x == REVERSE => -self.cruise,
@@ -191,6 +216,11 @@ impl SimNode {
         } else {
             FixQuality::RtkFixed
         });
+        if let (Some(p), true) = (self.profile, self.forward) {
+            let turning = self.sim.true_state().wheel_angle.abs() > p.turn_angle;
+            self.sim
+                .set_speed_target(if turning { p.min } else { p.max });
+        }
         self.outs.clear();
         let mut outs = std::mem::take(&mut self.outs);
         self.sim.advance_to(t, &mut outs);
@@ -410,5 +440,41 @@ mod tests {
             assert!((a.roll.unwrap() - 2.0).abs() < 0.011, "{:?}", a.roll);
             assert!(a.pitch.unwrap().abs() < 0.011);
         }
+    }
+
+    #[test]
+    fn speed_profile_slows_in_turns_and_speeds_up_on_the_straight() {
+        let p = SpeedProfile {
+            min: 4.0 / 3.6,
+            max: 15.0 / 3.6,
+            turn_angle: 5f64.to_radians(),
+        };
+        let mut n = node(Disturbances::default()).with_speed_profile(Some(p));
+        let mut frames = Vec::new();
+        let mut prev = n.sim().true_state().speed;
+        let mut t = 0.0;
+        let mut step = |n: &mut SimNode, until: f64, prev: &mut f64| {
+            while t < until {
+                t += 0.02;
+                frames.clear();
+                n.advance_to(t, &mut frames);
+                let v = n.sim().true_state().speed;
+                // At most the simulator's acceleration (0.5 m/s²).
+                assert!((v - *prev).abs() <= 0.5 * 0.02 + 1e-9);
+                *prev = v;
+            }
+        };
+        step(&mut n, 10.0, &mut prev);
+        assert!((n.sim().true_state().speed - p.max).abs() < 1e-9);
+        n.sim_mut().set_command(0.3);
+        step(&mut n, 20.0, &mut prev);
+        assert!((n.sim().true_state().speed - p.min).abs() < 1e-9);
+        n.sim_mut().set_command(0.0);
+        step(&mut n, 30.0, &mut prev);
+        assert!((n.sim().true_state().speed - p.max).abs() < 1e-9);
+        // Off: the start speed is kept.
+        let mut n = node(Disturbances::default());
+        n.advance_to(10.0, &mut frames);
+        assert_eq!(n.sim().true_state().speed, 3.0);
     }
 }
