@@ -93,7 +93,7 @@ pub struct Disturbances {
     pub slip: f64,
     /// Wheel-angle sensor bias, rad (added to the reported angle).
     pub was_bias: f64,
-    /// Actuator deadband: no motion while the lagged target is within this of the actuator
+    /// Actuator deadband: no motion while the delayed command is within this of the actuator
     /// position, rad (half-width).
     pub deadband: f64,
     /// Backlash (total play) between the actuator and the wheels, rad.
