@@ -55,6 +55,7 @@ impl Rig {
                     roll: None,
                 }),
                 SimOutput::WheelAngle { t, angle } => self.ctrl.on_wheel_angle(t, angle),
+                SimOutput::Attitude { .. } => {}
             }
         }
         t

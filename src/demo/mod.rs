@@ -16,8 +16,8 @@ use crate::geo::{left_normal, signed_offset, v2, Pose, Vec2};
 use crate::guidance::progress::{Phase, Progress};
 use crate::guidance::{Event, JobPlan};
 use crate::safety::SafetyState;
-use crate::sim::can_node::{Scenario, SimAddresses, SimNode};
-use crate::sim::{SimParams, Simulator};
+use crate::sim::can_node::{Scenario, SimAddresses, SimNode, SpeedProfile};
+use crate::sim::{Disturbances, SimParams, Simulator};
 use serde::Serialize;
 
 /// Work-line samples closer than this to the line start are excluded from the XTE figures, m.
@@ -48,8 +48,44 @@ pub fn sim_params(cfg: &Config) -> SimParams {
         step: s.step_s,
         seed: s.seed,
         accel: s.accel_mps2,
+        dist: Disturbances {
+            gnss_markov_sigma: s.gnss_markov_sigma_m,
+            gnss_markov_tau: s.gnss_markov_tau_s,
+            multipath_rate: s.gnss_multipath_rate_per_h / 3600.0,
+            multipath_magnitude: s.gnss_multipath_m,
+            multipath_duration: s.gnss_multipath_duration_s,
+            float_windows: s
+                .gnss_float_windows_s
+                .iter()
+                .map(|w| (w[0], w[1]))
+                .collect(),
+            float_sigma: s.gnss_float_sigma_m,
+            float_tau: s.gnss_float_tau_s,
+            terrain_slope: s.terrain_slope_deg.to_radians(),
+            terrain_downhill: s.terrain_downhill_deg.to_radians(),
+            terrain_slope_amp: s.terrain_slope_amp_deg.to_radians(),
+            terrain_wavelength: s.terrain_wavelength_m,
+            imu_rate_hz: s.imu_rate_hz,
+            imu_noise: s.imu_noise_deg.to_radians(),
+            // Per degree of roll → per radian.
+            slip_per_roll: s.slip_per_roll_mps_per_deg.to_degrees(),
+            slip: s.slip_mps,
+            was_bias: s.was_bias_deg.to_radians(),
+            deadband: s.actuator_deadband_deg.to_radians(),
+            backlash: s.actuator_backlash_deg.to_radians(),
+        },
         ..SimParams::default()
     }
+}
+
+/// The simulated driver's speed profile from the configuration, if one is set.
+pub fn speed_profile(cfg: &Config) -> Option<SpeedProfile> {
+    let s = &cfg.sim;
+    (s.speed_max_kmh > 0.0).then(|| SpeedProfile {
+        min: s.speed_min_kmh / 3.6,
+        max: s.speed_max_kmh / 3.6,
+        turn_angle: s.speed_turn_angle_deg.to_radians(),
+    })
 }
 
 /// |XTE| statistics in constant memory: a histogram of 0.1 mm bins up to 2 m.
@@ -384,7 +420,8 @@ pub fn run(
         *node.enu(),
         SimAddresses::default(),
         opts.scenario.clone(),
-    );
+    )
+    .with_speed_profile(speed_profile(cfg));
     // The controller and the simulator talk only through frames on an in-memory bus.
     let mut bus_ctrl = MemBus::new();
     let mut bus_sim = bus_ctrl.node();

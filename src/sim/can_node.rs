@@ -5,11 +5,13 @@
 //! counter and CRC, and the wheel-based speed. It receives steering commands and checks their
 //! CRC and counter as a real actuator would, ignoring bad ones; while not engaged (or without
 //! valid commands) the "driver" holds the wheels where they are. A scenario scripts faults.
+//! With an IMU configured it sends the roll and pitch (0xFF30) at the IMU rate with counter
+//! and CRC; during the simulator's RTK-float windows 129029 reports method 5 (RTK float).
 
 use super::{FixQuality, SimOutput, Simulator};
 use crate::can::codec::{
-    self, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, Packer, PositionRapid,
-    SteeringCommand, VesselHeading, WheelAngle, WheelSpeed,
+    self, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, ImuAttitude, Packer,
+    PositionRapid, SteeringCommand, VesselHeading, WheelAngle, WheelSpeed,
 };
 use crate::can::direction_request::{REVERSE, STOP};
 use crate::can::fastpacket::split;
@@ -71,6 +73,7 @@ pub struct SimAddresses {
     pub gnss: u8,
     pub wheel_angle: u8,
     pub tractor: u8,
+    pub imu: u8,
 }
 
 impl Default for SimAddresses {
@@ -79,8 +82,22 @@ impl Default for SimAddresses {
             gnss: 0x1C,
             wheel_angle: 0x13,
             tractor: 0xF0,
+            imu: 0x14,
         }
     }
+}
+
+/// The driver's (or the tractor's speed control's) speed profile going forward: the maximum
+/// speed on the straight, slowing to the minimum in turns (at the line ends), at the
+/// simulator's acceleration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeedProfile {
+    /// Speed in turns, m/s.
+    pub min: f64,
+    /// Speed on the straight, m/s.
+    pub max: f64,
+    /// Wheel angles beyond this are a turn, rad.
+    pub turn_angle: f64,
 }
 
 /// The simulator node.
@@ -90,6 +107,7 @@ pub struct SimNode {
     gnss: Packer,
     was: Packer,
     tractor: Packer,
+    imu: Packer,
     checks: CounterCheck,
     scenario: Scenario,
     outs: Vec<SimOutput>,
@@ -102,6 +120,9 @@ pub struct SimNode {
     distance: f64,
     /// Speed magnitude at the start: what the tractor drives at either way, m/s.
     cruise: f64,
+    profile: Option<SpeedProfile>,
+    /// The last direction request was forward (or there was none).
+    forward: bool,
 }
 
 impl SimNode {
@@ -113,6 +134,7 @@ impl SimNode {
             gnss: Packer::new(addresses.gnss),
             was: Packer::new(addresses.wheel_angle),
             tractor: Packer::new(addresses.tractor),
+            imu: Packer::new(addresses.imu),
             checks: CounterCheck::default(),
             scenario,
             outs: Vec::with_capacity(64),
@@ -123,7 +145,15 @@ impl SimNode {
             rejected: 0,
             frozen_counter: None,
             distance: 0.0,
+            profile: None,
+            forward: true,
         }
+    }
+
+    /// Drive forward with a speed profile (see [`SpeedProfile`]).
+    pub fn with_speed_profile(mut self, profile: Option<SpeedProfile>) -> Self {
+        self.profile = profile;
+        self
     }
 
     pub fn sim(&self) -> &Simulator {
@@ -151,6 +181,7 @@ impl SimNode {
         };
         if let Some(r) = d.to::<DirectionRequest>() {
             // The tractor obeys: brake to a stop, or head for the cruise speed either way.
+            self.forward = r.direction != STOP && r.direction != REVERSE;
             let target = match r.direction {
                 x if x == STOP => 0.0,
                 x if x == REVERSE => -self.cruise,
@@ -185,6 +216,11 @@ impl SimNode {
         } else {
             FixQuality::RtkFixed
         });
+        if let (Some(p), true) = (self.profile, self.forward) {
+            let turning = self.sim.true_state().wheel_angle.abs() > p.turn_angle;
+            self.sim
+                .set_speed_target(if turning { p.min } else { p.max });
+        }
         self.outs.clear();
         let mut outs = std::mem::take(&mut self.outs);
         self.sim.advance_to(t, &mut outs);
@@ -192,6 +228,14 @@ impl SimNode {
         for o in outs.drain(..) {
             match o {
                 SimOutput::WheelAngle { t: ts, angle } => self.wheel_frames(ts, angle, out),
+                SimOutput::Attitude { t: ts, roll, pitch } => {
+                    if let Ok(f) = self.imu.pack(&ImuAttitude {
+                        roll: Some(roll.to_degrees().clamp(-90.0, 90.0)),
+                        pitch: Some(pitch.to_degrees().clamp(-90.0, 90.0)),
+                    }) {
+                        out.push((ts, f));
+                    }
+                }
                 SimOutput::Gnss(m) => {
                     let ts = m.t_delivered;
                     if self.scenario.active(FaultKind::GnssDropout, ts) {
@@ -298,5 +342,139 @@ impl SimNode {
             f.data[7] ^= 0x5A;
         }
         out.push((ts, f));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::can::fastpacket::Reassembler;
+    use crate::geo::wgs84::LatLon;
+    use crate::geo::Pose;
+    use crate::sim::{Disturbances, SimParams};
+
+    fn node(dist: Disturbances) -> SimNode {
+        let p = SimParams {
+            antenna_up: 3.0,
+            dist,
+            ..SimParams::default()
+        };
+        SimNode::new(
+            Simulator::new(p, Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2), 3.0),
+            EnuFrame::new(LatLon {
+                lat_deg: 52.0,
+                lon_deg: 5.0,
+            }),
+            SimAddresses::default(),
+            Scenario::default(),
+        )
+    }
+
+    /// (delivery time, 129029 method) of every GNSS Position Data message.
+    fn methods(frames: &[(f64, Frame)]) -> Vec<(f64, u8)> {
+        let mut fast = Reassembler::default();
+        let mut out = Vec::new();
+        for (t, f) in frames {
+            let Ok(d) = codec::decode(f.id, f.payload()) else {
+                continue;
+            };
+            if d.index == codec::GnssPositionData::INDEX {
+                if let Ok(Some(p)) = fast.push(d.source, f.payload()) {
+                    out.push((*t, GnssPosition::decode(p).unwrap().method));
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn rtk_float_window_sends_method_float() {
+        let mut n = node(Disturbances {
+            float_windows: vec![(5.0, 3.0)],
+            float_sigma: 0.2,
+            float_tau: 10.0,
+            ..Disturbances::default()
+        });
+        let mut frames = Vec::new();
+        n.advance_to(12.0, &mut frames);
+        let m = methods(&frames);
+        assert!(m.len() > 100);
+        for (t, method) in m {
+            // Delivered 0.05 s after it was measured.
+            let measured = t - 0.05;
+            let expect = if (5.0 - 1e-9..8.0 - 1e-9).contains(&measured) {
+                METHOD_RTK_FLOAT
+            } else {
+                METHOD_RTK_FIXED
+            };
+            assert_eq!(method, expect, "measured at {measured}");
+        }
+        // No IMU configured: no attitude frames.
+        assert!(!frames.iter().any(|(_, f)| codec::decode(f.id, f.payload())
+            .is_ok_and(|d| d.to::<ImuAttitude>().is_some())));
+    }
+
+    #[test]
+    fn imu_frames_carry_roll_and_pitch_at_the_rate() {
+        let mut n = node(Disturbances {
+            terrain_slope: 2f64.to_radians(),
+            terrain_wavelength: 100.0,
+            imu_rate_hz: 50.0,
+            ..Disturbances::default()
+        });
+        let mut frames = Vec::new();
+        n.advance_to(2.0, &mut frames);
+        let mut checks = CounterCheck::default();
+        let imu: Vec<ImuAttitude> = frames
+            .iter()
+            .filter_map(|(_, f)| codec::decode(f.id, f.payload()).ok())
+            .filter(|d| d.to::<ImuAttitude>().is_some())
+            .map(|d| {
+                assert!(checks.check(&d), "counter and CRC");
+                d.to::<ImuAttitude>().unwrap()
+            })
+            .collect();
+        assert_eq!(imu.len(), 101);
+        for a in imu {
+            // Driving north across a slope falling East: right side down, +2°.
+            assert!((a.roll.unwrap() - 2.0).abs() < 0.011, "{:?}", a.roll);
+            assert!(a.pitch.unwrap().abs() < 0.011);
+        }
+    }
+
+    #[test]
+    fn speed_profile_slows_in_turns_and_speeds_up_on_the_straight() {
+        let p = SpeedProfile {
+            min: 4.0 / 3.6,
+            max: 15.0 / 3.6,
+            turn_angle: 5f64.to_radians(),
+        };
+        let mut n = node(Disturbances::default()).with_speed_profile(Some(p));
+        let mut frames = Vec::new();
+        let mut prev = n.sim().true_state().speed;
+        let mut t = 0.0;
+        let mut step = |n: &mut SimNode, until: f64, prev: &mut f64| {
+            while t < until {
+                t += 0.02;
+                frames.clear();
+                n.advance_to(t, &mut frames);
+                let v = n.sim().true_state().speed;
+                // At most the simulator's acceleration (0.5 m/s²).
+                assert!((v - *prev).abs() <= 0.5 * 0.02 + 1e-9);
+                *prev = v;
+            }
+        };
+        step(&mut n, 10.0, &mut prev);
+        assert!((n.sim().true_state().speed - p.max).abs() < 1e-9);
+        n.sim_mut().set_command(0.3);
+        step(&mut n, 20.0, &mut prev);
+        assert!((n.sim().true_state().speed - p.min).abs() < 1e-9);
+        n.sim_mut().set_command(0.0);
+        step(&mut n, 30.0, &mut prev);
+        assert!((n.sim().true_state().speed - p.max).abs() < 1e-9);
+        // Off: the start speed is kept.
+        let mut n = node(Disturbances::default());
+        n.advance_to(10.0, &mut frames);
+        assert_eq!(n.sim().true_state().speed, 3.0);
     }
 }

@@ -68,7 +68,8 @@ pub fn run(
         enu,
         SimAddresses::default(),
         scenario,
-    );
+    )
+    .with_speed_profile(agsteer::demo::speed_profile(cfg));
     let mut bus =
         SocketCanBus::open(iface, &[]).with_context(|| format!("opening CAN interface {iface}"))?;
     let mut traj = match trajectory {
