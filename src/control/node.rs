@@ -5,8 +5,8 @@
 use super::{ControlError, Controller};
 use crate::can::codec::{
     self, CodecError, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, GnssPositionData,
-    GuidanceStatus, GuidanceSystemCommand, OperatorCommand, Packer, PositionRapid, SteeringCommand,
-    VesselHeading, WheelAngle, WheelSpeed,
+    GuidanceStatus, GuidanceSystemCommand, ImuAttitude, OperatorCommand, Packer, PositionRapid,
+    SteeringCommand, VesselHeading, WheelAngle, WheelSpeed,
 };
 use crate::can::fastpacket::Reassembler;
 use crate::can::gnss::{yaw_from_north_cw, GnssPosition, METHOD_RTK_FIXED, METHOD_RTK_FLOAT};
@@ -22,6 +22,8 @@ use serde::Serialize;
 
 /// A dual-antenna heading older than this is not used, s.
 const HEADING_MAX_AGE: f64 = 0.5;
+/// An IMU roll older than this is not used to correct the antenna's lean, s.
+const ROLL_MAX_AGE: f64 = 0.5;
 /// A 129029 quality older than this no longer vouches for positions, s.
 const QUALITY_MAX_AGE: f64 = 2.0;
 
@@ -60,6 +62,8 @@ pub struct ControllerNode {
     fast: Reassembler,
     output: OutputKind,
     heading: Option<(f64, f64)>,
+    /// Latest IMU roll: (time s, rad, positive right side down).
+    roll: Option<(f64, f64)>,
     speed: f64,
     quality: Option<(f64, FixQuality)>,
     status_every: u64,
@@ -146,6 +150,7 @@ impl ControllerNode {
             fast: Reassembler::default(),
             output: cfg.bus.output,
             heading: None,
+            roll: None,
             speed: 0.0,
             quality: None,
             status_every: ((cfg.bus.status_period_s / cfg.dt()).round() as u64).max(1),
@@ -253,7 +258,10 @@ impl ControllerNode {
                 antenna,
                 heading,
                 speed: self.speed,
-                roll: None,
+                roll: self
+                    .roll
+                    .filter(|(tr, _)| t - tr <= ROLL_MAX_AGE)
+                    .map(|(_, r)| r),
             });
             let q = match self.quality {
                 Some((tq, q)) if t - tq <= QUALITY_MAX_AGE => q,
@@ -261,6 +269,10 @@ impl ControllerNode {
             };
             self.status.fix = q;
             self.supervisor.on_gnss(t, q);
+        } else if let Some(m) = d.to::<ImuAttitude>() {
+            if let Some(deg) = m.roll.filter(|r| r.is_finite()) {
+                self.roll = Some((t, deg.to_radians()));
+            }
         } else if let Some(m) = d.to::<VesselHeading>() {
             if let Some(h) = m.heading {
                 self.heading = Some((t, yaw_from_north_cw(h)));
