@@ -50,7 +50,6 @@ fn square_plan(side: f64, width: f64) -> (Field, FieldPlan) {
     let plan = FieldPlan {
         segments,
         working_area: vec![(field.boundary.clone(), Vec::new())],
-        headland_inner: Vec::new(),
         cells: 1,
         swath_angles: vec![0.0],
         swaths: n,

@@ -160,11 +160,17 @@ pub fn plan_geojson(
             json!({"role": "working_area", "index": i}),
         ));
     }
-    if !plan.headland_inner.is_empty() {
+    // The headland: the field inside its boundary and outside the working area.
+    let working_outlines: Vec<Vec<Vec2>> = plan
+        .working_area
+        .iter()
+        .map(|(outer, _)| outer.clone())
+        .collect();
+    if !working_outlines.is_empty() {
         features.push(polygon_feature(
             &frame,
             &field.boundary,
-            &plan.headland_inner,
+            &working_outlines,
             json!({"role": "headland_area"}),
         ));
     }
@@ -320,7 +326,6 @@ mod tests {
                 ),
             ],
             working_area: vec![(field.boundary.clone(), vec![])],
-            headland_inner: vec![],
             cells: 1,
             swath_angles: vec![0.0],
             swaths: 1,
@@ -364,6 +369,16 @@ mod tests {
         .unwrap();
         assert_eq!(back.field.obstacles.len(), 1);
         assert!((back.cleanup.area_after_m2 - (5000.0 - 50.0)).abs() < 0.01);
+        // The headland polygon: the boundary with each working area's outline as a hole.
+        let headland: Vec<&Value> = feats
+            .iter()
+            .filter(|f| f["properties"]["role"] == "headland_area")
+            .collect();
+        assert_eq!(headland.len(), usize::from(!plan.working_area.is_empty()));
+        if let Some(h) = headland.first() {
+            let rings = h["geometry"]["coordinates"].as_array().unwrap();
+            assert_eq!(rings.len(), 1 + plan.working_area.len());
+        }
     }
 
     #[test]

@@ -7,6 +7,11 @@
 
 use super::{cross, v2, Vec2};
 
+/// Length along a polyline, m.
+pub fn polyline_length(points: &[Vec2]) -> f64 {
+    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
 /// The signed area of a ring, m² (positive when counter-clockwise).
 pub fn signed_area(ring: &[Vec2]) -> f64 {
     let n = ring.len();

@@ -38,7 +38,7 @@ impl JobSegment {
 
     /// Length along the points, m.
     pub fn length(&self) -> f64 {
-        self.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+        crate::geo::polygon::polyline_length(&self.points)
     }
 }
 

@@ -133,7 +133,7 @@ pub fn headland_tracks(boundary: &[Vec2], p: &CoverageParams) -> Vec<Vec<Vec2>> 
 /// Points evenly spaced by arc length along a polyline, about `spacing` m apart, from its
 /// first to its exact last point.
 pub fn resample(points: &[Vec2], spacing: f64) -> Vec<Vec2> {
-    let total: f64 = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    let total = crate::geo::polygon::polyline_length(points);
     let Some(&first) = points.first() else {
         return Vec::new();
     };

@@ -123,10 +123,6 @@ fn max_curvature(points: &[Vec2]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn length(points: &[Vec2]) -> f64 {
-    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
-}
-
 fn inside_inflated(p: &Vec2, obstacle: &[Vec2], margin: f64) -> bool {
     if contains_point(obstacle, p) {
         return true;
@@ -214,7 +210,7 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
         plan.segments
             .iter()
             .filter(|s| s.kind == k)
-            .map(|s| length(&s.points))
+            .map(|s| crate::geo::polygon::polyline_length(&s.points))
             .sum()
     };
     let reversals = plan

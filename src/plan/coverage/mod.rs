@@ -112,9 +112,6 @@ pub struct FieldPlan {
     pub segments: Vec<PlanSegment>,
     /// The working area (inside the headland) as polygons: (outer ring, holes), all CCW.
     pub working_area: Vec<(Vec<Vec2>, Vec<Vec<Vec2>>)>,
-    /// The headland ring: the field boundary minus the working area, as its inner boundary
-    /// rings (CCW) — the outer boundary is the field's.
-    pub headland_inner: Vec<Vec<Vec2>>,
     /// Number of cells after decomposition.
     pub cells: usize,
     /// Swath direction of each cell, rad CCW from East.
@@ -323,16 +320,6 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         }
     }
 
-    if std::env::var("DBG").is_ok() {
-        for (c, a) in &cells {
-            eprintln!("cell {} verts {} holes angle {a}", c.0.len(), c.1.len());
-        }
-        eprintln!(
-            "working {} areas, holes {:?}",
-            working.len(),
-            working.iter().map(|w| w.1.len()).collect::<Vec<_>>()
-        );
-    }
     let tp = p.turn_params();
     let mut cache = turns::TurnCache::default();
     let mut segments: Vec<PlanSegment> = Vec::new();
@@ -597,20 +584,7 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
                 .map(|(a, b)| b - a)
                 .sum::<f64>()
             / lines.ys.len().max(1) as f64;
-        if std::env::var("DBG").is_ok() {
-            for (k, iv) in lines.intervals.iter().enumerate() {
-                if iv.len() > 1
-                    || (k > 0 && lines.intervals[k - 1].len() > 1)
-                    || lines.intervals.get(k + 1).is_some_and(|v| v.len() > 1)
-                {
-                    eprintln!("line {k} y {:.2} {:?}", lines.ys[k], iv);
-                }
-            }
-        }
         for run in swaths::runs(&lines) {
-            if std::env::var("DBG").is_ok() {
-                eprintln!("run {:?}", run.iter().map(|r| r.0).collect::<Vec<_>>());
-            }
             swath_total += run.len();
             pending.push((ci, *angle, run, lines.clone()));
         }
@@ -647,7 +621,6 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     Ok(FieldPlan {
         segments,
         working_area: working,
-        headland_inner: Vec::new(),
         cells: cells.len(),
         swath_angles: cells.iter().map(|c| c.1).collect(),
         swaths: swath_total,
@@ -687,9 +660,9 @@ fn split_for_detours(
 ) -> Vec<(SegmentKind, Vec<Vec2>)> {
     let n = pts.len();
     let blocked: Vec<usize> = (0..n).filter(|&i| !clear(&pts[i])).collect();
-    let (Some(&first), Some(&last)) = (blocked.first(), blocked.last()) else {
+    if blocked.is_empty() {
         return vec![(SegmentKind::Work, pts)];
-    };
+    }
     // Blocked stretches, merged when their leads would overlap.
     let mut stretches: Vec<(usize, usize)> = Vec::new();
     for &i in &blocked {
@@ -697,9 +670,6 @@ fn split_for_detours(
             Some(s) if i <= s.1 + 2 * lead + 1 => s.1 = i,
             _ => stretches.push((i, i)),
         }
-    }
-    if first < lead || last + lead >= n {
-        return vec![(SegmentKind::Work, pts)];
     }
     let heading = vec_heading(&(pts[n - 1] - pts[0]));
     let mut out = Vec::new();
@@ -716,7 +686,7 @@ fn split_for_detours(
                     return None;
                 }
                 let way = detour(pts[a], heading, pts[b], heading)?;
-                let extra = transit::polyline_length(&way) - (pts[b] - pts[a]).norm();
+                let extra = crate::geo::polygon::polyline_length(&way) - (pts[b] - pts[a]).norm();
                 Some((extra, a, b, way))
             })
             .collect();
@@ -943,19 +913,6 @@ mod tests {
     pub(crate) fn check(field: &Field, p: &CoverageParams) -> FieldPlan {
         let plan = plan_field(field, p).unwrap();
         assert!(plan.swaths > 0);
-        if std::env::var("DBG").is_ok() {
-            for s in &plan.segments {
-                eprintln!(
-                    "{} {:?} {:?} {:?} → {:?} n={}",
-                    s.index,
-                    s.kind,
-                    s.direction,
-                    s.points[0],
-                    s.points.last().unwrap(),
-                    s.points.len()
-                );
-            }
-        }
         for s in &plan.segments {
             for q in &s.points {
                 assert!(

@@ -216,11 +216,6 @@ impl WaypointGrid {
     }
 }
 
-/// Length of a polyline, m.
-pub fn polyline_length(points: &[Vec2]) -> f64 {
-    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
-}
-
 /// Weight of the distance to go (through the grid) in the search's priority (> 1: fewer
 /// states expanded, a transit at most about this factor longer than the best).
 const HEURISTIC_WEIGHT: f64 = 1.5;
@@ -257,7 +252,7 @@ pub fn route_graph(
     };
     let edge = |a: (Vec2, f64), b: (Vec2, f64)| -> Option<(f64, Vec<Vec2>)> {
         match transit(a.0, a.1, b.0, b.1, r, step, clear) {
-            Some((pts, true)) => Some((polyline_length(&pts), pts)),
+            Some((pts, true)) => Some((crate::geo::polygon::polyline_length(&pts), pts)),
             _ => None,
         }
     };

@@ -32,7 +32,6 @@ fn plan(swath_ys: &[f64]) -> (Field, FieldPlan) {
     let plan = FieldPlan {
         segments,
         working_area: vec![(field.boundary.clone(), Vec::new())],
-        headland_inner: Vec::new(),
         cells: 1,
         swath_angles: vec![0.0],
         swaths: swath_ys.len(),
