@@ -6,3 +6,5 @@
 //! sampled at any spacing.
 
 pub mod path;
+pub mod collision;
+mod tmp_curve;
