@@ -8,3 +8,6 @@
 pub mod path;
 pub mod collision;
 mod tmp_curve;
+pub mod expansion;
+pub mod search;
+pub mod steering;

@@ -156,3 +156,19 @@ pub fn cc_turn(delta_rad: f64, direction: Direction, params: &CurveParams) -> Ve
         ]
     }
 }
+
+pub fn reeds_shepp_shortest(_start: &Pose, _goal: &Pose, _r_min_m: f64) -> Option<CurvePath> {
+    None
+}
+
+pub fn reeds_shepp_length(start: &Pose, goal: &Pose, _r_min_m: f64) -> Option<f64> {
+    Some((goal.pos - start.pos).norm())
+}
+
+pub fn cc_reeds_shepp_shortest(
+    _start: &Pose,
+    _goal: &Pose,
+    _params: &CurveParams,
+) -> Option<CurvePath> {
+    None
+}

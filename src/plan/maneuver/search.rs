@@ -1,0 +1,648 @@
+//! The seed-004 manoeuvre planner (SPEC §4): endpoint checks, straight-line expansion to a
+//! rough route, a reversing pattern at the goal chosen from the side the route arrives from,
+//! and a hybrid-A* search with curve primitives and analytic connection for the rest.
+//!
+//! Stages, in order (each later one only when the earlier ones found nothing):
+//! 1. **Endpoints.** The footprint at the start and at the goal must be clear; otherwise
+//!    [`ManeuverError::Endpoint`] names the endpoint and why.
+//! 2. **Direct.** The analytic connection start → goal, when it is clear.
+//! 3. **Rough route** ([`rough_route`]), used by 4 and 6.
+//! 4. **Goal pattern** (seed ¶51–60). The first two legs of the route at the goal say whether it
+//!    arrives from the goal's left or right, and by how much it must turn (the angle between
+//!    the second leg's direction of travel and the goal heading). Each configured pattern
+//!    (written for an arrival from the left, e.g. `lrlr_pnpn`; mirrored l ↔ r for the right)
+//!    splits that turn evenly over its curves; the pattern is laid back from the goal to its
+//!    other end, and when its sweep is clear the search (5) runs from the start to that end.
+//!    The pattern's curves are the same continuous-curvature turns as the primitives.
+//! 5. **Hybrid A\*** from the start to the goal (Dolgov et al., "Practical search techniques in
+//!    path planning for autonomous driving", 2008; primitives as in seed ¶34–36): from every node
+//!    the primitive turns whose heading change steps by `heading_step` up to `primitive_max`
+//!    either way, forward and reverse (a change of 0 is a straight of `straight_step_m`); cost =
+//!    forward length + `reverse_penalty` × reverse length + `cusp_penalty_m` per change of
+//!    direction; heuristic max(Euclidean, Reeds-Shepp length); duplicates merged on a coarse
+//!    (x, y, heading) grid; every `analytic_every` expansions the analytic connection to the
+//!    target is tried and, when clear, kept if it is the cheapest so far; the search goes on for
+//!    `extra_expansions` more expansions (or until no open node can beat it) and returns the
+//!    cheapest. When the pattern stage found a path, this search runs with that cost as a bound
+//!    and replaces it only with a cheaper one, so a pattern's reversals are kept only when they
+//!    pay (the seed takes the pattern unconditionally; a farmer would not want needless
+//!    reversals in open ground).
+//! 6. **Fallback** (seed ¶81–82): the search is retried between points along the route's first
+//!    leg and points along its last leg (reached from the endpoints by straight driving along
+//!    their headings).
+//!
+//! Pure: no I/O, no clock. All limits are in [`ManeuverParams`] (the `[maneuver]` section).
+
+use super::collision::{Blocked, CollisionMap, Footprint};
+use super::expansion::{leg_clear, rough_route, ExpansionParams, RoughRoute};
+use super::path::{CurveKind, CurveSegment};
+use super::steering::Steering;
+use super::tmp_curve::{CurvePath, PathSample};
+use crate::geo::{cross, heading_vec, vec_heading, wrap_angle, Direction, Pose, Vec2};
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap, HashSet};
+
+/// Every tunable of the planner, SI units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ManeuverParams {
+    /// Vehicle (and implement) rectangle with the clearance margin.
+    pub footprint: Footprint,
+    /// Largest distance any footprint point moves between collision samples, m.
+    pub sample_tolerance_m: f64,
+    /// Straight-line expansion limits.
+    pub expansion: ExpansionParams,
+    /// Goal-side reversing patterns for an arrival from the left (mirrored for the right),
+    /// e.g. `lrlr_pnpn`; empty = no pattern stage.
+    pub goal_patterns: Vec<String>,
+    /// Heading-change step of the primitives, rad.
+    pub heading_step_rad: f64,
+    /// Largest heading change of a primitive, rad (≤ π).
+    pub primitive_max_rad: f64,
+    /// Length of the straight primitive, m.
+    pub straight_step_m: f64,
+    /// Reverse length is multiplied by this in the cost (≥ 1).
+    pub reverse_penalty: f64,
+    /// Cost of each change of driving direction, m.
+    pub cusp_penalty_m: f64,
+    /// Duplicate-detection grid: position cell, m, and heading cell, rad.
+    pub xy_resolution_m: f64,
+    pub heading_resolution_rad: f64,
+    /// Most node expansions over all searches of one plan.
+    pub max_expansions: usize,
+    /// Try the analytic connection every this many expansions (1 = every one).
+    pub analytic_every: usize,
+    /// Expansions after the first solution spent looking for a cheaper one.
+    pub extra_expansions: usize,
+    /// Points per leg tried in the fallback stage.
+    pub fallback_points: usize,
+}
+
+/// How a path was found.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// The analytic connection start → goal.
+    Direct,
+    /// Search to a goal pattern, then the pattern (its name as applied, e.g. `rlrl_pnpn`).
+    Pattern(String),
+    /// Hybrid-A* search straight to the goal.
+    Search,
+    /// Search between points on the rough route's first and last legs.
+    Fallback,
+}
+
+/// The planner's answer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ManeuverResult {
+    /// The path from the start pose, when found.
+    pub path: Option<CurvePath>,
+    pub method: Option<Method>,
+    /// Node expansions over all searches.
+    pub expansions: usize,
+    /// The rough route of the straight-line expansion (empty when not needed or not found).
+    pub rough_route: Vec<Vec2>,
+    /// Why no path was found (`None` when found).
+    pub failure: Option<String>,
+}
+
+/// Which endpoint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Endpoint {
+    Start,
+    Goal,
+}
+
+impl std::fmt::Display for Endpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Endpoint::Start => "start",
+            Endpoint::Goal => "goal",
+        })
+    }
+}
+
+/// Why planning could not start.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ManeuverError {
+    #[error("{endpoint} pose is invalid: {reason}")]
+    Endpoint { endpoint: Endpoint, reason: Blocked },
+    #[error("{endpoint} pose is not finite")]
+    NotFinite { endpoint: Endpoint },
+    #[error("goal pattern `{0}`: expected curves of l/r, `_`, and as many directions p/n (e.g. lrlr_pnpn)")]
+    BadPattern(String),
+}
+
+/// Parse a pattern like `lrlr_pnpn` into (curvature sign, direction) per curve.
+pub fn parse_pattern(s: &str) -> Result<Vec<(f64, Direction)>, ManeuverError> {
+    let bad = || ManeuverError::BadPattern(s.to_string());
+    let (curves, dirs) = s.split_once('_').ok_or_else(bad)?;
+    if curves.is_empty() || curves.len() != dirs.len() {
+        return Err(bad());
+    }
+    curves
+        .chars()
+        .zip(dirs.chars())
+        .map(|(c, d)| {
+            let side = match c {
+                'l' => 1.0,
+                'r' => -1.0,
+                _ => return Err(bad()),
+            };
+            let dir = match d {
+                'p' => Direction::Forward,
+                'n' => Direction::Reverse,
+                _ => return Err(bad()),
+            };
+            Ok((side, dir))
+        })
+        .collect()
+}
+
+fn dir_sign(d: Direction) -> f64 {
+    match d {
+        Direction::Forward => 1.0,
+        Direction::Reverse => -1.0,
+    }
+}
+
+/// `local` (relative to the origin pose) placed at `at`.
+fn compose(at: &Pose, local: &Pose) -> Pose {
+    let (s, c) = at.heading.sin_cos();
+    Pose::new(
+        at.pos.x + c * local.pos.x - s * local.pos.y,
+        at.pos.y + s * local.pos.x + c * local.pos.y,
+        at.heading + local.heading,
+    )
+}
+
+/// A precomputed primitive: its segments and its samples relative to the origin pose.
+struct Primitive {
+    segments: Vec<CurveSegment>,
+    direction: Direction,
+    length: f64,
+    end: Pose,
+    samples: Vec<Pose>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    pose: Pose,
+    g: f64,
+    parent: Option<usize>,
+    primitive: usize,
+    direction: Option<Direction>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Open {
+    f: f64,
+    node: usize,
+}
+impl Eq for Open {}
+impl Ord for Open {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.f.total_cmp(&self.f).then(o.node.cmp(&self.node))
+    }
+}
+impl PartialOrd for Open {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+struct Planner<'a, S: Steering> {
+    map: &'a CollisionMap,
+    steer: &'a S,
+    p: &'a ManeuverParams,
+    spacing: f64,
+    prims: Vec<Primitive>,
+    expansions: usize,
+    buf: Vec<PathSample>,
+}
+
+impl<'a, S: Steering> Planner<'a, S> {
+    fn new(map: &'a CollisionMap, steer: &'a S, p: &'a ManeuverParams) -> Self {
+        let spacing = p
+            .footprint
+            .sample_spacing_m(p.sample_tolerance_m, steer.kappa_max());
+        let mut prims = Vec::new();
+        let mut buf = Vec::new();
+        let step = p.heading_step_rad.max(1e-3);
+        let n = (p.primitive_max_rad / step + 1e-9).floor() as i64;
+        for direction in [Direction::Forward, Direction::Reverse] {
+            for k in -n..=n {
+                let delta = k as f64 * step;
+                let segments = steer.turn(delta, direction, p.straight_step_m);
+                let path = CurvePath {
+                    start: Pose::new(0.0, 0.0, 0.0),
+                    segments,
+                };
+                path.sample(spacing, &mut buf);
+                prims.push(Primitive {
+                    length: path.length(),
+                    end: path.end_pose(),
+                    samples: buf.iter().skip(1).map(|s| s.pose).collect(),
+                    segments: path.segments,
+                    direction,
+                });
+            }
+        }
+        Planner {
+            map,
+            steer,
+            p,
+            spacing,
+            prims,
+            expansions: 0,
+            buf,
+        }
+    }
+
+    fn path_clear(&mut self, path: &CurvePath) -> bool {
+        path.sample(self.spacing, &mut self.buf);
+        self.map
+            .poses_clear(&self.p.footprint, self.buf.iter().map(|s| &s.pose))
+            .is_ok()
+    }
+
+    /// Cost of segments driven after a segment in `prev` direction.
+    fn cost(&self, segments: &[CurveSegment], mut prev: Option<Direction>) -> f64 {
+        let mut c = 0.0;
+        for s in segments.iter().filter(|s| s.length > 1e-9) {
+            c += match s.direction {
+                Direction::Forward => s.length,
+                Direction::Reverse => self.p.reverse_penalty * s.length,
+            };
+            if prev.is_some_and(|d| d != s.direction) {
+                c += self.p.cusp_penalty_m;
+            }
+            prev = Some(s.direction);
+        }
+        c
+    }
+
+    fn key(&self, pose: &Pose) -> (i64, i64, i64) {
+        let r = self.p.xy_resolution_m;
+        let h = self.p.heading_resolution_rad;
+        (
+            (pose.pos.x / r).floor() as i64,
+            (pose.pos.y / r).floor() as i64,
+            ((wrap_angle(pose.heading) + std::f64::consts::PI) / h).round() as i64
+                % ((std::f64::consts::TAU / h).round() as i64).max(1),
+        )
+    }
+
+    fn heuristic(&self, pose: &Pose, goal: &Pose) -> f64 {
+        self.steer.distance(pose, goal)
+    }
+
+    fn budget_left(&self) -> usize {
+        self.p.max_expansions.saturating_sub(self.expansions)
+    }
+
+    /// Hybrid A* from `from` to `to`. Returns the path and its cost when one cheaper than
+    /// `bound` is found.
+    fn search(
+        &mut self,
+        from: &Pose,
+        to: &Pose,
+        first_direction: Option<Direction>,
+        bound: f64,
+    ) -> Option<(CurvePath, f64)> {
+        let mut nodes = vec![Node {
+            pose: *from,
+            g: 0.0,
+            parent: None,
+            primitive: usize::MAX,
+            direction: first_direction,
+        }];
+        let mut open = BinaryHeap::new();
+        open.push(Open {
+            f: self.heuristic(from, to),
+            node: 0,
+        });
+        let mut best_g: HashMap<(i64, i64, i64), f64> = HashMap::new();
+        best_g.insert(self.key(from), 0.0);
+        let mut closed: HashSet<(i64, i64, i64)> = HashSet::new();
+        let mut best: Option<(usize, CurvePath, f64)> = None;
+        let mut bound = bound;
+        let mut since_found = 0usize;
+        let mut local = 0usize;
+        while let Some(Open { f, node }) = open.pop() {
+            if f >= bound {
+                break;
+            }
+            let n = nodes[node];
+            let key = self.key(&n.pose);
+            if !closed.insert(key) && node != 0 {
+                continue;
+            }
+            if self.budget_left() == 0 {
+                break;
+            }
+            self.expansions += 1;
+            local += 1;
+            if best.is_some() {
+                since_found += 1;
+                if since_found > self.p.extra_expansions {
+                    break;
+                }
+            }
+            if (local - 1) % self.p.analytic_every.max(1) == 0 {
+                if let Some(conn) = self.steer.connect(&n.pose, to) {
+                    let c = n.g + self.cost(&conn.segments, n.direction);
+                    if c < bound && self.path_clear(&conn) {
+                        bound = c;
+                        best = Some((node, conn, c));
+                    }
+                }
+            }
+            for (pi, prim) in self.prims.iter().enumerate() {
+                let end = compose(&n.pose, &prim.end);
+                let mut g = n.g + prim.length;
+                if prim.direction == Direction::Reverse {
+                    g += (self.p.reverse_penalty - 1.0) * prim.length;
+                }
+                if n.direction.is_some_and(|d| d != prim.direction) {
+                    g += self.p.cusp_penalty_m;
+                }
+                let k = self.key(&end);
+                if closed.contains(&k) || best_g.get(&k).is_some_and(|&b| b <= g) {
+                    continue;
+                }
+                let h = self.heuristic(&end, to);
+                if g + h >= bound {
+                    continue;
+                }
+                let clear = prim.samples.iter().all(|s| {
+                    self.map
+                        .pose_clear(&self.p.footprint, &compose(&n.pose, s))
+                        .is_ok()
+                });
+                if !clear {
+                    continue;
+                }
+                best_g.insert(k, g);
+                nodes.push(Node {
+                    pose: end,
+                    g,
+                    parent: Some(node),
+                    primitive: pi,
+                    direction: Some(prim.direction),
+                });
+                open.push(Open {
+                    f: g + h,
+                    node: nodes.len() - 1,
+                });
+            }
+        }
+        let (node, conn, cost) = best?;
+        let mut chain = Vec::new();
+        let mut k = Some(node);
+        while let Some(i) = k {
+            if nodes[i].parent.is_some() {
+                chain.push(nodes[i].primitive);
+            }
+            k = nodes[i].parent;
+        }
+        chain.reverse();
+        let mut segments: Vec<CurveSegment> = chain
+            .iter()
+            .flat_map(|&pi| self.prims[pi].segments.iter().copied())
+            .collect();
+        segments.extend(conn.segments);
+        Some((
+            CurvePath {
+                start: *from,
+                segments,
+            },
+            cost,
+        ))
+    }
+
+    /// The goal pattern laid back from `goal`: its start pose and path, when clear.
+    fn goal_pattern(
+        &mut self,
+        pattern: &[(f64, Direction)],
+        mirror: bool,
+        turn: f64,
+        goal: &Pose,
+    ) -> Option<CurvePath> {
+        let delta = turn.abs() / pattern.len() as f64;
+        let mut segments = Vec::new();
+        for &(side, dir) in pattern {
+            let side = if mirror { -side } else { side };
+            // Heading change = curvature sign × driving-direction sign.
+            let d = side * dir_sign(dir) * delta;
+            segments.extend(self.steer.turn(d, dir, 0.0));
+        }
+        let rel = CurvePath {
+            start: Pose::new(0.0, 0.0, 0.0),
+            segments: segments.clone(),
+        }
+        .end_pose();
+        // start ∘ rel = goal.
+        let h = goal.heading - rel.heading;
+        let (s, c) = h.sin_cos();
+        let start = Pose::new(
+            goal.pos.x - (c * rel.pos.x - s * rel.pos.y),
+            goal.pos.y - (s * rel.pos.x + c * rel.pos.y),
+            h,
+        );
+        let path = CurvePath { start, segments };
+        self.path_clear(&path).then_some(path)
+    }
+}
+
+/// The side the rough route arrives from at the goal and the heading change it implies: the
+/// goal heading minus the direction of travel along the route's second leg from the goal
+/// (+ = arriving from the goal's left, turning left into it). `None` when the route has a
+/// single leg at the goal and the start lies on the goal's line.
+pub fn approach_turn(route: &RoughRoute, goal: &Pose) -> Option<f64> {
+    let n = route.points.len();
+    let from = if n >= 3 {
+        route.points[n - 3]
+    } else {
+        *route.points.first()?
+    };
+    let side = cross(&heading_vec(goal.heading), &(from - goal.pos));
+    if side.abs() < 1e-6 {
+        return None;
+    }
+    let mut turn = std::f64::consts::FRAC_PI_2;
+    if n >= 3 {
+        let travel = vec_heading(&(route.points[n - 2] - from));
+        // The first leg may be driven forward or in reverse: fold into [0, π/2].
+        let t = wrap_angle(goal.heading - travel).abs();
+        let t = t.min(std::f64::consts::PI - t);
+        if t > 1e-6 {
+            turn = t;
+        }
+    }
+    Some(side.signum() * turn)
+}
+
+/// Plan a manoeuvre from `start` to `goal` on `map` with `steer` (see the module docs).
+pub fn plan_maneuver<S: Steering>(
+    map: &CollisionMap,
+    steer: &S,
+    p: &ManeuverParams,
+    start: &Pose,
+    goal: &Pose,
+) -> Result<ManeuverResult, ManeuverError> {
+    for (endpoint, pose) in [(Endpoint::Start, start), (Endpoint::Goal, goal)] {
+        if !(pose.pos.x.is_finite() && pose.pos.y.is_finite() && pose.heading.is_finite()) {
+            return Err(ManeuverError::NotFinite { endpoint });
+        }
+        map.pose_clear(&p.footprint, pose)
+            .map_err(|reason| ManeuverError::Endpoint { endpoint, reason })?;
+    }
+    let patterns = p
+        .goal_patterns
+        .iter()
+        .map(|s| parse_pattern(s).map(|pat| (s.clone(), pat)))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut pl = Planner::new(map, steer, p);
+    let found = |path: CurvePath, method: Method, pl: &Planner<S>, route: Vec<Vec2>| {
+        tracing::debug!(?method, expansions = pl.expansions, "manoeuvre found");
+        ManeuverResult {
+            path: Some(path),
+            method: Some(method),
+            expansions: pl.expansions,
+            rough_route: route,
+            failure: None,
+        }
+    };
+    // 2. Direct connection.
+    if let Some(direct) = steer.connect(start, goal) {
+        if pl.path_clear(&direct) {
+            return Ok(found(direct, Method::Direct, &pl, Vec::new()));
+        }
+    }
+    // 3. Rough route.
+    let route = rough_route(
+        map,
+        &p.footprint,
+        start,
+        goal,
+        &p.expansion,
+        pl.spacing.max(0.05),
+    );
+    let route_pts = route.as_ref().map(|r| r.points.clone()).unwrap_or_default();
+    // 4. Goal pattern, then 5. the plain search with the pattern's cost as a bound.
+    let mut best: Option<(CurvePath, f64, Method)> = None;
+    if let Some(turn) = route.as_ref().and_then(|r| approach_turn(r, goal)) {
+        if turn.abs() > p.heading_step_rad * 0.5 {
+            for (name, pat) in &patterns {
+                let mirror = turn < 0.0;
+                let Some(tail) = pl.goal_pattern(pat, mirror, turn, goal) else {
+                    continue;
+                };
+                if let Some((head, c)) = pl.search(start, &tail.start, None, f64::INFINITY) {
+                    let last = head.segments.iter().rev().find(|s| s.length > 1e-9);
+                    let total = c + pl.cost(&tail.segments, last.map(|s| s.direction));
+                    let applied = if mirror {
+                        name.chars()
+                            .map(|ch| match ch {
+                                'l' => 'r',
+                                'r' => 'l',
+                                other => other,
+                            })
+                            .collect()
+                    } else {
+                        name.clone()
+                    };
+                    best = Some((head.then(tail), total, Method::Pattern(applied)));
+                    break;
+                }
+            }
+        }
+    }
+    let bound = best.as_ref().map_or(f64::INFINITY, |b| b.1);
+    if let Some((path, c)) = pl.search(start, goal, None, bound) {
+        if c < bound {
+            best = Some((path, c, Method::Search));
+        }
+    }
+    if let Some((path, _, method)) = best {
+        return Ok(found(path, method, &pl, route_pts));
+    }
+    // 6. Fallback along the first and last legs.
+    if let Some(r) = &route {
+        if let (Some((s0, s1)), Some((g0, g1))) = (r.first_leg(), r.last_leg()) {
+            let k = p.fallback_points.max(1);
+            let along = |a: Vec2, b: Vec2, i: usize| a + (b - a) * (i as f64 / k as f64);
+            'outer: for i in 1..=k {
+                let ps = along(s0, s1, i);
+                for j in 0..k {
+                    if pl.budget_left() == 0 {
+                        break 'outer;
+                    }
+                    let pg = along(g0, g1, j);
+                    let from = Pose::new(ps.x, ps.y, start.heading);
+                    let to = Pose::new(pg.x, pg.y, goal.heading);
+                    let lead = straight(start, &from);
+                    let trail = straight(&to, goal);
+                    if !leg_clear(map, &p.footprint, start.pos, ps, pl.spacing)
+                        || !pl.path_clear(&lead)
+                        || !pl.path_clear(&trail)
+                    {
+                        continue;
+                    }
+                    let first_dir = lead.segments.first().map(|s| s.direction);
+                    if let Some((mid, _)) = pl.search(&from, &to, first_dir, f64::INFINITY) {
+                        let path = lead.then(mid).then(trail);
+                        return Ok(found(path, Method::Fallback, &pl, route_pts));
+                    }
+                }
+            }
+        }
+    }
+    let failure = if route.is_none() {
+        format!(
+            "no route: the straight-line expansion found no way between start and goal, and the search found no path in {} expansions",
+            pl.expansions
+        )
+    } else if pl.budget_left() == 0 {
+        format!("search budget of {} expansions used up", p.max_expansions)
+    } else {
+        format!(
+            "no collision-free path found ({} expansions)",
+            pl.expansions
+        )
+    };
+    Ok(ManeuverResult {
+        path: None,
+        method: None,
+        expansions: pl.expansions,
+        rough_route: route_pts,
+        failure: Some(failure),
+    })
+}
+
+/// A straight drive from `a` to `b` (same heading): forward when `b` lies ahead.
+fn straight(a: &Pose, b: &Pose) -> CurvePath {
+    let d = b.pos - a.pos;
+    let ahead = d.dot(&heading_vec(a.heading));
+    let direction = if ahead >= 0.0 {
+        Direction::Forward
+    } else {
+        Direction::Reverse
+    };
+    let length = d.norm();
+    CurvePath {
+        start: *a,
+        segments: if length > 1e-9 {
+            vec![CurveSegment {
+                kind: CurveKind::Line,
+                direction,
+                length,
+                kappa_start: 0.0,
+                kappa_end: 0.0,
+                sharpness: 0.0,
+            }]
+        } else {
+            Vec::new()
+        },
+    }
+}
