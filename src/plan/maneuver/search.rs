@@ -49,6 +49,8 @@ pub struct ManeuverParams {
     pub footprint: Footprint,
     /// Largest distance any footprint point moves between collision samples, m.
     pub sample_tolerance_m: f64,
+    /// Cell of the collision map's broad-phase grid, m (for whoever builds the map).
+    pub grid_cell_m: f64,
     /// Straight-line expansion limits.
     pub expansion: ExpansionParams,
     /// Goal-side reversing patterns for an arrival from the left (mirrored for the right),

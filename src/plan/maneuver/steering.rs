@@ -2,9 +2,9 @@
 //! CC Reeds-Shepp connections (SPEC §4), or plain arcs and Reeds-Shepp connections.
 
 use super::path::{CurveKind, CurveSegment};
+pub use super::tmp_curve::CurveParams;
 use super::tmp_curve::{
-    cc_reeds_shepp_shortest, cc_turn, reeds_shepp_length, reeds_shepp_shortest, CurveParams,
-    CurvePath,
+    cc_reeds_shepp_shortest, cc_turn, reeds_shepp_length, reeds_shepp_shortest, CurvePath,
 };
 use crate::geo::{Direction, Pose};
 
