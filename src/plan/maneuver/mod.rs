@@ -8,3 +8,4 @@
 pub mod cc_turn;
 pub mod fresnel;
 pub mod path;
+pub mod reeds_shepp;
