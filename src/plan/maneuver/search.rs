@@ -35,9 +35,8 @@
 
 use super::collision::{Blocked, CollisionMap, Footprint};
 use super::expansion::{leg_clear, rough_route, ExpansionParams, RoughRoute};
-use super::path::{CurveKind, CurveSegment};
+use super::path::{CurveKind, CurvePath, CurveSegment, PathSample};
 use super::steering::Steering;
-use super::tmp_curve::{CurvePath, PathSample};
 use crate::geo::{cross, heading_vec, vec_heading, wrap_angle, Direction, Pose, Vec2};
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap, HashSet};

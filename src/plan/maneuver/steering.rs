@@ -2,10 +2,11 @@
 //! CC Reeds-Shepp connections (SPEC §4), or plain arcs and Reeds-Shepp connections.
 
 use super::path::{CurveKind, CurveSegment};
-pub use super::tmp_curve::CurveParams;
-use super::tmp_curve::{
-    cc_reeds_shepp_shortest, cc_turn, reeds_shepp_length, reeds_shepp_shortest, CurvePath,
-};
+use super::cc_turn::cc_turn;
+pub use super::path::CurveParams;
+use super::path::CurvePath;
+use super::reeds_shepp::{reeds_shepp_length, reeds_shepp_shortest};
+use super::tmp_curve::cc_reeds_shepp_shortest;
 use crate::geo::{Direction, Pose};
 
 /// What the search needs from a curve family.
