@@ -668,7 +668,7 @@ impl Default for ManeuverConfig {
             expansion_step_m: 5.0,
             expansion_join_m: 0.5,
             expansion_max_depth: 8,
-            expansion_max_legs: 300,
+            expansion_max_legs: 600,
             goal_patterns: vec!["lrlr_pnpn".to_string(), "lr_pn".to_string()],
             heading_step_deg: 10.0,
             primitive_max_deg: 90.0,

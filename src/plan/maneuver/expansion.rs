@@ -3,7 +3,10 @@
 //!
 //! From each endpoint a first leg runs along its heading (forward and backward, each kept when
 //! the vehicle driving along it stays clear); from the end of every newest leg two legs run at
-//! right angles to it, one to each side, kept when clear. The two trees grow a level at a time
+//! right angles to it, one to each side, kept when clear; beyond the seed, a third leg continues
+//! straight on (with only right-angle children the legs alternate between two directions and
+//! two trees on offset lattices often pass each other without meeting). The two trees grow a
+//! level at a time
 //! until a newest leg of one comes within `join_m` of a leg of the other (crossing legs are at
 //! distance 0). Walking back from the two closest points to the roots gives the route.
 
@@ -112,7 +115,8 @@ fn segment_distance(a0: Vec2, a1: Vec2, b0: Vec2, b1: Vec2) -> (f64, Vec2, Vec2)
 struct Tree {
     legs: Vec<Leg>,
     newest: Vec<usize>,
-    ends: HashSet<(i64, i64)>,
+    /// Leg ends seen, with the leg's orientation (0 = mostly along x, 1 = along y).
+    ends: HashSet<(i64, i64, bool)>,
 }
 
 impl Tree {
@@ -130,9 +134,14 @@ impl Tree {
         t
     }
 
-    fn key(p: &Vec2, step: f64) -> (i64, i64) {
+    fn key(a: &Vec2, b: &Vec2, step: f64) -> (i64, i64, bool) {
         let c = 0.5 * step;
-        ((p.x / c).round() as i64, (p.y / c).round() as i64)
+        let d = b - a;
+        (
+            (b.x / c).round() as i64,
+            (b.y / c).round() as i64,
+            d.x.abs() >= d.y.abs(),
+        )
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -146,7 +155,7 @@ impl Tree {
         p: &ExpansionParams,
         sp: f64,
     ) {
-        if self.legs.len() >= p.max_legs || !self.ends.insert(Self::key(&b, p.step_m)) {
+        if self.legs.len() >= p.max_legs || !self.ends.insert(Self::key(&a, &b, p.step_m)) {
             return;
         }
         if leg_clear(map, fp, a, b, sp) {
@@ -164,6 +173,8 @@ impl Tree {
             for s in [1.0, -1.0] {
                 self.add(leg.b, leg.b + n * (s * p.step_m), Some(i), map, fp, p, sp);
             }
+            let on = d.normalize() * p.step_m;
+            self.add(leg.b, leg.b + on, Some(i), map, fp, p, sp);
         }
     }
 
