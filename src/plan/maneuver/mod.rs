@@ -5,6 +5,7 @@
 //! Paths are lists of [`CurveSegment`](path::CurveSegment)s from a start
 //! [`Pose`](crate::geo::Pose); they can be sampled at any spacing.
 
+pub mod cc_reeds_shepp;
 pub mod cc_turn;
 pub mod fresnel;
 pub mod path;
