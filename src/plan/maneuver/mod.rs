@@ -15,4 +15,3 @@ pub mod collision;
 pub mod expansion;
 pub mod search;
 pub mod steering;
-mod tmp_curve;

@@ -1,12 +1,12 @@
 //! The curve family the manoeuvre search steers with: continuous-curvature (clothoid) turns and
 //! CC Reeds-Shepp connections (SPEC §4), or plain arcs and Reeds-Shepp connections.
 
-use super::path::{CurveKind, CurveSegment};
+use super::cc_reeds_shepp::cc_reeds_shepp_shortest;
 use super::cc_turn::cc_turn;
+use super::path::{CurveKind, CurveSegment};
 pub use super::path::CurveParams;
 use super::path::CurvePath;
 use super::reeds_shepp::{reeds_shepp_length, reeds_shepp_shortest};
-use super::tmp_curve::cc_reeds_shepp_shortest;
 use crate::geo::{Direction, Pose};
 
 /// What the search needs from a curve family.
