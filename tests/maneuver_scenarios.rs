@@ -167,26 +167,53 @@ fn check(name: &str, curve: CurveChoice) {
         s.min_cusps
     );
     // Independent collision check of the bare vehicle every 5 cm.
-    let (boundary, obstacles) = geo_map(&map_text);
+    if let Some(hit) = first_collision(&cfg, &map_text, path) {
+        panic!("{name} ({curve:?}): {hit}");
+    }
+}
+
+/// The first place where the bare vehicle, sampled every 5 cm along `path`, leaves the
+/// boundary or meets an obstacle (geo crate predicates).
+fn first_collision(cfg: &Config, map_text: &str, path: &CurvePath) -> Option<String> {
+    let (boundary, obstacles) = geo_map(map_text);
     let mut samples: Vec<PathSample> = Vec::new();
     path.sample(0.05, &mut samples);
     assert!(samples.len() as f64 >= path.length() / 0.05);
     for smp in &samples {
-        let rect = rectangle(&cfg, &smp.pose);
-        assert!(
-            boundary.contains(&rect),
-            "{name} ({curve:?}): vehicle leaves the boundary at s = {:.2} m, {:?}",
-            smp.s,
-            smp.pose
-        );
+        let rect = rectangle(cfg, &smp.pose);
+        if !boundary.contains(&rect) {
+            return Some(format!(
+                "vehicle leaves the boundary at s = {:.2} m, {:?}",
+                smp.s, smp.pose
+            ));
+        }
         for (i, o) in obstacles.iter().enumerate() {
-            assert!(
-                !o.intersects(&rect),
-                "{name} ({curve:?}): vehicle hits obstacle {i} at s = {:.2} m",
-                smp.s
-            );
+            if o.intersects(&rect) {
+                return Some(format!("vehicle hits obstacle {i} at s = {:.2} m", smp.s));
+            }
         }
     }
+    None
+}
+
+#[test]
+fn independent_check_catches_collisions() {
+    // The check itself must be able to fail: straight through the slalom hits wall 2, and a
+    // straight out of the corridor leaves the boundary.
+    use agsteer::geo::Direction;
+    use agsteer::plan::maneuver::path::CurveSegment;
+    let cfg = Config::default();
+    let straight = |x: f64, y: f64, h: f64, len: f64| CurvePath {
+        start: Pose::new(x, y, h),
+        segments: vec![CurveSegment::line(Direction::Forward, len)],
+    };
+    let (_, slalom) = load("obstacle_slalom");
+    let hit = first_collision(&cfg, &slalom, &straight(4.0, 10.5, 0.0, 60.0)).unwrap();
+    assert!(hit.contains("obstacle 1"), "{hit}");
+    let (_, corridor) = load("three_point_turn");
+    let hit = first_collision(&cfg, &corridor, &straight(20.0, 3.5, 0.5, 20.0)).unwrap();
+    assert!(hit.contains("boundary"), "{hit}");
+    assert!(first_collision(&cfg, &corridor, &straight(5.0, 6.0, 0.0, 40.0)).is_none());
 }
 
 #[test]
