@@ -35,7 +35,7 @@
 
 use super::collision::{Blocked, CollisionMap, Footprint};
 use super::expansion::{leg_clear, rough_route, ExpansionParams, RoughRoute};
-use super::path::{CurveKind, CurvePath, CurveSegment, PathSample};
+use super::path::{CurveKind, CurvePath, CurveSegment};
 use super::steering::Steering;
 use crate::geo::{cross, heading_vec, vec_heading, wrap_angle, Direction, Pose, Vec2};
 use std::cmp::Ordering;
@@ -218,7 +218,6 @@ struct Planner<'a, S: Steering> {
     spacing: f64,
     prims: Vec<Primitive>,
     expansions: usize,
-    buf: Vec<PathSample>,
 }
 
 impl<'a, S: Steering> Planner<'a, S> {
@@ -255,15 +254,30 @@ impl<'a, S: Steering> Planner<'a, S> {
             spacing,
             prims,
             expansions: 0,
-            buf,
         }
     }
 
+    /// Whether the footprint stays clear along `path`, sampled every `spacing` (at most);
+    /// stops at the first blocked sample instead of sampling the whole path first.
     fn path_clear(&mut self, path: &CurvePath) -> bool {
-        path.sample(self.spacing, &mut self.buf);
-        self.map
-            .poses_clear(&self.p.footprint, self.buf.iter().map(|s| &s.pose))
-            .is_ok()
+        let fp = &self.p.footprint;
+        let mut pose = path.start;
+        if self.map.pose_clear(fp, &pose).is_err() {
+            return false;
+        }
+        for seg in &path.segments {
+            if seg.length > 0.0 {
+                let n = (seg.length / self.spacing).ceil().max(1.0) as usize;
+                for k in 1..=n {
+                    let s = seg.length * k as f64 / n as f64;
+                    if self.map.pose_clear(fp, &seg.pose_at(&pose, s)).is_err() {
+                        return false;
+                    }
+                }
+            }
+            pose = seg.end_pose(&pose);
+        }
+        true
     }
 
     /// Cost of segments driven after a segment in `prev` direction.
