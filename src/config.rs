@@ -645,6 +645,8 @@ pub struct ManeuverConfig {
     pub heading_resolution_deg: f64,
     /// Most node expansions over all searches of one plan.
     pub max_expansions: usize,
+    /// Most expansions of the search to one goal pattern's start (part of max_expansions).
+    pub pattern_max_expansions: usize,
     /// Try the analytic connection to the goal every this many expansions (1 = each).
     pub analytic_every: usize,
     /// Expansions spent after the first solution looking for a cheaper one.
@@ -668,7 +670,7 @@ impl Default for ManeuverConfig {
             expansion_step_m: 5.0,
             expansion_join_m: 0.5,
             expansion_max_depth: 8,
-            expansion_max_legs: 600,
+            expansion_max_legs: 200,
             goal_patterns: vec!["lrlr_pnpn".to_string(), "lr_pn".to_string()],
             heading_step_deg: 10.0,
             primitive_max_deg: 90.0,
@@ -678,6 +680,7 @@ impl Default for ManeuverConfig {
             xy_resolution_m: 1.0,
             heading_resolution_deg: 10.0,
             max_expansions: 4000,
+            pattern_max_expansions: 600,
             analytic_every: 1,
             extra_expansions: 40,
             fallback_points: 3,
@@ -731,6 +734,7 @@ impl Config {
             xy_resolution_m: m.xy_resolution_m,
             heading_resolution_rad: m.heading_resolution_deg.to_radians(),
             max_expansions: m.max_expansions,
+            pattern_max_expansions: m.pattern_max_expansions,
             analytic_every: m.analytic_every,
             extra_expansions: m.extra_expansions,
             fallback_points: m.fallback_points,
@@ -1301,6 +1305,13 @@ impl Config {
             90.0,
         );
         count(c, "maneuver.max_expansions", m.max_expansions, 1, 10_000_000);
+        count(
+            c,
+            "maneuver.pattern_max_expansions",
+            m.pattern_max_expansions,
+            0,
+            10_000_000,
+        );
         count(c, "maneuver.analytic_every", m.analytic_every, 1, 10_000);
         count(c, "maneuver.extra_expansions", m.extra_expansions, 0, 10_000_000);
         count(c, "maneuver.fallback_points", m.fallback_points, 1, 100);

@@ -65,6 +65,8 @@ struct ResultOut {
     max_curvature_rate: f64,
     expansions: usize,
     plan_time_ms: f64,
+    /// What each planner stage did.
+    stages: Vec<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     failure: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -92,6 +94,7 @@ fn result_out(r: &Result<ManeuverResult, ManeuverError>, ms: f64) -> ResultOut {
         max_curvature_rate: 0.0,
         expansions: 0,
         plan_time_ms: ms,
+        stages: Vec::new(),
         failure: None,
         error: None,
     };
@@ -99,6 +102,7 @@ fn result_out(r: &Result<ManeuverResult, ManeuverError>, ms: f64) -> ResultOut {
         Err(e) => out.error = Some(e.to_string()),
         Ok(res) => {
             out.expansions = res.expansions;
+            out.stages = res.stages.clone();
             out.failure = res.failure.clone();
             out.method = res.method.as_ref().map(method_name);
             if let Some(p) = &res.path {

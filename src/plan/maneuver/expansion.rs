@@ -112,6 +112,23 @@ fn segment_distance(a0: Vec2, a1: Vec2, b0: Vec2, b1: Vec2) -> (f64, Vec2, Vec2)
         .unwrap_or((f64::INFINITY, a0, b0))
 }
 
+/// Drop route points where the route goes straight on, so each leg is a real change of
+/// direction.
+fn merge_collinear(points: Vec<Vec2>) -> Vec<Vec2> {
+    let mut out: Vec<Vec2> = Vec::with_capacity(points.len());
+    for p in points {
+        if out.len() >= 2 {
+            let (a, b) = (out[out.len() - 2], out[out.len() - 1]);
+            let (u, v) = (b - a, p - b);
+            if cross(&u, &v).abs() <= 1e-9 * u.norm() * v.norm() && u.dot(&v) > 0.0 {
+                out.pop();
+            }
+        }
+        out.push(p);
+    }
+    out
+}
+
 struct Tree {
     legs: Vec<Leg>,
     newest: Vec<usize>,
@@ -231,7 +248,9 @@ pub fn rough_route(
             back.reverse();
             points.extend(back);
             points.dedup_by(|a, b| (*a - *b).norm() < 1e-9);
-            return Some(RoughRoute { points });
+            return Some(RoughRoute {
+                points: merge_collinear(points),
+            });
         }
         if ts.newest.is_empty() && tg.newest.is_empty() {
             return None;
@@ -290,6 +309,15 @@ mod tests {
         let (a, b) = r.last_leg().unwrap();
         assert!((b - goal.pos).norm() < 1e-9);
         assert!((a.x - b.x).abs() < 1e-6, "last leg along the goal heading: {a:?}");
+    }
+
+    #[test]
+    fn collinear_points_merge_but_reversals_stay() {
+        let pts = vec![v2(0.0, 0.0), v2(5.0, 0.0), v2(10.0, 0.0), v2(10.0, 5.0), v2(10.0, 2.0)];
+        assert_eq!(
+            merge_collinear(pts),
+            vec![v2(0.0, 0.0), v2(10.0, 0.0), v2(10.0, 5.0), v2(10.0, 2.0)]
+        );
     }
 
     #[test]

@@ -70,6 +70,8 @@ pub struct ManeuverParams {
     pub heading_resolution_rad: f64,
     /// Most node expansions over all searches of one plan.
     pub max_expansions: usize,
+    /// Most expansions of the search to one goal pattern's start.
+    pub pattern_max_expansions: usize,
     /// Try the analytic connection every this many expansions (1 = every one).
     pub analytic_every: usize,
     /// Expansions after the first solution spent looking for a cheaper one.
@@ -104,6 +106,8 @@ pub struct ManeuverResult {
     pub rough_route: Vec<Vec2>,
     /// Why no path was found (`None` when found).
     pub failure: Option<String>,
+    /// What each stage did, in order (for logs and the CLI's JSON).
+    pub stages: Vec<String>,
 }
 
 /// Which endpoint.
@@ -324,6 +328,18 @@ impl<'a, S: Steering> Planner<'a, S> {
         first_direction: Option<Direction>,
         bound: f64,
     ) -> Option<(CurvePath, f64)> {
+        self.search_limited(from, to, first_direction, bound, usize::MAX)
+    }
+
+    /// [`Self::search`] that also stops when the expansion count reaches `stop_at`.
+    fn search_limited(
+        &mut self,
+        from: &Pose,
+        to: &Pose,
+        first_direction: Option<Direction>,
+        bound: f64,
+        stop_at: usize,
+    ) -> Option<(CurvePath, f64)> {
         let mut nodes = vec![Node {
             pose: *from,
             g: 0.0,
@@ -352,7 +368,7 @@ impl<'a, S: Steering> Planner<'a, S> {
             if !closed.insert(key) && node != 0 {
                 continue;
             }
-            if self.budget_left() == 0 {
+            if self.budget_left() == 0 || self.expansions >= stop_at {
                 break;
             }
             self.expansions += 1;
@@ -518,21 +534,30 @@ pub fn plan_maneuver<S: Steering>(
         .map(|s| parse_pattern(s).map(|pat| (s.clone(), pat)))
         .collect::<Result<Vec<_>, _>>()?;
     let mut pl = Planner::new(map, steer, p);
-    let found = |path: CurvePath, method: Method, pl: &Planner<S>, route: Vec<Vec2>| {
-        tracing::debug!(?method, expansions = pl.expansions, "manoeuvre found");
+    let mut stages = Vec::new();
+    let found = |path: CurvePath,
+                 method: Method,
+                 pl: &Planner<S>,
+                 route: Vec<Vec2>,
+                 stages: Vec<String>| {
+        tracing::debug!(?method, expansions = pl.expansions, ?stages, "manoeuvre found");
         ManeuverResult {
             path: Some(path),
             method: Some(method),
             expansions: pl.expansions,
             rough_route: route,
             failure: None,
+            stages,
         }
     };
     // 2. Direct connection.
-    if let Some(direct) = steer.connect(start, goal) {
-        if pl.path_clear(&direct) {
-            return Ok(found(direct, Method::Direct, &pl, Vec::new()));
+    match steer.connect(start, goal) {
+        Some(direct) if pl.path_clear(&direct) => {
+            stages.push("direct: clear".into());
+            return Ok(found(direct, Method::Direct, &pl, Vec::new(), stages));
         }
+        Some(_) => stages.push("direct: blocked".into()),
+        None => stages.push("direct: no connection".into()),
     }
     // 3. Rough route.
     let route = rough_route(
@@ -544,43 +569,77 @@ pub fn plan_maneuver<S: Steering>(
         pl.spacing.max(0.05),
     );
     let route_pts = route.as_ref().map(|r| r.points.clone()).unwrap_or_default();
+    stages.push(match &route {
+        Some(r) => format!("rough route: {} legs", r.points.len().saturating_sub(1)),
+        None => "rough route: none".into(),
+    });
     // 4. Goal pattern, then 5. the plain search with the pattern's cost as a bound.
     let mut best: Option<(CurvePath, f64, Method)> = None;
     if let Some(turn) = route.as_ref().and_then(|r| approach_turn(r, goal)) {
         if turn.abs() > p.heading_step_rad * 0.5 {
             for (name, pat) in &patterns {
                 let mirror = turn < 0.0;
+                let applied: String = if mirror {
+                    name.chars()
+                        .map(|ch| match ch {
+                            'l' => 'r',
+                            'r' => 'l',
+                            other => other,
+                        })
+                        .collect()
+                } else {
+                    name.clone()
+                };
                 let Some(tail) = pl.goal_pattern(pat, mirror, turn, goal) else {
+                    stages.push(format!(
+                        "pattern {applied} ({:.0}°): blocked",
+                        turn.to_degrees()
+                    ));
                     continue;
                 };
-                if let Some((head, c)) = pl.search(start, &tail.start, None, f64::INFINITY) {
-                    let last = head.segments.iter().rev().find(|s| s.length > 1e-9);
-                    let total = c + pl.cost(&tail.segments, last.map(|s| s.direction));
-                    let applied = if mirror {
-                        name.chars()
-                            .map(|ch| match ch {
-                                'l' => 'r',
-                                'r' => 'l',
-                                other => other,
-                            })
-                            .collect()
-                    } else {
-                        name.clone()
-                    };
-                    best = Some((head.then(tail), total, Method::Pattern(applied)));
-                    break;
+                let before = pl.expansions;
+                let budget = before.saturating_add(p.pattern_max_expansions);
+                match pl.search_limited(start, &tail.start, None, f64::INFINITY, budget) {
+                    Some((head, c)) => {
+                        let last = head.segments.iter().rev().find(|s| s.length > 1e-9);
+                        let total = c + pl.cost(&tail.segments, last.map(|s| s.direction));
+                        stages.push(format!(
+                            "pattern {applied} ({:.0}°): found, cost {total:.1} m, {} expansions",
+                            turn.to_degrees(),
+                            pl.expansions - before
+                        ));
+                        best = Some((head.then(tail), total, Method::Pattern(applied)));
+                        break;
+                    }
+                    None => stages.push(format!(
+                        "pattern {applied} ({:.0}°): no search to its start in {} expansions",
+                        turn.to_degrees(),
+                        pl.expansions - before
+                    )),
                 }
             }
+        } else {
+            stages.push("pattern: the route arrives straight".into());
         }
     }
     let bound = best.as_ref().map_or(f64::INFINITY, |b| b.1);
-    if let Some((path, c)) = pl.search(start, goal, None, bound) {
-        if c < bound {
+    let before = pl.expansions;
+    match pl.search(start, goal, None, bound) {
+        Some((path, c)) if c < bound => {
+            stages.push(format!(
+                "search: found, cost {c:.1} m, {} expansions",
+                pl.expansions - before
+            ));
             best = Some((path, c, Method::Search));
         }
+        _ => stages.push(format!(
+            "search: nothing{} in {} expansions",
+            if bound.is_finite() { " cheaper" } else { "" },
+            pl.expansions - before
+        )),
     }
     if let Some((path, _, method)) = best {
-        return Ok(found(path, method, &pl, route_pts));
+        return Ok(found(path, method, &pl, route_pts, stages));
     }
     // 6. Fallback along the first and last legs.
     if let Some(r) = &route {
@@ -607,7 +666,8 @@ pub fn plan_maneuver<S: Steering>(
                     let first_dir = lead.segments.first().map(|s| s.direction);
                     if let Some((mid, _)) = pl.search(&from, &to, first_dir, f64::INFINITY) {
                         let path = lead.then(mid).then(trail);
-                        return Ok(found(path, Method::Fallback, &pl, route_pts));
+                        stages.push(format!("fallback: found from leg point {i} to {j}"));
+                        return Ok(found(path, Method::Fallback, &pl, route_pts, stages));
                     }
                 }
             }
@@ -621,12 +681,14 @@ pub fn plan_maneuver<S: Steering>(
     if route.is_none() {
         failure.push_str("; the straight-line expansion found no route either");
     }
+    stages.push("fallback: nothing".into());
     Ok(ManeuverResult {
         path: None,
         method: None,
         expansions: pl.expansions,
         rough_route: route_pts,
         failure: Some(failure),
+        stages,
     })
 }
 
