@@ -25,7 +25,7 @@
 //! footprint's `margin_m`, so the continuous sweep of the bare vehicle is proved clear when
 //! `margin_m ≥ tol/2` (the `[maneuver]` validation enforces this).
 
-use crate::geo::polygon::{bbox, contains_point, segments_intersect};
+use crate::geo::polygon::{bbox, contains_point, point_segment_distance, segments_intersect};
 use crate::geo::{v2, Pose, Vec2};
 
 /// The vehicle's own rectangle.
@@ -104,7 +104,10 @@ impl Footprint {
         let (boxes, n) = self.local_boxes();
         boxes[..n]
             .iter()
-            .map(|b| b.x_min.abs().max(b.x_max.abs()).hypot(b.half_width))
+            .map(|b| {
+                let x = b.x_min.abs().max(b.x_max.abs());
+                (x * x + b.half_width * b.half_width).sqrt()
+            })
             .fold(0.0, f64::max)
     }
 
@@ -178,10 +181,16 @@ pub struct CollisionMap {
     /// Cell k's edges are `cell_edges[cell_start[k]..cell_start[k + 1]]`.
     cell_start: Vec<u32>,
     cell_edges: Vec<u32>,
+    /// Per cell: radius of a disc around any point of the cell that is certainly free (no map
+    /// edge within it, and the cell centre in free space), m; ≤ 0 = unknown. Lets a pose whose
+    /// footprint fits in that disc skip the exact test.
+    cell_free_radius: Vec<f64>,
 }
 
 /// Most grid cells a map may have; the cell size grows to stay below it.
 const MAX_CELLS: f64 = 250_000.0;
+/// The free-disc table is built only when cells × edges is below this.
+const MAX_FREE_TABLE_WORK: usize = 20_000_000;
 
 impl CollisionMap {
     /// A map from a boundary ring (`None` = unbounded free space) and obstacle rings, with a
@@ -254,6 +263,7 @@ impl CollisionMap {
             ny,
             cell_start: Vec::new(),
             cell_edges: Vec::new(),
+            cell_free_radius: Vec::new(),
         };
         // Counting sort of (cell, edge) pairs.
         let mut counts = vec![0u32; nx * ny + 1];
@@ -287,7 +297,50 @@ impl CollisionMap {
         }
         map.cell_start = counts;
         map.cell_edges = cell_edges;
+        map.cell_free_radius = map.free_radius_table();
         Ok(map)
+    }
+
+    /// The per-cell free-disc radii (see `cell_free_radius`).
+    fn free_radius_table(&self) -> Vec<f64> {
+        let cells = self.nx * self.ny;
+        let vertices: usize = self.obstacles.iter().map(Vec::len).sum::<usize>()
+            + self.boundary.as_ref().map_or(0, Vec::len);
+        if cells.saturating_mul(self.edges.len() + vertices) > MAX_FREE_TABLE_WORK {
+            return vec![0.0; cells];
+        }
+        let half_diag = std::f64::consts::FRAC_1_SQRT_2 * self.cell_m;
+        let mut out = Vec::with_capacity(cells);
+        for iy in 0..self.ny {
+            for ix in 0..self.nx {
+                let c = self.origin + v2((ix as f64 + 0.5) * self.cell_m, (iy as f64 + 0.5) * self.cell_m);
+                let free = self.boundary.as_ref().is_none_or(|b| contains_point(b, &c))
+                    && !self.obstacles.iter().any(|o| contains_point(o, &c));
+                if !free {
+                    out.push(0.0);
+                    continue;
+                }
+                let d = self
+                    .edges
+                    .iter()
+                    .map(|e| point_segment_distance(&c, &e.a, &e.b))
+                    .fold(f64::INFINITY, f64::min);
+                out.push(d - half_diag);
+            }
+        }
+        out
+    }
+
+    /// Whether a disc of radius `r` about `p` is certainly free (table look-up only).
+    fn disc_surely_free(&self, p: &Vec2, r: f64) -> bool {
+        let fx = ((p.x - self.origin.x) / self.cell_m).floor();
+        let fy = ((p.y - self.origin.y) / self.cell_m).floor();
+        if !(fx >= 0.0 && fy >= 0.0 && fx < self.nx as f64 && fy < self.ny as f64) {
+            return false;
+        }
+        self.cell_free_radius
+            .get(fy as usize * self.nx + fx as usize)
+            .is_some_and(|&free| free > r)
     }
 
     /// Unbounded free space.
@@ -304,6 +357,7 @@ impl CollisionMap {
             ny: 1,
             cell_start: vec![0, 0],
             cell_edges: Vec::new(),
+            cell_free_radius: vec![0.0],
         }
     }
 
@@ -384,8 +438,28 @@ impl CollisionMap {
         Ok(())
     }
 
+    /// Whether rectangles already placed in the world (corners in order) are clear, given
+    /// that they all lie within `radius` of `centre` (the quick free-disc test uses it).
+    pub fn placed_clear(
+        &self,
+        centre: &Vec2,
+        radius: f64,
+        rectangles: &[[Vec2; 4]],
+    ) -> Result<(), Blocked> {
+        if self.disc_surely_free(centre, radius) {
+            return Ok(());
+        }
+        for r in rectangles {
+            self.rectangle_clear(r)?;
+        }
+        Ok(())
+    }
+
     /// Whether `footprint` at `pose` is clear.
     pub fn pose_clear(&self, footprint: &Footprint, pose: &Pose) -> Result<(), Blocked> {
+        if self.disc_surely_free(&pose.pos, footprint.max_corner_radius_m()) {
+            return Ok(());
+        }
         let (boxes, n) = footprint.local_boxes();
         for b in &boxes[..n] {
             self.rectangle_clear(&corners(b, pose))?;

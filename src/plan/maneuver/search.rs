@@ -37,7 +37,7 @@ use super::collision::{Blocked, CollisionMap, Footprint};
 use super::expansion::{leg_clear, rough_route, ExpansionParams, RoughRoute};
 use super::path::{CurveKind, CurvePath, CurveSegment};
 use super::steering::Steering;
-use crate::geo::{cross, heading_vec, vec_heading, wrap_angle, Direction, Pose, Vec2};
+use crate::geo::{cross, heading_vec, v2, vec_heading, wrap_angle, Direction, Pose, Vec2};
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap, HashSet};
 
@@ -186,7 +186,9 @@ struct Primitive {
     direction: Direction,
     length: f64,
     end: Pose,
-    samples: Vec<Pose>,
+    /// Per sample: the rear-axle position and the footprint's rectangles, relative to the
+    /// primitive's start pose (placing them only needs one rotation per node).
+    samples: Vec<(Vec2, Vec<[Vec2; 4]>)>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -202,6 +204,8 @@ struct Node {
 struct Open {
     f: f64,
     node: usize,
+    /// Whether `f` already uses the Reeds-Shepp heuristic (else only the Euclidean bound).
+    refined: bool,
 }
 impl Eq for Open {}
 impl Ord for Open {
@@ -220,6 +224,8 @@ struct Planner<'a, S: Steering> {
     steer: &'a S,
     p: &'a ManeuverParams,
     spacing: f64,
+    /// Largest distance of the footprint from the rear axle, m.
+    radius: f64,
     prims: Vec<Primitive>,
     expansions: usize,
 }
@@ -245,7 +251,11 @@ impl<'a, S: Steering> Planner<'a, S> {
                 prims.push(Primitive {
                     length: path.length(),
                     end: path.end_pose(),
-                    samples: buf.iter().skip(1).map(|s| s.pose).collect(),
+                    samples: buf
+                        .iter()
+                        .skip(1)
+                        .map(|s| (s.pose.pos, p.footprint.rectangles(&s.pose)))
+                        .collect(),
                     segments: path.segments,
                     direction,
                 });
@@ -256,6 +266,7 @@ impl<'a, S: Steering> Planner<'a, S> {
             steer,
             p,
             spacing,
+            radius: p.footprint.max_corner_radius_m(),
             prims,
             expansions: 0,
         }
@@ -351,6 +362,7 @@ impl<'a, S: Steering> Planner<'a, S> {
         open.push(Open {
             f: self.heuristic(from, to),
             node: 0,
+            refined: true,
         });
         let mut best_g: HashMap<(i64, i64, i64), f64> = HashMap::new();
         best_g.insert(self.key(from), 0.0);
@@ -358,10 +370,26 @@ impl<'a, S: Steering> Planner<'a, S> {
         let mut best: Option<(usize, CurvePath, f64)> = None;
         let mut bound = bound;
         let mut since_found = 0usize;
+        let mut placed: Vec<[Vec2; 4]> = Vec::with_capacity(2);
         let mut local = 0usize;
-        while let Some(Open { f, node }) = open.pop() {
+        while let Some(Open { f, node, refined }) = open.pop() {
             if f >= bound {
                 break;
+            }
+            if !refined {
+                // Lazy heuristic: children are queued with the Euclidean distance and get the
+                // (dearer) Reeds-Shepp distance only when they reach the top; a larger value
+                // sends them back into the queue.
+                let g = nodes[node].g;
+                let f2 = g + self.heuristic(&nodes[node].pose, to);
+                if f2 > f + 1e-9 {
+                    open.push(Open {
+                        f: f2,
+                        node,
+                        refined: true,
+                    });
+                    continue;
+                }
             }
             let n = nodes[node];
             let key = self.key(&n.pose);
@@ -388,6 +416,7 @@ impl<'a, S: Steering> Planner<'a, S> {
                     }
                 }
             }
+            let (sin, cos) = n.pose.heading.sin_cos();
             for (pi, prim) in self.prims.iter().enumerate() {
                 let end = compose(&n.pose, &prim.end);
                 let mut g = n.g + prim.length;
@@ -401,14 +430,15 @@ impl<'a, S: Steering> Planner<'a, S> {
                 if closed.contains(&k) || best_g.get(&k).is_some_and(|&b| b <= g) {
                     continue;
                 }
-                let h = self.heuristic(&end, to);
+                let h = (to.pos - end.pos).norm();
                 if g + h >= bound {
                     continue;
                 }
-                let clear = prim.samples.iter().all(|s| {
-                    self.map
-                        .pose_clear(&self.p.footprint, &compose(&n.pose, s))
-                        .is_ok()
+                let clear = prim.samples.iter().rev().all(|(pos, rects)| {
+                    let at = |v: &Vec2| n.pose.pos + v2(cos * v.x - sin * v.y, sin * v.x + cos * v.y);
+                    placed.clear();
+                    placed.extend(rects.iter().map(|r| [at(&r[0]), at(&r[1]), at(&r[2]), at(&r[3])]));
+                    self.map.placed_clear(&at(pos), self.radius, &placed).is_ok()
                 });
                 if !clear {
                     continue;
@@ -424,6 +454,7 @@ impl<'a, S: Steering> Planner<'a, S> {
                 open.push(Open {
                     f: g + h,
                     node: nodes.len() - 1,
+                    refined: false,
                 });
             }
         }
