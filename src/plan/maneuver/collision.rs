@@ -642,6 +642,33 @@ mod tests {
     }
 
     #[test]
+    fn free_disc_shortcut_agrees_with_the_exact_test() {
+        // A big open yard with one obstacle: most poses take the free-disc shortcut, and every
+        // answer must equal the exact test (a single huge cell never takes the shortcut).
+        let boundary = vec![v2(0.0, 0.0), v2(80.0, 0.0), v2(80.0, 60.0), v2(30.0, 70.0), v2(0.0, 60.0)];
+        let obstacles = vec![rect(40.0, 20.0, 44.0, 50.0)];
+        let fine = CollisionMap::new(Some(boundary.clone()), obstacles.clone(), 2.0).unwrap();
+        let exact = CollisionMap::new(Some(boundary), obstacles, 1e6).unwrap();
+        let f = tractor();
+        let r = f.max_corner_radius_m();
+        let mut shortcut = 0;
+        for k in 0..5000 {
+            let p = Pose::new(
+                (k as f64 * 0.618_033_988_7 * 90.0) % 90.0 - 5.0,
+                (k as f64 * 0.414_213_562_3 * 80.0) % 80.0 - 5.0,
+                k as f64 * 0.9,
+            );
+            shortcut += usize::from(fine.disc_surely_free(&p.pos, r));
+            assert_eq!(
+                fine.pose_clear(&f, &p).is_ok(),
+                exact.pose_clear(&f, &p).is_ok(),
+                "{p:?}"
+            );
+        }
+        assert!(shortcut > 2000, "the shortcut is exercised: {shortcut}");
+    }
+
+    #[test]
     fn sample_spacing_bounds_corner_motion() {
         let f = tractor();
         let kappa = 0.2;
