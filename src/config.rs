@@ -1222,7 +1222,12 @@ impl Config {
         );
         c.range("vehicle.length_m", v.length_m, 0.5, 40.0);
         c.range("vehicle.width_m", v.width_m, 0.3, 20.0);
-        c.range("vehicle.rear_axle_from_rear_m", v.rear_axle_from_rear_m, 0.0, 40.0);
+        c.range(
+            "vehicle.rear_axle_from_rear_m",
+            v.rear_axle_from_rear_m,
+            0.0,
+            40.0,
+        );
         if v.rear_axle_from_rear_m > v.length_m {
             c.push(
                 "vehicle.rear_axle_from_rear_m",
@@ -1259,13 +1264,23 @@ impl Config {
             0.001,
             10.0,
         );
-        c.range("maneuver.implement_length_m", m.implement_length_m, 0.0, 40.0);
+        c.range(
+            "maneuver.implement_length_m",
+            m.implement_length_m,
+            0.0,
+            40.0,
+        );
         if m.implement_length_m > 0.0 {
             c.range("maneuver.implement_width_m", m.implement_width_m, 0.1, 60.0);
         }
         c.range("maneuver.implement_hitch_m", m.implement_hitch_m, 0.0, 20.0);
         c.range("maneuver.clearance_m", m.clearance_m, 0.0, 5.0);
-        c.range("maneuver.sample_tolerance_m", m.sample_tolerance_m, 0.01, 2.0);
+        c.range(
+            "maneuver.sample_tolerance_m",
+            m.sample_tolerance_m,
+            0.01,
+            2.0,
+        );
         if m.clearance_m.is_finite() && m.clearance_m < 0.5 * m.sample_tolerance_m {
             c.push(
                 "maneuver.clearance_m",
@@ -1278,11 +1293,27 @@ impl Config {
         c.range("maneuver.expansion_join_m", m.expansion_join_m, 0.0, 20.0);
         let count = |c: &mut Checker, key: &str, v: usize, lo: usize, hi: usize| {
             if !(lo..=hi).contains(&v) {
-                c.push(key, v.to_string(), &format!("must be an integer in {lo}..={hi}"));
+                c.push(
+                    key,
+                    v.to_string(),
+                    &format!("must be an integer in {lo}..={hi}"),
+                );
             }
         };
-        count(c, "maneuver.expansion_max_depth", m.expansion_max_depth, 1, 100);
-        count(c, "maneuver.expansion_max_legs", m.expansion_max_legs, 2, 100_000);
+        count(
+            c,
+            "maneuver.expansion_max_depth",
+            m.expansion_max_depth,
+            1,
+            100,
+        );
+        count(
+            c,
+            "maneuver.expansion_max_legs",
+            m.expansion_max_legs,
+            2,
+            100_000,
+        );
         for (i, pat) in m.goal_patterns.iter().enumerate() {
             if crate::plan::maneuver::search::parse_pattern(pat).is_err() {
                 c.push(
@@ -1293,7 +1324,12 @@ impl Config {
             }
         }
         c.range("maneuver.heading_step_deg", m.heading_step_deg, 1.0, 90.0);
-        c.range("maneuver.primitive_max_deg", m.primitive_max_deg, 0.0, 180.0);
+        c.range(
+            "maneuver.primitive_max_deg",
+            m.primitive_max_deg,
+            0.0,
+            180.0,
+        );
         c.range("maneuver.straight_step_m", m.straight_step_m, 0.1, 50.0);
         c.range("maneuver.reverse_penalty", m.reverse_penalty, 1.0, 100.0);
         c.range("maneuver.cusp_penalty_m", m.cusp_penalty_m, 0.0, 1000.0);
@@ -1304,7 +1340,13 @@ impl Config {
             1.0,
             90.0,
         );
-        count(c, "maneuver.max_expansions", m.max_expansions, 1, 10_000_000);
+        count(
+            c,
+            "maneuver.max_expansions",
+            m.max_expansions,
+            1,
+            10_000_000,
+        );
         count(
             c,
             "maneuver.pattern_max_expansions",
@@ -1313,7 +1355,13 @@ impl Config {
             10_000_000,
         );
         count(c, "maneuver.analytic_every", m.analytic_every, 1, 10_000);
-        count(c, "maneuver.extra_expansions", m.extra_expansions, 0, 10_000_000);
+        count(
+            c,
+            "maneuver.extra_expansions",
+            m.extra_expansions,
+            0,
+            10_000_000,
+        );
         count(c, "maneuver.fallback_points", m.fallback_points, 1, 100);
     }
 

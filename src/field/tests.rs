@@ -264,3 +264,34 @@ fn taskdata_boundary_interior_ring_and_obstacle_polygon() {
     let e = load_field(&broken, &opts()).unwrap_err().to_string();
     assert!(e.contains("PFD 0 (id PFD1)") && e.contains("PNT 0"), "{e}");
 }
+
+#[test]
+fn local_map_reads_metres_holes_and_obstacle_features() {
+    // Coordinates far outside lat/lon ranges are fine in metres; the boundary is clockwise
+    // and gets reoriented; a hole and an obstacle Feature (crossing the boundary) are kept.
+    let text = r#"{"type":"FeatureCollection","features":[
+      {"type":"Feature","properties":{"name":"yard"},"geometry":{"type":"Polygon","coordinates":[
+        [[0,0],[0,300],[500,300],[500,0],[0,0]],
+        [[10,10],[20,10],[20,20],[10,20],[10,10]]]}},
+      {"type":"Feature","properties":{"obstacle":true},"geometry":{"type":"Polygon","coordinates":[
+        [[490,100],[510,100],[510,120],[490,120],[490,100]]]}}]}"#;
+    let f = load_local_map(text).unwrap();
+    assert_eq!(f.boundary.len(), 4);
+    assert!(signed_area(&f.boundary) > 0.0);
+    assert!((signed_area(&f.boundary) - 150_000.0).abs() < 1e-6);
+    assert_eq!(f.obstacles.len(), 2);
+    assert!(f.obstacles.iter().any(|o| o.contains(&v2(510.0, 120.0))));
+    // Errors name the feature.
+    let two = r#"{"type":"FeatureCollection","features":[
+      {"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1],[0,0]]]}},
+      {"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[5,0],[6,0],[6,1],[5,0]]]}}]}"#;
+    assert!(matches!(
+        load_local_map(two),
+        Err(FieldError::SeveralBoundaries { count: 2, .. })
+    ));
+    let bad = r#"{"type":"Polygon","coordinates":[[[0,0],[1,"x"],[1,1],[0,0]]]}"#;
+    assert!(load_local_map(bad)
+        .unwrap_err()
+        .to_string()
+        .contains("position 1"));
+}

@@ -313,7 +313,11 @@ impl CollisionMap {
         let mut out = Vec::with_capacity(cells);
         for iy in 0..self.ny {
             for ix in 0..self.nx {
-                let c = self.origin + v2((ix as f64 + 0.5) * self.cell_m, (iy as f64 + 0.5) * self.cell_m);
+                let c = self.origin
+                    + v2(
+                        (ix as f64 + 0.5) * self.cell_m,
+                        (iy as f64 + 0.5) * self.cell_m,
+                    );
                 let free = self.boundary.as_ref().is_none_or(|b| contains_point(b, &c))
                     && !self.obstacles.iter().any(|o| contains_point(o, &c));
                 if !free {
@@ -615,7 +619,12 @@ mod tests {
             let edges_hit = |ring: &[Vec2]| {
                 (0..ring.len()).any(|i| {
                     (0..4).any(|j| {
-                        segments_intersect(&c[j], &c[(j + 1) % 4], &ring[i], &ring[(i + 1) % ring.len()])
+                        segments_intersect(
+                            &c[j],
+                            &c[(j + 1) % 4],
+                            &ring[i],
+                            &ring[(i + 1) % ring.len()],
+                        )
                     })
                 })
             };
@@ -638,14 +647,23 @@ mod tests {
             assert_eq!(coarse.pose_clear(&f, &p).is_ok(), brute.is_ok());
             hits += usize::from(r.is_err());
         }
-        assert!(hits > 200 && hits < 3800, "test poses mix clear and blocked: {hits}");
+        assert!(
+            hits > 200 && hits < 3800,
+            "test poses mix clear and blocked: {hits}"
+        );
     }
 
     #[test]
     fn free_disc_shortcut_agrees_with_the_exact_test() {
         // A big open yard with one obstacle: most poses take the free-disc shortcut, and every
         // answer must equal the exact test (a single huge cell never takes the shortcut).
-        let boundary = vec![v2(0.0, 0.0), v2(80.0, 0.0), v2(80.0, 60.0), v2(30.0, 70.0), v2(0.0, 60.0)];
+        let boundary = vec![
+            v2(0.0, 0.0),
+            v2(80.0, 0.0),
+            v2(80.0, 60.0),
+            v2(30.0, 70.0),
+            v2(0.0, 60.0),
+        ];
         let obstacles = vec![rect(40.0, 20.0, 44.0, 50.0)];
         let fine = CollisionMap::new(Some(boundary.clone()), obstacles.clone(), 2.0).unwrap();
         let exact = CollisionMap::new(Some(boundary), obstacles, 1e6).unwrap();

@@ -435,10 +435,17 @@ impl<'a, S: Steering> Planner<'a, S> {
                     continue;
                 }
                 let clear = prim.samples.iter().rev().all(|(pos, rects)| {
-                    let at = |v: &Vec2| n.pose.pos + v2(cos * v.x - sin * v.y, sin * v.x + cos * v.y);
+                    let at =
+                        |v: &Vec2| n.pose.pos + v2(cos * v.x - sin * v.y, sin * v.x + cos * v.y);
                     placed.clear();
-                    placed.extend(rects.iter().map(|r| [at(&r[0]), at(&r[1]), at(&r[2]), at(&r[3])]));
-                    self.map.placed_clear(&at(pos), self.radius, &placed).is_ok()
+                    placed.extend(
+                        rects
+                            .iter()
+                            .map(|r| [at(&r[0]), at(&r[1]), at(&r[2]), at(&r[3])]),
+                    );
+                    self.map
+                        .placed_clear(&at(pos), self.radius, &placed)
+                        .is_ok()
                 });
                 if !clear {
                     continue;
@@ -571,7 +578,12 @@ pub fn plan_maneuver<S: Steering>(
                  pl: &Planner<S>,
                  route: Vec<Vec2>,
                  stages: Vec<String>| {
-        tracing::debug!(?method, expansions = pl.expansions, ?stages, "manoeuvre found");
+        tracing::debug!(
+            ?method,
+            expansions = pl.expansions,
+            ?stages,
+            "manoeuvre found"
+        );
         ManeuverResult {
             path: Some(path),
             method: Some(method),
@@ -707,7 +719,10 @@ pub fn plan_maneuver<S: Steering>(
     let mut failure = if pl.budget_left() == 0 {
         format!("search budget of {} expansions used up", p.max_expansions)
     } else {
-        format!("no collision-free path found ({} expansions)", pl.expansions)
+        format!(
+            "no collision-free path found ({} expansions)",
+            pl.expansions
+        )
     };
     if route.is_none() {
         failure.push_str("; the straight-line expansion found no route either");
@@ -888,7 +903,9 @@ mod tests {
         let goal = Pose::new(3.0, -2.0, 0.4);
         let pat = parse_pattern("lrlr_pnpn").unwrap();
         for (mirror, sign) in [(false, 1.0), (true, -1.0)] {
-            let path = pl.goal_pattern(&pat, mirror, sign * FRAC_PI_2, &goal).unwrap();
+            let path = pl
+                .goal_pattern(&pat, mirror, sign * FRAC_PI_2, &goal)
+                .unwrap();
             let end = path.end_pose();
             assert!((end.pos - goal.pos).norm() < 1e-6, "{end:?}");
             assert!(wrap_angle(end.heading - goal.heading).abs() < 1e-9);
