@@ -673,7 +673,7 @@ impl Default for ManeuverConfig {
             expansion_max_legs: 200,
             goal_patterns: vec!["lrlr_pnpn".to_string(), "lr_pn".to_string()],
             heading_step_deg: 10.0,
-            primitive_max_deg: 90.0,
+            primitive_max_deg: 180.0,
             straight_step_m: 2.0,
             reverse_penalty: 1.5,
             cusp_penalty_m: 5.0,

@@ -109,7 +109,8 @@ fn result_out(r: &Result<ManeuverResult, ManeuverError>, ms: f64) -> ResultOut {
                 out.found = true;
                 out.length_m = p.length();
                 out.cusps = p.cusps();
-                out.reverse_length_m = p.reverse_length();
+                // + 0.0: an empty float sum is -0.0.
+                out.reverse_length_m = p.reverse_length() + 0.0;
                 out.max_curvature = p.max_curvature();
                 out.max_curvature_rate = p.max_curvature_rate();
                 out.segments = p
@@ -238,8 +239,8 @@ fn svg_points(pts: &[Vec2]) -> String {
         .join(" ")
 }
 
-/// The map, the path coloured by direction (forward blue, reverse red), vehicle outlines every
-/// ~3 m, cusps as circles, start and goal outlines.
+/// The map, the rough route (dashed green), the path coloured by direction (forward blue,
+/// reverse red), vehicle outlines every ~3 m, cusps as circles, start and goal outlines.
 fn maneuver_svg(
     cfg: &Config,
     field: Option<&agsteer::plan::coverage::Field>,
@@ -288,6 +289,14 @@ fn maneuver_svg(
                 svg_points(o)
             );
         }
+    }
+    // The rough route of the straight-line expansion, dashed.
+    if res.rough_route.len() >= 2 {
+        let _ = writeln!(
+            s,
+            r##"<polyline points="{}" fill="none" stroke="#8a6" stroke-width="0.08" stroke-dasharray="0.5 0.3"/>"##,
+            svg_points(&res.rough_route)
+        );
     }
     // Vehicle outlines every ~3 m.
     let mut next = 0.0;
