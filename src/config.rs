@@ -647,6 +647,9 @@ pub struct ManeuverConfig {
     pub max_expansions: usize,
     /// Most expansions of the search to one goal pattern's start (part of max_expansions).
     pub pattern_max_expansions: usize,
+    /// Most expansions of the search straight to the goal (part of max_expansions; the rest is
+    /// left for the fallback).
+    pub search_max_expansions: usize,
     /// Try the analytic connection to the goal every this many expansions (1 = each).
     pub analytic_every: usize,
     /// Expansions spent after the first solution looking for a cheaper one.
@@ -681,6 +684,7 @@ impl Default for ManeuverConfig {
             heading_resolution_deg: 10.0,
             max_expansions: 4000,
             pattern_max_expansions: 600,
+            search_max_expansions: 2500,
             analytic_every: 1,
             extra_expansions: 40,
             fallback_points: 3,
@@ -735,6 +739,7 @@ impl Config {
             heading_resolution_rad: m.heading_resolution_deg.to_radians(),
             max_expansions: m.max_expansions,
             pattern_max_expansions: m.pattern_max_expansions,
+            search_max_expansions: m.search_max_expansions,
             analytic_every: m.analytic_every,
             extra_expansions: m.extra_expansions,
             fallback_points: m.fallback_points,
@@ -1352,6 +1357,13 @@ impl Config {
             "maneuver.pattern_max_expansions",
             m.pattern_max_expansions,
             0,
+            10_000_000,
+        );
+        count(
+            c,
+            "maneuver.search_max_expansions",
+            m.search_max_expansions,
+            1,
             10_000_000,
         );
         count(c, "maneuver.analytic_every", m.analytic_every, 1, 10_000);

@@ -72,6 +72,9 @@ pub struct ManeuverParams {
     pub max_expansions: usize,
     /// Most expansions of the search to one goal pattern's start.
     pub pattern_max_expansions: usize,
+    /// Most expansions of the search straight to the goal (the rest of `max_expansions` is
+    /// left for the fallback).
+    pub search_max_expansions: usize,
     /// Try the analytic connection every this many expansions (1 = every one).
     pub analytic_every: usize,
     /// Expansions after the first solution spent looking for a cheaper one.
@@ -667,7 +670,8 @@ pub fn plan_maneuver<S: Steering>(
     }
     let bound = best.as_ref().map_or(f64::INFINITY, |b| b.1);
     let before = pl.expansions;
-    match pl.search(start, goal, None, bound) {
+    let stop_at = before.saturating_add(p.search_max_expansions);
+    match pl.search_limited(start, goal, None, bound, stop_at) {
         Some((path, c)) if c < bound => {
             stages.push(format!(
                 "search: found, cost {c:.1} m, {} expansions",
@@ -881,6 +885,40 @@ mod tests {
         assert!(r.expansions > 0 && r.expansions <= 300);
         let why = r.failure.unwrap();
         assert!(why.contains("expansions"), "{why}");
+    }
+
+    #[test]
+    fn fallback_searches_between_the_first_and_last_legs() {
+        // The bay of tools/maneuvers with the direct search cut to one expansion and no
+        // patterns: only the fallback can find the way, and its path is clear and exact.
+        let mut boundary = vec![
+            v2(0.0, 0.0),
+            v2(50.0, 0.0),
+            v2(50.0, 9.0),
+            v2(26.6, 9.0),
+            v2(26.6, 16.0),
+            v2(23.0, 16.0),
+            v2(23.0, 9.0),
+            v2(0.0, 9.0),
+        ];
+        crate::geo::polygon::make_ccw(&mut boundary);
+        let map = CollisionMap::new(Some(boundary), vec![], 2.0).unwrap();
+        let mut p = params();
+        p.goal_patterns.clear();
+        p.search_max_expansions = 1;
+        let (start, goal) = (
+            Pose::new(5.0, 4.5, 0.0),
+            Pose::new(24.8, 13.8, -FRAC_PI_2),
+        );
+        let r = plan_maneuver(&map, &RS, &p, &start, &goal).unwrap();
+        assert_eq!(r.method, Some(Method::Fallback), "{:?}", r.stages);
+        let path = r.path.unwrap();
+        let end = path.end_pose();
+        assert!((end.pos - goal.pos).norm() < 1e-6);
+        assert!(wrap_angle(end.heading - goal.heading).abs() < 1e-6);
+        assert!((path.start.pos - start.pos).norm() < 1e-12);
+        assert_clear(&map, &p, &path);
+        assert!(r.stages.iter().any(|s| s.starts_with("fallback: found")));
     }
 
     #[test]
