@@ -353,7 +353,7 @@ fn maneuver_svg(
             "{:.1} m, {} cusps, {:.1} m reverse",
             p.length(),
             p.cusps(),
-            p.reverse_length()
+            p.reverse_length() + 0.0
         ),
         None => format!("no path: {}", res.failure.as_deref().unwrap_or("not found")),
     };
