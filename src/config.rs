@@ -51,6 +51,20 @@ pub enum JobKind {
     Field,
 }
 
+/// In which order the lines of an AB job are driven.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LineOrder {
+    /// The seed-000 order: blocks of `N = 2·ceil(2·r_min/line_width) + a` lines driven in a
+    /// skip order so that every turn is a forward pi turn (SPEC §2).
+    #[default]
+    Blocks,
+    /// Adjacent lines in turn. Lines closer than `2·r_min` are joined by a fishtail turn with
+    /// a reversal (continuous-curvature when `vehicle.max_curvature_rate_per_m2` > 0). Needs a
+    /// finite `line_num`.
+    Sequential,
+}
+
 /// Side of A→B on which the following lines are laid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
@@ -95,6 +109,10 @@ pub struct JobConfig {
     pub line_num: u64,
     /// Side of A→B on which further lines are laid: "left" or "right".
     pub side: LineSide,
+    /// For `kind = "ab"`: "blocks" (the seed-000 skip order, forward turns only) or
+    /// "sequential" (adjacent lines in turn, fishtail turns with a reversal where the lines
+    /// are closer than 2·r_min; needs `line_num` ≥ 1).
+    pub line_order: LineOrder,
     /// WGS-84 latitude of the local ENU origin, degrees.
     pub origin_lat_deg: f64,
     /// WGS-84 longitude of the local ENU origin, degrees.
@@ -111,6 +129,7 @@ impl Default for JobConfig {
             line_width_m: 3.0,
             line_num: 12,
             side: LineSide::Right,
+            line_order: LineOrder::Blocks,
             origin_lat_deg: 52.0,
             origin_lon_deg: 5.0,
         }
@@ -762,6 +781,13 @@ impl Config {
             );
         }
         c.range("job.line_width_m", j.line_width_m, 0.1, 100.0);
+        if j.kind == JobKind::Ab && j.line_order == LineOrder::Sequential && j.line_num == 0 {
+            c.push(
+                "job.line_num",
+                "0".to_string(),
+                "must be at least 1 when job.line_order = \"sequential\" (the whole job is planned at start)",
+            );
+        }
         if j.kind == JobKind::Field && j.field_path.trim().is_empty() {
             c.push(
                 "job.field_path",

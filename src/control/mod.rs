@@ -5,7 +5,7 @@
 //! allocation-free per cycle and never does I/O: callers feed it inputs and persist the
 //! progress snapshots it hands out.
 
-use crate::config::{Config, JobKind, LineSide, TrackerChoice};
+use crate::config::{Config, JobKind, LineOrder, LineSide, TrackerChoice};
 use crate::estimate::{AntennaOffset, Estimator, EstimatorParams, GnssFix, VehicleEstimate};
 use crate::geo::{v2, Direction, Pose};
 use crate::guidance::progress::{JobDefinition, Progress};
@@ -42,6 +42,29 @@ pub fn ab_params(cfg: &Config) -> AbParams {
             max_points: cfg.guidance.turn_max_points,
         },
     }
+}
+
+/// The AB job configured by `cfg`: the seed-000 block plan, or (`job.line_order =
+/// "sequential"`) every line and turn in turn as a segment job.
+pub fn ab_job_plan(cfg: &Config) -> Result<JobPlan, ControlError> {
+    let params = ab_params(cfg);
+    Ok(match cfg.job.line_order {
+        LineOrder::Blocks => AbPlan::new(params)?.into(),
+        LineOrder::Sequential => {
+            let segments = crate::plan::abline::sequential_segments(&params)?;
+            JobPlan::Segments(crate::guidance::segments::SegmentJob::new(
+                segments
+                    .into_iter()
+                    .map(|s| crate::guidance::segments::JobSegment {
+                        kind: s.kind,
+                        direction: s.direction,
+                        cell: s.cell,
+                        points: s.points,
+                    })
+                    .collect(),
+            )?)
+        }
+    })
 }
 
 /// The state machine's parameters from the configuration.
@@ -174,7 +197,7 @@ impl Controller {
         if cfg.job.kind == JobKind::Field {
             return Err(ControlError::NoPlan);
         }
-        Controller::with_job(cfg, AbPlan::new(ab_params(cfg))?.into(), resume)
+        Controller::with_job(cfg, ab_job_plan(cfg)?, resume)
     }
 
     /// A job given by its plan (an AB plan or a segment job such as a field plan), or the

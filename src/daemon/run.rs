@@ -16,7 +16,6 @@ use crate::control::ControlError;
 use crate::geo::wgs84::LatLon;
 use crate::guidance::progress::{JobDefinition, Progress};
 use crate::guidance::JobPlan;
-use crate::plan::abline::AbPlan;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
@@ -116,8 +115,7 @@ pub struct DaemonJob {
 pub fn prepare_job(cfg: &Config) -> Result<DaemonJob, DaemonError> {
     let (plan, origin) = match cfg.job.kind {
         JobKind::Ab => {
-            let plan = AbPlan::new(crate::control::ab_params(cfg)).map_err(ControlError::from)?;
-            (JobPlan::from(plan), None)
+            (crate::control::ab_job_plan(cfg)?, None)
         }
         JobKind::Field => {
             let start = std::time::Instant::now();

@@ -383,6 +383,20 @@ pub fn run(
     on_event: &mut dyn FnMut(f64, &Event),
 ) -> Result<DemoRun, ControlError> {
     let wall = std::time::Instant::now();
+    // A sequential AB job is a segment job: plan it here so its segments are scored.
+    let sequential;
+    let opts = if opts.job.is_none()
+        && cfg.job.kind == crate::config::JobKind::Ab
+        && cfg.job.line_order == crate::config::LineOrder::Sequential
+    {
+        sequential = DemoOptions {
+            job: Some(crate::control::ab_job_plan(cfg)?),
+            ..opts.clone()
+        };
+        &sequential
+    } else {
+        opts
+    };
     let mut node = match &opts.job {
         Some(job) => ControllerNode::with_job(cfg, job.clone(), opts.resume.as_ref())?,
         None => ControllerNode::new(cfg, opts.resume.as_ref())?,
