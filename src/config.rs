@@ -187,6 +187,11 @@ pub struct VehicleConfig {
     pub r_min_m: f64,
     /// Largest front-wheel angle either way, degrees.
     pub max_wheel_angle_deg: f64,
+    /// Largest rate of change of the steering curvature per metre driven, 1/m² (σ_max of
+    /// the continuous-curvature turns and manoeuvres, SPEC §4). It comes from the steering
+    /// speed: about max wheel rate (rad/s) / (wheelbase (m) · speed in turns (m/s)); 30°/s,
+    /// 2.5 m and 6 km/h give 0.13. 0 = turns of arcs only (curvature steps at their ends).
+    pub max_curvature_rate_per_m2: f64,
     /// GNSS antenna position ahead of the rear-axle centre, m.
     pub antenna_forward_m: f64,
     /// GNSS antenna position left of the rear-axle centre, m.
@@ -201,6 +206,7 @@ impl Default for VehicleConfig {
             wheelbase_m: 3.0,
             r_min_m: 5.0,
             max_wheel_angle_deg: 35.0,
+            max_curvature_rate_per_m2: 0.06,
             antenna_forward_m: 1.0,
             antenna_left_m: 0.0,
             antenna_up_m: 3.0,
@@ -617,6 +623,7 @@ impl Config {
             },
             route: f.route,
             small_obstacle_max_m: f.small_obstacle_max_m,
+            max_curvature_rate: self.vehicle.max_curvature_rate_per_m2,
         }
     }
 
@@ -851,6 +858,12 @@ impl Config {
         let v = &self.vehicle;
         c.range("vehicle.wheelbase_m", v.wheelbase_m, 0.5, 20.0);
         c.range("vehicle.r_min_m", v.r_min_m, 0.5, 100.0);
+        c.range(
+            "vehicle.max_curvature_rate_per_m2",
+            v.max_curvature_rate_per_m2,
+            0.0,
+            10.0,
+        );
         c.range(
             "vehicle.max_wheel_angle_deg",
             v.max_wheel_angle_deg,

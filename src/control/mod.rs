@@ -40,6 +40,7 @@ pub fn ab_params(cfg: &Config) -> AbParams {
             merge_distance: cfg.guidance.turn_merge_distance_m,
             point_spacing: cfg.guidance.point_spacing_m,
             max_points: cfg.guidance.turn_max_points,
+            max_curvature_rate: cfg.vehicle.max_curvature_rate_per_m2,
         },
     }
 }

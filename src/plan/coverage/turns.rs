@@ -135,6 +135,7 @@ mod tests {
             merge_distance: 0.05,
             point_spacing: 1.0,
             max_points: 500,
+            max_curvature_rate: 0.0,
         }
     }
 
