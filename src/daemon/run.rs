@@ -114,9 +114,7 @@ pub struct DaemonJob {
 /// its coverage: blocking work, done once at start-up, never in the control loop.
 pub fn prepare_job(cfg: &Config) -> Result<DaemonJob, DaemonError> {
     let (plan, origin) = match cfg.job.kind {
-        JobKind::Ab => {
-            (crate::control::ab_job_plan(cfg)?, None)
-        }
+        JobKind::Ab => (crate::control::ab_job_plan(cfg)?, None),
         JobKind::Field => {
             let start = std::time::Instant::now();
             let fj = field_file::load(cfg).map_err(DaemonError::Field)?;

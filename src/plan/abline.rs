@@ -680,7 +680,9 @@ pub fn sequential_segments(params: &AbParams) -> Result<Vec<PlanSegment>, PlanEr
             }
         }
         let n = ((plan.length / spacing).ceil() as usize).max(1);
-        let points = (0..=n).map(|i| s + (e - s) * (i as f64 / n as f64)).collect();
+        let points = (0..=n)
+            .map(|i| s + (e - s) * (i as f64 / n as f64))
+            .collect();
         push(&mut out, SegmentKind::Work, Direction::Forward, points);
     }
     Ok(out)

@@ -6,5 +6,6 @@
 //! [`Pose`](crate::geo::Pose); they can be sampled at any spacing.
 
 pub mod cc_turn;
+pub mod drive;
 pub mod fresnel;
 pub mod path;
