@@ -9,3 +9,4 @@ pub mod cc_turn;
 pub mod drive;
 pub mod fresnel;
 pub mod path;
+pub mod reeds_shepp;
