@@ -159,6 +159,13 @@ pub struct GuidanceConfig {
     pub stopped_speed_mps: f64,
     /// A vehicle stopped within this distance of a cusp moves on to the next segment, m.
     pub cusp_capture_m: f64,
+    /// Approach paths: when the operator engages at the start of a line too far from it to
+    /// engage (|XTE| ≥ `safety.max_engage_xte_m` or heading error ≥
+    /// `safety.max_engage_heading_error_deg`), plan a continuous-curvature path (reversing
+    /// where shorter, κ_max = 1/`vehicle.r_min_m`, σ_max = `vehicle.max_curvature_rate_per_m2`)
+    /// from the vehicle to the line start, inside the field when the job has one, and drive
+    /// it first. false = refuse to engage there, as without approach paths.
+    pub approach_paths: bool,
 }
 
 impl Default for GuidanceConfig {
@@ -173,6 +180,7 @@ impl Default for GuidanceConfig {
             cusp_decel_mps2: 0.5,
             stopped_speed_mps: 0.05,
             cusp_capture_m: 1.0,
+            approach_paths: true,
         }
     }
 }

@@ -190,6 +190,43 @@ pub struct Controller {
     integral: IntegralAction,
     /// Time of the previous tick, s.
     last_tick: Option<f64>,
+    /// Approach paths (`guidance.approach_paths`), `None` when off.
+    approach: Option<ApproachSettings>,
+}
+
+/// Whether a sampled approach path keeps the vehicle inside the field and off its obstacles.
+pub type ClearanceCheck =
+    std::sync::Arc<dyn Fn(&crate::plan::maneuver::path::CurvePath) -> bool + Send + Sync>;
+
+/// How approach paths are planned (issue 6 part 5b).
+#[derive(Clone)]
+pub struct ApproachSettings {
+    pub curve: crate::plan::maneuver::path::CurveParams,
+    /// Spacing of the approach path's points, m.
+    pub spacing: f64,
+    /// An approach is planned when |XTE| or the heading error reach these (the engage
+    /// limits), m and rad.
+    pub max_xte: f64,
+    pub max_heading_error: f64,
+    /// The field check, when the job has a field.
+    pub clear: Option<ClearanceCheck>,
+}
+
+/// Approach settings from the configuration (`None` when `guidance.approach_paths` is off or
+/// `vehicle.max_curvature_rate_per_m2` is 0).
+pub fn approach_settings(cfg: &Config) -> Option<ApproachSettings> {
+    (cfg.guidance.approach_paths && cfg.vehicle.max_curvature_rate_per_m2 > 0.0).then(|| {
+        ApproachSettings {
+            curve: crate::plan::maneuver::path::CurveParams {
+                kappa_max: 1.0 / cfg.vehicle.r_min_m,
+                sigma_max: cfg.vehicle.max_curvature_rate_per_m2,
+            },
+            spacing: cfg.guidance.point_spacing_m.min(0.5),
+            max_xte: cfg.safety.max_engage_xte_m,
+            max_heading_error: cfg.safety.max_engage_heading_error_deg.to_radians(),
+            clear: None,
+        }
+    })
 }
 
 impl Controller {
@@ -220,7 +257,63 @@ impl Controller {
             law: law_params(cfg),
             integral: integral_action(cfg, 0.0),
             last_tick: None,
+            approach: approach_settings(cfg),
         })
+    }
+
+    /// Check approach paths against the job's field (see [`ClearanceCheck`]).
+    pub fn set_approach_clearance(&mut self, clear: ClearanceCheck) {
+        if let Some(a) = &mut self.approach {
+            a.clear = Some(clear);
+        }
+    }
+
+    /// On an engage request at time `t`: when the vehicle is at the start of a line but too
+    /// far from it to engage, plan an approach path to the line start and drive it first.
+    /// `None` when no approach is needed (or approaches are off); else the number of parts
+    /// (1 + cusps) or why none could be planned. Runs the analytic connection only (µs).
+    pub fn plan_approach(
+        &mut self,
+        t: f64,
+    ) -> Option<Result<usize, crate::plan::maneuver::approach::ApproachError>> {
+        let a = self.approach.as_ref()?;
+        let g = &self.guidance;
+        if g.is_finished()
+            || g.is_approaching()
+            || g.phase() != crate::guidance::progress::Phase::Work
+            || g.index_global() > 0
+        {
+            return None;
+        }
+        let est = self.estimator.estimate(t)?;
+        let (xte, heading_error) = g.errors(&est.pose)?;
+        if xte.abs() < a.max_xte && heading_error.abs() < a.max_heading_error {
+            return None;
+        }
+        let to = self.path_start_pose()?;
+        let always = |_: &crate::plan::maneuver::path::CurvePath| true;
+        let clear: &dyn Fn(&crate::plan::maneuver::path::CurvePath) -> bool = match &a.clear {
+            Some(c) => c.as_ref(),
+            None => &always,
+        };
+        let result = crate::plan::maneuver::approach::approach_path(
+            &est.pose, &to, &a.curve, a.spacing, clear,
+        )
+        .map(|(_, parts)| {
+            let n = parts.len();
+            let segments = parts
+                .into_iter()
+                .map(|p| crate::guidance::segments::JobSegment {
+                    kind: crate::plan::coverage::SegmentKind::Transit,
+                    direction: p.direction,
+                    cell: 0,
+                    points: p.points,
+                })
+                .collect();
+            self.guidance.set_approach(segments);
+            n
+        });
+        Some(result)
     }
 
     pub fn on_fix(&mut self, fix: &GnssFix) {

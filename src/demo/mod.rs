@@ -596,7 +596,10 @@ pub fn run(
         last_wheel = truth.wheel_angle;
         let g = node.controller().guidance();
         let mut xte_abs = None;
-        if let Some(score) = segment_scores.get_mut(g.index_rank()) {
+        let scored_segment = (!g.is_approaching())
+            .then(|| segment_scores.get_mut(g.index_rank()))
+            .flatten();
+        if let Some(score) = scored_segment {
             if !segment_path.is_current(g) {
                 segment_path.set(g);
             }

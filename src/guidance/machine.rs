@@ -447,7 +447,8 @@ impl Guidance {
     }
 
     /// Driving direction of the next segment of a segment job or an approach (`None` at the
-    /// last one and for AB jobs, whose lines are driven forward).
+    /// last one; forward for AB jobs, whose lines and turns are all driven forward, until they
+    /// finish).
     pub fn next_direction(&self) -> Option<Direction> {
         if let Some(i) = self.approach_index {
             return Some(match self.approach.get(i + 1) {
@@ -464,7 +465,7 @@ impl Guidance {
         }
         match &self.plan {
             JobPlan::Segments(job) => job.segments().get(self.index_rank + 1).map(|s| s.direction),
-            JobPlan::Ab(_) => None,
+            JobPlan::Ab(_) => (!self.is_finished()).then_some(Direction::Forward),
         }
     }
 

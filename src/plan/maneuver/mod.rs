@@ -5,6 +5,7 @@
 //! Paths are lists of [`CurveSegment`](path::CurveSegment)s from a start
 //! [`Pose`](crate::geo::Pose); they can be sampled at any spacing.
 
+pub mod approach;
 pub mod cc_turn;
 pub mod drive;
 pub mod fresnel;
