@@ -6,6 +6,7 @@
 //! [`Pose`](crate::geo::Pose); they can be sampled at any spacing.
 
 pub mod approach;
+pub mod cc_reeds_shepp;
 pub mod cc_turn;
 pub mod drive;
 pub mod fresnel;
