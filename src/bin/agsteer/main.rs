@@ -1,6 +1,7 @@
 //! `agsteer`: the technician's and developer's tool.
 
 mod dbc_cmd;
+mod maneuver_cmd;
 mod plan_cmd;
 mod sim_cmd;
 
@@ -113,6 +114,38 @@ enum Command {
         #[command(flatten)]
         cfg: ConfigArgs,
     },
+    /// Plan a manoeuvre with reversing between two poses (local metres) on a map: prints the
+    /// path's length, cusps and segments; exit status 3 when no path is found.
+    Maneuver {
+        /// Configuration file ([maneuver], [vehicle]).
+        #[arg(long, default_value = "config/demo.toml")]
+        config: PathBuf,
+        /// Map: GeoJSON in local metres; a Polygon's exterior is the boundary, its holes and
+        /// Features with "obstacle": true are obstacles. Without it the space is free.
+        #[arg(long)]
+        map: Option<PathBuf>,
+        /// Start pose x,y,heading_deg (metres, degrees CCW from East).
+        #[arg(long, allow_hyphen_values = true, required_unless_present = "batch")]
+        from: Option<String>,
+        /// Goal pose x,y,heading_deg.
+        #[arg(long, allow_hyphen_values = true, required_unless_present = "batch")]
+        to: Option<String>,
+        /// Curve family: cc (continuous curvature) or rs (plain Reeds-Shepp); default
+        /// maneuver.curve.
+        #[arg(long, value_parser = parse_curve)]
+        curve: Option<agsteer::config::CurveChoice>,
+        /// Draw the map and path into this SVG file.
+        #[arg(long)]
+        svg: Option<PathBuf>,
+        /// Print the result as JSON.
+        #[arg(long)]
+        json: bool,
+        /// JSON lines {"from":[x,y,deg],"to":[x,y,deg]}: one JSON result per line on stdout.
+        #[arg(long, conflicts_with_all = ["from", "to", "svg"])]
+        batch: Option<PathBuf>,
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    },
     /// Validate a configuration: print it resolved, or every problem (exit status 2).
     CheckConfig {
         /// Configuration file.
@@ -153,6 +186,30 @@ fn main() -> ExitCode {
             cfg,
         } => load_config(&config, &cfg.set).and_then(|c| run_plan(&field, &c, &out, json)),
         Command::Dbc { cmd } => dbc_cmd::run(cmd),
+        Command::Maneuver {
+            config,
+            map,
+            from,
+            to,
+            curve,
+            svg,
+            json,
+            batch,
+            cfg,
+        } => load_config(&config, &cfg.set).and_then(|c| {
+            maneuver_cmd::run(
+                &c,
+                &maneuver_cmd::ManeuverArgs {
+                    map: map.as_deref(),
+                    from: from.as_deref(),
+                    to: to.as_deref(),
+                    curve,
+                    svg: svg.as_deref(),
+                    json,
+                    batch: batch.as_deref(),
+                },
+            )
+        }),
         Command::Sim {
             iface,
             config,
@@ -191,6 +248,14 @@ fn main() -> ExitCode {
 
 fn run_plan(field: &Path, cfg: &Config, out: &Path, json: bool) -> Result<u8> {
     plan_cmd::run(field, cfg, out, json, agsteer::plan::coverage::plan_field)
+}
+
+fn parse_curve(s: &str) -> Result<agsteer::config::CurveChoice, String> {
+    match s {
+        "cc" => Ok(agsteer::config::CurveChoice::Cc),
+        "rs" => Ok(agsteer::config::CurveChoice::Rs),
+        other => Err(format!("`{other}`: expected cc or rs")),
+    }
 }
 
 fn load_config(path: &Path, set: &[String]) -> Result<Config> {

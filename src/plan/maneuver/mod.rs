@@ -12,3 +12,8 @@ pub mod drive;
 pub mod fresnel;
 pub mod path;
 pub mod reeds_shepp;
+
+pub mod collision;
+pub mod expansion;
+pub mod search;
+pub mod steering;
