@@ -49,6 +49,9 @@ pub enum JobKind {
     Ab,
     /// A field coverage plan (SPEC §3) made from the field at `job.field_path`.
     Field,
+    /// A manoeuvre with reversing (SPEC §4) from `job.maneuver_from` to `job.maneuver_to` on
+    /// the map at `job.maneuver_map_path`, planned at start-up with `[maneuver]`.
+    Maneuver,
 }
 
 /// In which order the lines of an AB job are driven.
@@ -99,6 +102,14 @@ pub struct JobConfig {
     /// configuration), not from the configuration file's directory. Read and planned once
     /// when agsteerd or `agsteer demo` starts.
     pub field_path: String,
+    /// For `kind = "maneuver"`: the map, GeoJSON in local metres (boundary polygon, holes and
+    /// `"obstacle": true` features are obstacles; see `agsteer maneuver`); empty = free space.
+    pub maneuver_map_path: String,
+    /// For `kind = "maneuver"`: start pose [x m, y m, heading degrees CCW from East], local
+    /// ENU about `job.origin_*`.
+    pub maneuver_from: [f64; 3],
+    /// For `kind = "maneuver"`: goal pose [x m, y m, heading degrees].
+    pub maneuver_to: [f64; 3],
     /// Point A of the first work line, local ENU [east, north], m.
     pub point_a_m: [f64; 2],
     /// Point B of the first work line, local ENU [east, north], m.
@@ -124,6 +135,9 @@ impl Default for JobConfig {
         JobConfig {
             kind: JobKind::Ab,
             field_path: String::new(),
+            maneuver_map_path: String::new(),
+            maneuver_from: [0.0, 0.0, 0.0],
+            maneuver_to: [20.0, 0.0, 0.0],
             point_a_m: [0.0, 0.0],
             point_b_m: [0.0, 150.0],
             line_width_m: 3.0,
@@ -967,6 +981,18 @@ impl Config {
                 "must be at least 1 when job.line_order = \"sequential\" (the whole job is planned at start)",
             );
         }
+        for (key, pose) in [
+            ("job.maneuver_from", j.maneuver_from),
+            ("job.maneuver_to", j.maneuver_to),
+        ] {
+            if pose.iter().any(|v| !v.is_finite()) {
+                c.push(
+                    key,
+                    format!("{pose:?}"),
+                    "must be [x m, y m, heading degrees], all finite",
+                );
+            }
+        }
         if j.kind == JobKind::Field && j.field_path.trim().is_empty() {
             c.push(
                 "job.field_path",
@@ -1269,7 +1295,12 @@ impl Config {
         );
         c.range("vehicle.length_m", v.length_m, 0.5, 40.0);
         c.range("vehicle.width_m", v.width_m, 0.3, 20.0);
-        c.range("vehicle.rear_axle_from_rear_m", v.rear_axle_from_rear_m, 0.0, 40.0);
+        c.range(
+            "vehicle.rear_axle_from_rear_m",
+            v.rear_axle_from_rear_m,
+            0.0,
+            40.0,
+        );
         if v.rear_axle_from_rear_m > v.length_m {
             c.push(
                 "vehicle.rear_axle_from_rear_m",
@@ -1306,13 +1337,23 @@ impl Config {
             0.001,
             10.0,
         );
-        c.range("maneuver.implement_length_m", m.implement_length_m, 0.0, 40.0);
+        c.range(
+            "maneuver.implement_length_m",
+            m.implement_length_m,
+            0.0,
+            40.0,
+        );
         if m.implement_length_m > 0.0 {
             c.range("maneuver.implement_width_m", m.implement_width_m, 0.1, 60.0);
         }
         c.range("maneuver.implement_hitch_m", m.implement_hitch_m, 0.0, 20.0);
         c.range("maneuver.clearance_m", m.clearance_m, 0.0, 5.0);
-        c.range("maneuver.sample_tolerance_m", m.sample_tolerance_m, 0.01, 2.0);
+        c.range(
+            "maneuver.sample_tolerance_m",
+            m.sample_tolerance_m,
+            0.01,
+            2.0,
+        );
         if m.clearance_m.is_finite() && m.clearance_m < 0.5 * m.sample_tolerance_m {
             c.push(
                 "maneuver.clearance_m",
@@ -1325,11 +1366,27 @@ impl Config {
         c.range("maneuver.expansion_join_m", m.expansion_join_m, 0.0, 20.0);
         let count = |c: &mut Checker, key: &str, v: usize, lo: usize, hi: usize| {
             if !(lo..=hi).contains(&v) {
-                c.push(key, v.to_string(), &format!("must be an integer in {lo}..={hi}"));
+                c.push(
+                    key,
+                    v.to_string(),
+                    &format!("must be an integer in {lo}..={hi}"),
+                );
             }
         };
-        count(c, "maneuver.expansion_max_depth", m.expansion_max_depth, 1, 100);
-        count(c, "maneuver.expansion_max_legs", m.expansion_max_legs, 2, 100_000);
+        count(
+            c,
+            "maneuver.expansion_max_depth",
+            m.expansion_max_depth,
+            1,
+            100,
+        );
+        count(
+            c,
+            "maneuver.expansion_max_legs",
+            m.expansion_max_legs,
+            2,
+            100_000,
+        );
         for (i, pat) in m.goal_patterns.iter().enumerate() {
             if crate::plan::maneuver::search::parse_pattern(pat).is_err() {
                 c.push(
@@ -1340,7 +1397,12 @@ impl Config {
             }
         }
         c.range("maneuver.heading_step_deg", m.heading_step_deg, 1.0, 90.0);
-        c.range("maneuver.primitive_max_deg", m.primitive_max_deg, 0.0, 180.0);
+        c.range(
+            "maneuver.primitive_max_deg",
+            m.primitive_max_deg,
+            0.0,
+            180.0,
+        );
         c.range("maneuver.straight_step_m", m.straight_step_m, 0.1, 50.0);
         c.range("maneuver.reverse_penalty", m.reverse_penalty, 1.0, 100.0);
         c.range("maneuver.cusp_penalty_m", m.cusp_penalty_m, 0.0, 1000.0);
@@ -1351,7 +1413,13 @@ impl Config {
             1.0,
             90.0,
         );
-        count(c, "maneuver.max_expansions", m.max_expansions, 1, 10_000_000);
+        count(
+            c,
+            "maneuver.max_expansions",
+            m.max_expansions,
+            1,
+            10_000_000,
+        );
         count(
             c,
             "maneuver.pattern_max_expansions",
@@ -1360,7 +1428,13 @@ impl Config {
             10_000_000,
         );
         count(c, "maneuver.analytic_every", m.analytic_every, 1, 10_000);
-        count(c, "maneuver.extra_expansions", m.extra_expansions, 0, 10_000_000);
+        count(
+            c,
+            "maneuver.extra_expansions",
+            m.extra_expansions,
+            0,
+            10_000_000,
+        );
         count(c, "maneuver.fallback_points", m.fallback_points, 1, 100);
     }
 

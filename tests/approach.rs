@@ -63,3 +63,37 @@ fn near_the_line_no_approach_is_planned() {
     assert!(r.report.finished);
     assert!(r.report.distance_m < 100.0, "{:?}", r.report);
 }
+
+#[test]
+fn a_field_job_approaches_inside_the_field() {
+    use agsteer::daemon::field_file;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.toml");
+    let mut cfg = Config::load(std::path::Path::new(path), &[]).unwrap();
+    // 8 m to the left of the first headland pass (into the field), facing 100° off it.
+    cfg.sim.start_offset_m = 8.0;
+    cfg.sim.start_heading_deg = 80.0;
+    cfg.sim.max_time_s = 120.0;
+    let fj = field_file::load(&cfg).unwrap();
+    let opts = DemoOptions {
+        job: Some(fj.job_plan()),
+        origin: Some(fj.origin()),
+        field: Some(fj.loaded.field.clone()),
+        ..Default::default()
+    };
+    let r = run(&cfg, &opts, &mut |_| {}, &mut |_, _| {})
+        .unwrap()
+        .report;
+    // Engaged at once (on the approach), and the first pass is then tracked as usual.
+    assert!(r.engaged_fraction > 0.99, "{r:?}");
+    assert!(r.distance_m > 250.0, "{r:?}");
+    assert!(r.xte_rms_m < 0.06 && r.xte_max_m < 0.3, "{r:?}");
+    // From outside the field (8 m to the right of the outer pass, driving away from it) every
+    // approach would leave the field: refused, so the supervisor does not engage.
+    cfg.sim.start_offset_m = -8.0;
+    cfg.sim.start_heading_deg = -80.0;
+    cfg.sim.max_time_s = 20.0;
+    let r = run(&cfg, &opts, &mut |_| {}, &mut |_, _| {})
+        .unwrap()
+        .report;
+    assert_eq!(r.engaged_fraction, 0.0, "{r:?}");
+}

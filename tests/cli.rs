@@ -190,14 +190,25 @@ fn maneuver_single_batch_and_bad_endpoint() {
     // --set reaches the planner: a larger radius is reported in the curvature.
     let (code, out, err) = agsteer(
         &[
-            "maneuver", "--from", "0,0,0", "--to", "40,-20,-90", "--json", "--set",
-            "vehicle.r_min_m=8", "--curve", "rs",
+            "maneuver",
+            "--from",
+            "0,0,0",
+            "--to",
+            "40,-20,-90",
+            "--json",
+            "--set",
+            "vehicle.r_min_m=8",
+            "--curve",
+            "rs",
         ],
         "",
     );
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    assert!((v["max_curvature"].as_f64().unwrap() - 0.125).abs() < 1e-9, "{v}");
+    assert!(
+        (v["max_curvature"].as_f64().unwrap() - 0.125).abs() < 1e-9,
+        "{v}"
+    );
     assert_eq!(v["max_curvature_rate"], 0.0);
 
     // Batch: one JSON result per line, a bad endpoint reported in its line.

@@ -80,7 +80,10 @@ fn geo_map(text: &str) -> (Polygon<f64>, Vec<Polygon<f64>>) {
 /// The bare vehicle rectangle (no clearance) at a pose, as a geo polygon.
 fn rectangle(cfg: &Config, pose: &Pose) -> Polygon<f64> {
     let v = &cfg.vehicle;
-    let (x0, x1) = (-v.rear_axle_from_rear_m, v.length_m - v.rear_axle_from_rear_m);
+    let (x0, x1) = (
+        -v.rear_axle_from_rear_m,
+        v.length_m - v.rear_axle_from_rear_m,
+    );
     let w = 0.5 * v.width_m;
     let (s, c) = pose.heading.sin_cos();
     let at = |x: f64, y: f64| Coord {
@@ -88,7 +91,13 @@ fn rectangle(cfg: &Config, pose: &Pose) -> Polygon<f64> {
         y: pose.pos.y + s * x + c * y,
     };
     Polygon::new(
-        LineString::from(vec![at(x0, -w), at(x1, -w), at(x1, w), at(x0, w), at(x0, -w)]),
+        LineString::from(vec![
+            at(x0, -w),
+            at(x1, -w),
+            at(x1, w),
+            at(x0, w),
+            at(x0, -w),
+        ]),
         vec![],
     )
 }

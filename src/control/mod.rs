@@ -141,7 +141,7 @@ pub enum ControlError {
     Guidance(#[from] GuidanceError),
     #[error("cannot plan the job: {0}")]
     Plan(#[from] crate::plan::PlanError),
-    #[error("job.kind = \"field\" needs its field plan: load it first (the daemon and `agsteer demo` read job.field_path)")]
+    #[error("job.kind = \"field\" or \"maneuver\" needs its plan: load it first (the daemon and `agsteer demo` read job.field_path or job.maneuver_map_path)")]
     NoPlan,
 }
 
@@ -232,7 +232,7 @@ pub fn approach_settings(cfg: &Config) -> Option<ApproachSettings> {
 impl Controller {
     /// A new job, or the continuation of `resume`.
     pub fn from_config(cfg: &Config, resume: Option<&Progress>) -> Result<Self, ControlError> {
-        if cfg.job.kind == JobKind::Field {
+        if matches!(cfg.job.kind, JobKind::Field | JobKind::Maneuver) {
             return Err(ControlError::NoPlan);
         }
         Controller::with_job(cfg, ab_job_plan(cfg)?, resume)
@@ -268,10 +268,11 @@ impl Controller {
         }
     }
 
-    /// On an engage request at time `t`: when the vehicle is at the start of a line but too
-    /// far from it to engage, plan an approach path to the line start and drive it first.
-    /// `None` when no approach is needed (or approaches are off); else the number of parts
-    /// (1 + cusps) or why none could be planned. Runs the analytic connection only (µs).
+    /// On an engage request at time `t`: when the job has not finished a line yet and the
+    /// vehicle is too far from the first line to engage, plan an approach path to the line
+    /// start and drive it first. `None` when no approach is needed (or approaches are off);
+    /// else the number of parts (1 + cusps) or why none could be planned. Runs the analytic
+    /// connection and the field check only (well under a millisecond).
     pub fn plan_approach(
         &mut self,
         t: f64,
@@ -281,7 +282,7 @@ impl Controller {
         if g.is_finished()
             || g.is_approaching()
             || g.phase() != crate::guidance::progress::Phase::Work
-            || g.index_global() > 0
+            || g.lines_done() > 0
         {
             return None;
         }
@@ -301,6 +302,7 @@ impl Controller {
         )
         .map(|(_, parts)| {
             let n = parts.len();
+            // Accepted: the conditions above are the guidance's own.
             let segments = parts
                 .into_iter()
                 .map(|p| crate::guidance::segments::JobSegment {

@@ -73,6 +73,8 @@ pub struct ControllerNode {
     /// A stop for a change of direction is under way (from the stop request until the vehicle
     /// moves the new way at the minimum speed).
     cusp: bool,
+    /// The last approach request was refused (already logged).
+    approach_refused: bool,
     last_request: Option<f64>,
 }
 
@@ -163,6 +165,7 @@ impl ControllerNode {
                 min_speed: cfg.safety.min_speed_kmh / 3.6,
             },
             cusp: false,
+            approach_refused: false,
             last_request: None,
             status: NodeStatus {
                 state: SafetyState::Disengaged,
@@ -304,10 +307,15 @@ impl ControllerNode {
                 c if c == operator::ENGAGE || c == operator::RESUME => {
                     match self.ctrl.plan_approach(t) {
                         Some(Ok(parts)) => {
+                            self.approach_refused = false;
                             tracing::info!(parts, "approach path to the line start planned")
                         }
-                        Some(Err(e)) => tracing::warn!("no approach path: {e}"),
-                        None => {}
+                        // Logged once per run of refusals (an operator may hold the button).
+                        Some(Err(e)) if !self.approach_refused => {
+                            self.approach_refused = true;
+                            tracing::warn!("no approach path: {e}")
+                        }
+                        _ => {}
                     }
                     self.supervisor.request_engage()
                 }

@@ -241,6 +241,8 @@ pub struct DemoOptions {
     /// ENU origin of the job's coordinates when it is not `job.origin_*` (a field plan:
     /// [`FieldJob::origin`](crate::field::job::FieldJob::origin)).
     pub origin: Option<crate::geo::wgs84::LatLon>,
+    /// The field approach paths must stay in (local ENU, as the job).
+    pub field: Option<crate::plan::coverage::Field>,
 }
 
 /// A recorded point of the true trajectory.
@@ -403,6 +405,12 @@ pub fn run(
     };
     if let Some(origin) = opts.origin {
         node = node.with_origin(origin);
+    }
+    if let Some(field) = &opts.field {
+        match crate::plan::maneuver::job::field_clearance(cfg, field) {
+            Ok(clear) => node.controller_mut().set_approach_clearance(clear),
+            Err(e) => tracing::warn!("approach paths are not checked against the field: {e}"),
+        }
     }
     let speed = cfg.speed();
     let start = match (&opts.resume, &opts.job) {

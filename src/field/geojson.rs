@@ -137,7 +137,9 @@ fn feature_name(feature: &Value) -> Option<String> {
 
 /// A WGS-84 GeoJSON document (`[lon, lat]` positions).
 pub(crate) fn parse(text: &str) -> Result<Parsed, FieldError> {
-    parse_with(text, |feature, lon, lat| check_coordinate(feature, lat, lon))
+    parse_with(text, |feature, lon, lat| {
+        check_coordinate(feature, lat, lon)
+    })
 }
 
 /// A GeoJSON document in local metres (`[x, y]` positions, any finite numbers).

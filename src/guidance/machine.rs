@@ -395,7 +395,12 @@ impl Guidance {
         }
         let dir = d / len;
         let xte = signed_offset(&pose.pos, &a, &dir);
-        Some((xte, wrap_angle(pose.heading - dir.y.atan2(dir.x))))
+        // Driven in reverse, the vehicle faces against the direction of travel.
+        let facing = match self.path[i].direction {
+            Direction::Forward => dir.y.atan2(dir.x),
+            Direction::Reverse => (-dir.y).atan2(-dir.x),
+        };
+        Some((xte, wrap_angle(pose.heading - facing)))
     }
 
     /// The AB plan, when this is an AB job.
@@ -506,11 +511,11 @@ impl Guidance {
     }
 
     /// Drive `segments` (an approach path from the vehicle to the start of the current line,
-    /// split at its cusps) before the line. Only at the start of a line (phase work, nothing
-    /// of it driven yet) and not while approaching; `false` when refused. An empty list is
-    /// accepted and changes nothing.
+    /// split at its cusps) before the line, which is then driven from its start. Only on a
+    /// work line before any line is done, and not while approaching; `false` when refused. An
+    /// empty list is accepted and changes nothing.
     pub fn set_approach(&mut self, segments: Vec<JobSegment>) -> bool {
-        if self.approach_index.is_some() || self.phase != Phase::Work || self.index_global > 0 {
+        if self.approach_index.is_some() || self.phase != Phase::Work || self.lines_done > 0 {
             return false;
         }
         if segments.is_empty() {

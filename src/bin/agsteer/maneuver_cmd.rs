@@ -200,8 +200,11 @@ pub fn run(cfg: &Config, a: &ManeuverArgs) -> Result<u8> {
     let out = result_out(&r, ms);
     if let Some(svg) = a.svg {
         let spacing = cfg.maneuver.sample_tolerance_m.max(0.05);
-        std::fs::write(svg, maneuver_svg(cfg, field.as_ref(), &res, &from, &to, spacing))
-            .with_context(|| format!("writing {}", svg.display()))?;
+        std::fs::write(
+            svg,
+            maneuver_svg(cfg, field.as_ref(), &res, &from, &to, spacing),
+        )
+        .with_context(|| format!("writing {}", svg.display()))?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
@@ -343,10 +346,7 @@ fn maneuver_svg(
             p.cusps(),
             p.reverse_length()
         ),
-        None => format!(
-            "no path: {}",
-            res.failure.as_deref().unwrap_or("not found")
-        ),
+        None => format!("no path: {}", res.failure.as_deref().unwrap_or("not found")),
     };
     let _ = writeln!(
         s,

@@ -541,7 +541,12 @@ mod tests {
             let edges_hit = |ring: &[Vec2]| {
                 (0..ring.len()).any(|i| {
                     (0..4).any(|j| {
-                        segments_intersect(&c[j], &c[(j + 1) % 4], &ring[i], &ring[(i + 1) % ring.len()])
+                        segments_intersect(
+                            &c[j],
+                            &c[(j + 1) % 4],
+                            &ring[i],
+                            &ring[(i + 1) % ring.len()],
+                        )
                     })
                 })
             };
@@ -564,7 +569,10 @@ mod tests {
             assert_eq!(coarse.pose_clear(&f, &p).is_ok(), brute.is_ok());
             hits += usize::from(r.is_err());
         }
-        assert!(hits > 200 && hits < 3800, "test poses mix clear and blocked: {hits}");
+        assert!(
+            hits > 200 && hits < 3800,
+            "test poses mix clear and blocked: {hits}"
+        );
     }
 
     #[test]

@@ -101,10 +101,26 @@ fn segment_distance(a0: Vec2, a1: Vec2, b0: Vec2, b1: Vec2) -> (f64, Vec2, Vec2)
         s0 + ab * t
     };
     let cands = [
-        (point_segment_distance(&a0, &b0, &b1), a0, closest(a0, b0, b1)),
-        (point_segment_distance(&a1, &b0, &b1), a1, closest(a1, b0, b1)),
-        (point_segment_distance(&b0, &a0, &a1), closest(b0, a0, a1), b0),
-        (point_segment_distance(&b1, &a0, &a1), closest(b1, a0, a1), b1),
+        (
+            point_segment_distance(&a0, &b0, &b1),
+            a0,
+            closest(a0, b0, b1),
+        ),
+        (
+            point_segment_distance(&a1, &b0, &b1),
+            a1,
+            closest(a1, b0, b1),
+        ),
+        (
+            point_segment_distance(&b0, &a0, &a1),
+            closest(b0, a0, a1),
+            b0,
+        ),
+        (
+            point_segment_distance(&b1, &a0, &a1),
+            closest(b1, a0, a1),
+            b1,
+        ),
     ];
     cands
         .into_iter()
@@ -308,12 +324,21 @@ mod tests {
         // Legs at the goal: the first is along the goal heading.
         let (a, b) = r.last_leg().unwrap();
         assert!((b - goal.pos).norm() < 1e-9);
-        assert!((a.x - b.x).abs() < 1e-6, "last leg along the goal heading: {a:?}");
+        assert!(
+            (a.x - b.x).abs() < 1e-6,
+            "last leg along the goal heading: {a:?}"
+        );
     }
 
     #[test]
     fn collinear_points_merge_but_reversals_stay() {
-        let pts = vec![v2(0.0, 0.0), v2(5.0, 0.0), v2(10.0, 0.0), v2(10.0, 5.0), v2(10.0, 2.0)];
+        let pts = vec![
+            v2(0.0, 0.0),
+            v2(5.0, 0.0),
+            v2(10.0, 0.0),
+            v2(10.0, 5.0),
+            v2(10.0, 2.0),
+        ];
         assert_eq!(
             merge_collinear(pts),
             vec![v2(0.0, 0.0), v2(10.0, 0.0), v2(10.0, 5.0), v2(10.0, 2.0)]
@@ -323,7 +348,12 @@ mod tests {
     #[test]
     fn no_route_when_walled_off() {
         let boundary = vec![v2(0.0, 0.0), v2(40.0, 0.0), v2(40.0, 30.0), v2(0.0, 30.0)];
-        let wall = vec![v2(19.0, -1.0), v2(21.0, -1.0), v2(21.0, 31.0), v2(19.0, 31.0)];
+        let wall = vec![
+            v2(19.0, -1.0),
+            v2(21.0, -1.0),
+            v2(21.0, 31.0),
+            v2(19.0, 31.0),
+        ];
         let map = CollisionMap::new(Some(boundary), vec![wall], 2.0).unwrap();
         let start = Pose::new(8.0, 5.0, 1.0);
         let goal = Pose::new(32.0, 5.0, -1.0);

@@ -15,5 +15,6 @@ pub mod reeds_shepp;
 
 pub mod collision;
 pub mod expansion;
+pub mod job;
 pub mod search;
 pub mod steering;

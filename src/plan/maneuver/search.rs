@@ -540,7 +540,12 @@ pub fn plan_maneuver<S: Steering>(
                  pl: &Planner<S>,
                  route: Vec<Vec2>,
                  stages: Vec<String>| {
-        tracing::debug!(?method, expansions = pl.expansions, ?stages, "manoeuvre found");
+        tracing::debug!(
+            ?method,
+            expansions = pl.expansions,
+            ?stages,
+            "manoeuvre found"
+        );
         ManeuverResult {
             path: Some(path),
             method: Some(method),
@@ -676,7 +681,10 @@ pub fn plan_maneuver<S: Steering>(
     let mut failure = if pl.budget_left() == 0 {
         format!("search budget of {} expansions used up", p.max_expansions)
     } else {
-        format!("no collision-free path found ({} expansions)", pl.expansions)
+        format!(
+            "no collision-free path found ({} expansions)",
+            pl.expansions
+        )
     };
     if route.is_none() {
         failure.push_str("; the straight-line expansion found no route either");
@@ -857,7 +865,9 @@ mod tests {
         let goal = Pose::new(3.0, -2.0, 0.4);
         let pat = parse_pattern("lrlr_pnpn").unwrap();
         for (mirror, sign) in [(false, 1.0), (true, -1.0)] {
-            let path = pl.goal_pattern(&pat, mirror, sign * FRAC_PI_2, &goal).unwrap();
+            let path = pl
+                .goal_pattern(&pat, mirror, sign * FRAC_PI_2, &goal)
+                .unwrap();
             let end = path.end_pose();
             assert!((end.pos - goal.pos).norm() < 1e-6, "{end:?}");
             assert!(wrap_angle(end.heading - goal.heading).abs() < 1e-9);

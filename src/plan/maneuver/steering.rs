@@ -3,9 +3,9 @@
 
 use super::cc_reeds_shepp::cc_reeds_shepp_shortest;
 use super::cc_turn::cc_turn;
-use super::path::{CurveKind, CurveSegment};
 pub use super::path::CurveParams;
 use super::path::CurvePath;
+use super::path::{CurveKind, CurveSegment};
 use super::reeds_shepp::{reeds_shepp_length, reeds_shepp_shortest};
 use crate::geo::{Direction, Pose};
 
