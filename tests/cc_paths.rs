@@ -30,6 +30,8 @@ fn pairs(n: usize, seed: u64) -> Vec<(Pose, Pose)> {
 struct Stats {
     none: usize,
     ratios: Vec<f64>,
+    /// (ratio, pair index, CC length, RS length) of the worst pair.
+    worst: (f64, usize, f64, f64),
 }
 
 fn check_all(params: CurveParams) -> Stats {
@@ -37,6 +39,7 @@ fn check_all(params: CurveParams) -> Stats {
     let mut stats = Stats {
         none: 0,
         ratios: Vec::new(),
+        worst: (0.0, 0, 0.0, 0.0),
     };
     for (i, (a, b)) in pairs(1000, 42).into_iter().enumerate() {
         let Some(path) = cc_reeds_shepp_shortest(&a, &b, &params) else {
@@ -100,7 +103,11 @@ fn check_all(params: CurveParams) -> Stats {
             );
         }
         let rs = reeds_shepp_length(&a, &b, 1.0 / params.kappa_max).expect("rs");
-        stats.ratios.push(path.length() / rs);
+        let ratio = path.length() / rs;
+        if ratio > stats.worst.0 {
+            stats.worst = (ratio, i, path.length(), rs);
+        }
+        stats.ratios.push(ratio);
     }
     stats
 }
@@ -115,6 +122,10 @@ fn report(name: &str, params: CurveParams, mut st: Stats) {
     println!(
         "{name}: κ_max {} /m, σ_max {} /m²: {n} paths, {} without; CC/RS length mean {mean:.4}, p95 {p95:.4}, min {min:.4}, max {max:.4}",
         params.kappa_max, params.sigma_max, st.none
+    );
+    println!(
+        "  worst: pair {} CC {:.3} m vs RS {:.3} m",
+        st.worst.1, st.worst.2, st.worst.3
     );
     assert_eq!(st.none, 0, "{name}: pairs without a path");
     // A CC path is an admissible path with curvature ≤ κ_max, so never shorter than RS.

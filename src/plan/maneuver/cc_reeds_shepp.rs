@@ -24,15 +24,23 @@
 //! * **TTT** with any directions (TTT, TcTT, TTcT, TcTcT, and TT/TcT in the limit): the middle
 //!   circle centre is an intersection of two circles around the start and goal centres;
 //!   4 × 4 × 4 circle types, two intersections each;
-//! * **TTST / TSTT** (TcTST, TSTcT with the middle turn of 90° deflection... see below) and the
-//!   four-turn families are **not** built: see [`cc_reeds_shepp_shortest`].
+//! * **TcTST, TSTcT, TcTSTcT** (Reeds-Shepp's C|CSC, CSC|C, C|CSC|C): intermediate turns of
+//!   fixed deflection ([`MID_DEFLECTIONS`], around Reeds & Shepp's optimal π/2); then the offset
+//!   between the start and goal centres is linear in the signed straight length, which comes
+//!   from a quadratic (`Solver::chain`);
+//! * **TTcTT, TcTTcT** (C C|C C, C|C C|C): the two intermediate circles placed mirror- or
+//!   point-symmetrically about the middle of the start and goal centres (as Banzhaf does).
+//!
+//! The chain and four-turn constructions fix one degree of freedom heuristically (as
+//! Reeds-Shepp's optimal families do for plain paths and Banzhaf does for CC paths), so the
+//! result is the shortest of these candidates, not a proven optimum.
 //!
 //! The shortest candidate is built into segments and its end is checked against the goal.
 
 use super::cc_turn::CcCircle;
 use super::path::{CurveParams, CurvePath, CurveSegment};
 use crate::geo::{v2, wrap_angle, Direction, Pose, Vec2};
-use std::f64::consts::TAU;
+use std::f64::consts::{PI, TAU};
 
 /// One piece of a candidate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,7 +54,38 @@ enum Piece {
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
     len: f64,
-    pieces: [Piece; 3],
+    n: usize,
+    pieces: [Piece; 6],
+}
+
+const NO_PIECE: Piece = Piece::Line { len: 0.0, s: 1.0 };
+
+impl Candidate {
+    fn new(len: f64, p: &[Piece]) -> Self {
+        let mut pieces = [NO_PIECE; 6];
+        pieces[..p.len()].copy_from_slice(p);
+        Candidate {
+            len,
+            n: p.len(),
+            pieces,
+        }
+    }
+
+    /// The same path driven backwards (from the goal to the start of the reversed problem).
+    fn reversed(&self) -> Self {
+        let mut pieces = [NO_PIECE; 6];
+        for (i, p) in self.pieces[..self.n].iter().rev().enumerate() {
+            pieces[i] = match *p {
+                Piece::Turn { delta, l, s } => Piece::Turn { delta, l, s: -s },
+                Piece::Line { len, s } => Piece::Line { len, s: -s },
+            };
+        }
+        Candidate {
+            len: self.len,
+            n: self.n,
+            pieces,
+        }
+    }
 }
 
 /// A CC circle placed in the plane.
@@ -56,6 +95,9 @@ struct Circ {
     l: f64,
     s: f64,
 }
+
+/// Fixed deflections (rad) tried for the intermediate turns of the chain families.
+const MID_DEFLECTIONS: [f64; 5] = [0.3 * PI, 0.4 * PI, 0.5 * PI, 0.6 * PI, 0.7 * PI];
 
 const TYPES: [(f64, f64); 4] = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
 
@@ -147,9 +189,9 @@ impl<'a> Solver<'a> {
                         let d1 = deflection(c1.l, c1.s, th0, th);
                         let d2 = deflection(c2.l, c2.s, th, thg);
                         let len = len.max(0.0);
-                        out.push(Candidate {
-                            len: self.g.turn_length(d1) + len + self.g.turn_length(d2),
-                            pieces: [
+                        out.push(Candidate::new(
+                            self.g.turn_length(d1) + len + self.g.turn_length(d2),
+                            &[
                                 Piece::Turn {
                                     delta: d1,
                                     l: c1.l,
@@ -162,7 +204,7 @@ impl<'a> Solver<'a> {
                                     s: c2.s,
                                 },
                             ],
-                        });
+                        ));
                     }
                 }
             }
@@ -198,11 +240,11 @@ impl<'a> Solver<'a> {
                         let d1 = deflection(c1.l, c1.s, th0, th1);
                         let d2 = deflection(l2, s2, th1, th2);
                         let d3 = deflection(c3.l, c3.s, th2, thg);
-                        out.push(Candidate {
-                            len: self.g.turn_length(d1)
+                        out.push(Candidate::new(
+                            self.g.turn_length(d1)
                                 + self.g.turn_length(d2)
                                 + self.g.turn_length(d3),
-                            pieces: [
+                            &[
                                 Piece::Turn {
                                     delta: d1,
                                     l: c1.l,
@@ -219,7 +261,7 @@ impl<'a> Solver<'a> {
                                     s: c3.s,
                                 },
                             ],
-                        });
+                        ));
                         if h == 0.0 {
                             break;
                         }
@@ -229,9 +271,227 @@ impl<'a> Solver<'a> {
         }
     }
 
+    /// A chain start circle → intermediate circles of fixed deflection → goal circle with
+    /// one straight piece (direction `sl`) at junction `line_at` (0 = right after the start
+    /// circle). With the intermediate deflections fixed, the offset Ω_goal − Ω_start in the
+    /// frame of the first junction heading is P + X·e (X the signed line length), so
+    /// |Ω_goal − Ω_start| gives X from a quadratic and the direction of Ω_goal − Ω_start the
+    /// first junction heading.
+    fn chain(
+        &self,
+        c1: &Circ,
+        cn: &Circ,
+        mids: &[(f64, f64, f64)],
+        line_at: usize,
+        sl: f64,
+        out: &mut Vec<Candidate>,
+    ) {
+        let k = mids.len();
+        let ty = |i: usize| -> (f64, f64) {
+            if i == 0 {
+                (c1.l, c1.s)
+            } else if i == k + 1 {
+                (cn.l, cn.s)
+            } else {
+                (mids[i - 1].0, mids[i - 1].1)
+            }
+        };
+        let mut phi = 0.0;
+        let mut p = v2(0.0, 0.0);
+        let mut e = v2(1.0, 0.0);
+        let mut mid_len = 0.0;
+        for j in 0..=k {
+            if j > 0 {
+                let (l, s, d) = mids[j - 1];
+                phi += l * s * d;
+                mid_len += self.g.turn_length(d);
+            }
+            let (l1, s1) = ty(j);
+            let (l2, s2) = ty(j + 1);
+            let v = self.junction(l1, s1, l2, s2);
+            p += rot(phi, v.x, v.y);
+            if j == line_at {
+                e = rot(phi, 1.0, 0.0);
+            }
+        }
+        let w = cn.c - c1.c;
+        let pe = p.dot(&e);
+        let disc = pe * pe - p.norm_squared() + w.norm_squared();
+        if disc < 0.0 {
+            return;
+        }
+        let root = disc.sqrt();
+        let wa = w.y.atan2(w.x);
+        for x in [-pe + root, -pe - root] {
+            let len = sl * x;
+            if len < -1e-12 {
+                continue;
+            }
+            let len = len.max(0.0);
+            let q = p + e * x;
+            let th0 = wa - q.y.atan2(q.x);
+            let d1 = deflection(c1.l, c1.s, self.start.heading, th0);
+            let dn = deflection(cn.l, cn.s, th0 + phi, self.goal.heading);
+            let mut pieces = [NO_PIECE; 6];
+            let mut n = 0;
+            pieces[n] = Piece::Turn {
+                delta: d1,
+                l: c1.l,
+                s: c1.s,
+            };
+            n += 1;
+            for j in 0..=k {
+                if j > 0 {
+                    let (l, s, d) = mids[j - 1];
+                    pieces[n] = Piece::Turn { delta: d, l, s };
+                    n += 1;
+                }
+                if j == line_at {
+                    pieces[n] = Piece::Line { len, s: sl };
+                    n += 1;
+                }
+            }
+            pieces[n] = Piece::Turn {
+                delta: dn,
+                l: cn.l,
+                s: cn.s,
+            };
+            n += 1;
+            out.push(Candidate {
+                len: self.g.turn_length(d1) + mid_len + len + self.g.turn_length(dn),
+                n,
+                pieces,
+            });
+        }
+    }
+
+    /// TcTST, TSTcT and TcTSTcT (Reeds-Shepp's C|CSC, CSC|C, C|CSC|C) with the intermediate
+    /// turns at fixed deflections (Reeds & Shepp's optimal value π/2 and a few around it).
+    fn chains(&self, out: &mut Vec<Candidate>) {
+        for c1 in &self.starts {
+            for &dm in &MID_DEFLECTIONS {
+                for cn in &self.goals {
+                    if cn.s == -c1.s {
+                        // TcTST: start, cusp, middle (−l1, −s1), straight −s1, goal (·, −s1).
+                        self.chain(c1, cn, &[(-c1.l, -c1.s, dm)], 1, -c1.s, out);
+                        // TSTcT: start, straight s1, middle (−ln, s1), cusp, goal (ln, −s1).
+                        self.chain(c1, cn, &[(-cn.l, c1.s, dm)], 0, c1.s, out);
+                    } else if cn.l == -c1.l {
+                        // TcTSTcT: start, cusp, (−l1, −s1), straight, (l1, −s1), cusp, goal.
+                        let mids = [(-c1.l, -c1.s, dm), (c1.l, -c1.s, dm)];
+                        self.chain(c1, cn, &mids, 1, -c1.s, out);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Four turns with the two intermediate circles placed symmetrically (mirror or point
+    /// symmetry about the middle of the start and goal centres): TTcTT (C C|C C) and TcTTcT
+    /// (C|C C|C).
+    fn four_turns(&self, out: &mut Vec<Candidate>) {
+        for c1 in &self.starts {
+            for cn in &self.goals {
+                if cn.l != -c1.l {
+                    continue;
+                }
+                let (l1, s1) = (c1.l, c1.s);
+                let (m1, m2) = if cn.s == -s1 {
+                    ((-l1, s1), (l1, -s1)) // TTcTT
+                } else {
+                    ((-l1, -s1), (l1, -s1)) // TcTTcT
+                };
+                self.sym4(c1, m1, m2, cn, out);
+            }
+        }
+    }
+
+    fn sym4(&self, c1: &Circ, m1: (f64, f64), m2: (f64, f64), cn: &Circ, out: &mut Vec<Candidate>) {
+        let v = [
+            self.junction(c1.l, c1.s, m1.0, m1.1),
+            self.junction(m1.0, m1.1, m2.0, m2.1),
+            self.junction(m2.0, m2.1, cn.l, cn.s),
+        ];
+        let (d12, d23) = (v[0].norm(), v[1].norm());
+        let w = cn.c - c1.c;
+        let dd = w.norm();
+        if dd < 1e-12 || (d12 - v[2].norm()).abs() > 1e-9 {
+            return;
+        }
+        let u = w / dd;
+        let nrm = v2(-u.y, u.x);
+        // (Δx, mirror?) options.
+        let opts = [
+            (0.5 * (dd - d23), true),
+            (0.5 * (dd + d23), true),
+            ((dd * dd + 4.0 * d12 * d12 - d23 * d23) / (4.0 * dd), false),
+        ];
+        for (dx, mirror) in opts {
+            let h2 = d12 * d12 - dx * dx;
+            if h2 < 0.0 {
+                continue;
+            }
+            let dy0 = h2.sqrt();
+            for dy in [dy0, -dy0] {
+                let o2 = c1.c + u * dx + nrm * dy;
+                let o3 = if mirror {
+                    cn.c - u * dx + nrm * dy
+                } else {
+                    cn.c - u * dx - nrm * dy
+                };
+                let cs = [c1.c, o2, o3, cn.c];
+                let mut th = [0.0; 3];
+                for j in 0..3 {
+                    let e = cs[j + 1] - cs[j];
+                    th[j] = e.y.atan2(e.x) - v[j].y.atan2(v[j].x);
+                }
+                let d1 = deflection(c1.l, c1.s, self.start.heading, th[0]);
+                let d2 = deflection(m1.0, m1.1, th[0], th[1]);
+                let d3 = deflection(m2.0, m2.1, th[1], th[2]);
+                let d4 = deflection(cn.l, cn.s, th[2], self.goal.heading);
+                let g = self.g;
+                out.push(Candidate::new(
+                    g.turn_length(d1) + g.turn_length(d2) + g.turn_length(d3) + g.turn_length(d4),
+                    &[
+                        Piece::Turn {
+                            delta: d1,
+                            l: c1.l,
+                            s: c1.s,
+                        },
+                        Piece::Turn {
+                            delta: d2,
+                            l: m1.0,
+                            s: m1.1,
+                        },
+                        Piece::Turn {
+                            delta: d3,
+                            l: m2.0,
+                            s: m2.1,
+                        },
+                        Piece::Turn {
+                            delta: d4,
+                            l: cn.l,
+                            s: cn.s,
+                        },
+                    ],
+                ));
+                if dy0 == 0.0 {
+                    break;
+                }
+            }
+        }
+    }
+
+    fn all(&self, out: &mut Vec<Candidate>) {
+        self.tst(out);
+        self.ttt(out);
+        self.chains(out);
+        self.four_turns(out);
+    }
+
     fn build(&self, cand: &Candidate) -> CurvePath {
         let mut segments = Vec::with_capacity(9);
-        for p in &cand.pieces {
+        for p in &cand.pieces[..cand.n] {
             match *p {
                 Piece::Turn { delta, l, s } => {
                     self.g.turn_segments(delta, l > 0.0, dir(s), &mut segments)
@@ -258,15 +518,11 @@ fn finite(p: &Pose) -> bool {
     p.pos.x.is_finite() && p.pos.y.is_finite() && p.heading.is_finite()
 }
 
-/// Shortest continuous-curvature Reeds-Shepp path among the families built here (TST and TTT
-/// with every choice of driving directions, i.e. TST, TcST, TScT, TcScT, TTT, TcTT, TTcT,
-/// TcTcT). Curvature is 0 at the start, the goal and every cusp. `None` only for invalid
-/// parameters or non-finite poses (the TST family with both turns on the same side always has
-/// a solution).
-///
-/// Missing compared with Fraichard & Scheuer / Banzhaf's CC00-RS: the families with an
-/// intermediate circle and a straight (TcTST, TSTcT, TcTSTcT) and the four-turn families
-/// (TTcTT, TcTTcT). Their absence only makes some paths longer, never invalid.
+/// Shortest continuous-curvature Reeds-Shepp path among the families of the module doc (TST,
+/// TcST, TScT, TcScT, TTT, TcTT, TTcT, TcTcT, TcTST, TSTcT, TcTSTcT, TTcTT, TcTTcT).
+/// Curvature is 0 at the start, the goal and every cusp. `None` only for invalid parameters
+/// or non-finite poses (the TST family with both turns on the same side always has a
+/// solution).
 pub fn cc_reeds_shepp_shortest(
     start: &Pose,
     goal: &Pose,
@@ -278,8 +534,7 @@ pub fn cc_reeds_shepp_shortest(
     let g = CcCircle::new(params);
     let solver = Solver::new(&g, start, goal);
     let mut cands = Vec::with_capacity(256);
-    solver.tst(&mut cands);
-    solver.ttt(&mut cands);
+    solver.all(&mut cands);
     cands.sort_by(|a, b| a.len.total_cmp(&b.len));
     // Build the shortest candidate whose end reaches the goal (a guard against numerically
     // degenerate junctions; in practice the first one).
@@ -305,7 +560,63 @@ pub fn cc_reeds_shepp_length(start: &Pose, goal: &Pose, params: &CurveParams) ->
     let g = CcCircle::new(params);
     let solver = Solver::new(&g, start, goal);
     let mut cands = Vec::with_capacity(256);
-    solver.tst(&mut cands);
-    solver.ttt(&mut cands);
+    solver.all(&mut cands);
     cands.iter().map(|c| c.len).min_by(f64::total_cmp)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    const P: CurveParams = CurveParams {
+        kappa_max: 0.2,
+        sigma_max: 0.1,
+    };
+
+    #[test]
+    fn straight_ahead_is_a_straight_line() {
+        let a = Pose::new(0.0, 0.0, 0.3);
+        let b = Pose::new(20.0 * 0.3f64.cos(), 20.0 * 0.3f64.sin(), 0.3);
+        let path = cc_reeds_shepp_shortest(&a, &b, &P).expect("path");
+        assert!((path.length() - 20.0).abs() < 1e-9, "{}", path.length());
+        assert_eq!(path.cusps(), 0);
+        assert!(path.max_curvature() < 1e-12);
+    }
+
+    #[test]
+    fn same_length_both_ways_and_never_shorter_than_rs() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for _ in 0..300 {
+            let mut p = || {
+                Pose::new(
+                    rng.gen_range(-15.0..15.0),
+                    rng.gen_range(-15.0..15.0),
+                    rng.gen_range(-PI..PI),
+                )
+            };
+            let (a, b) = (p(), p());
+            let ab = cc_reeds_shepp_length(&a, &b, &P).expect("length");
+            let ba = cc_reeds_shepp_length(&b, &a, &P).expect("length");
+            assert!((ab - ba).abs() < 1e-6 * ab.max(1.0), "{ab} vs {ba}");
+            let rs = super::super::reeds_shepp::reeds_shepp_length(&a, &b, 1.0 / P.kappa_max)
+                .expect("rs");
+            assert!(ab >= rs - 1e-9);
+        }
+    }
+
+    #[test]
+    fn rejects_bad_input() {
+        let a = Pose::new(0.0, 0.0, 0.0);
+        let bad = CurveParams {
+            kappa_max: 0.0,
+            sigma_max: 1.0,
+        };
+        assert!(cc_reeds_shepp_shortest(&a, &a, &bad).is_none());
+        let nan = Pose {
+            pos: v2(f64::NAN, 0.0),
+            heading: 0.0,
+        };
+        assert!(cc_reeds_shepp_length(&a, &nan, &P).is_none());
+    }
 }
