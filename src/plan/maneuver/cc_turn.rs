@@ -261,6 +261,20 @@ mod tests {
         assert!(segs[0].sharpness < p.sigma_max);
     }
 
+    /// The CC-RS search prunes with turn_length(0) as a lower bound for every turn.
+    #[test]
+    fn turn_length_non_decreasing() {
+        for sigma in [0.01, 0.1, 1.0, 10.0] {
+            let cc = CcCircle::new(&params(sigma));
+            let mut last = cc.turn_length(0.0);
+            for i in 1..=4000 {
+                let l = cc.turn_length(i as f64 * 0.0016);
+                assert!(l >= last - 1e-12, "σ {sigma}, δ {}", i as f64 * 0.0016);
+                last = l;
+            }
+        }
+    }
+
     #[test]
     fn reverse_sign_convention() {
         let p = params(0.1);
