@@ -154,6 +154,9 @@ struct Solver<'a> {
     goals: [Circ; 4],
     /// Direction angle of each junction offset, by type index (see [`tidx`]).
     jang: [[f64; 4]; 4],
+    /// Junction point as a complex factor of the centre offset: q = Ω_a + f·(Ω_b − Ω_a)
+    /// (independent of the junction heading), by type index; used for chord lower bounds.
+    jq: [[Vec2; 4]; 4],
     /// Length of the shortest CC turn (δ = 0: 2·R·sin μ), m; a lower bound for every turn
     /// (turn length is non-decreasing in δ), used to prune candidates early.
     tl0: f64,
@@ -179,10 +182,19 @@ impl<'a> Solver<'a> {
             })
         };
         let mut jang = [[0.0; 4]; 4];
+        let mut jq = [[v2(0.0, 0.0); 4]; 4];
         for (i, &(l1, s1)) in TYPES.iter().enumerate() {
             for (j, &(l2, s2)) in TYPES.iter().enumerate() {
                 let v = v2(r * (s1 + s2) * g.sin_mu, r * (l2 - l1) * g.cos_mu);
                 jang[i][j] = v.y.atan2(v.x);
+                // (q − Ω_a) = R·rot(θ)·(s_a sin μ, −l_a cos μ); divide by v as complex numbers.
+                let w = v2(r * s1 * g.sin_mu, -r * l1 * g.cos_mu);
+                let n2 = v.norm_squared();
+                jq[i][j] = if n2 > 0.0 {
+                    v2((w.x * v.x + w.y * v.y) / n2, (w.y * v.x - w.x * v.y) / n2)
+                } else {
+                    v2(0.0, 0.0)
+                };
             }
         }
         Solver {
@@ -192,8 +204,17 @@ impl<'a> Solver<'a> {
             starts: mk(start, true),
             goals: mk(goal, false),
             jang,
+            jq,
             tl0: g.turn_length(0.0),
         }
+    }
+
+    /// Junction point between circles `a` (type ia, centre ca) and `b`.
+    #[inline]
+    fn jpoint(&self, ia: usize, ca: Vec2, ib: usize, cb: Vec2) -> Vec2 {
+        let f = self.jq[ia][ib];
+        let d = cb - ca;
+        ca + v2(f.x * d.x - f.y * d.y, f.x * d.y + f.y * d.x)
     }
 
     /// Offset Ω2 − Ω1 of a junction between circle types (l1, s1) → (l2, s2), in the frame of
@@ -277,6 +298,18 @@ impl<'a> Solver<'a> {
                     let p = c1.c + u * a;
                     for sg in [1.0, -1.0] {
                         let o2 = p + v2(-u.y, u.x) * (sg * h);
+                        let (i1, i2, i3) = (tidx(c1.l, c1.s), tidx(l2, s2), tidx(c3.l, c3.s));
+                        let q1 = self.jpoint(i1, c1.c, i2, o2);
+                        let q2 = self.jpoint(i2, o2, i3, c3.c);
+                        let chord = (q1 - self.start.pos).norm()
+                            + (q2 - q1).norm()
+                            + (self.goal.pos - q2).norm();
+                        if chord >= out.best {
+                            if h == 0.0 {
+                                break;
+                            }
+                            continue;
+                        }
                         let e12 = o2 - c1.c;
                         let e23 = c3.c - o2;
                         let th1 = e12.y.atan2(e12.x) - self.jang[tidx(c1.l, c1.s)][tidx(l2, s2)];
@@ -499,6 +532,26 @@ impl<'a> Solver<'a> {
                     cn.c - u * dx - nrm * dy
                 };
                 let cs = [c1.c, o2, o3, cn.c];
+                let ids = [
+                    tidx(c1.l, c1.s),
+                    tidx(m1.0, m1.1),
+                    tidx(m2.0, m2.1),
+                    tidx(cn.l, cn.s),
+                ];
+                let mut chord = 0.0;
+                let mut last = self.start.pos;
+                for j in 0..3 {
+                    let q = self.jpoint(ids[j], cs[j], ids[j + 1], cs[j + 1]);
+                    chord += (q - last).norm();
+                    last = q;
+                }
+                chord += (self.goal.pos - last).norm();
+                if chord >= out.best {
+                    if dy0 == 0.0 {
+                        break;
+                    }
+                    continue;
+                }
                 let mut th = [0.0; 3];
                 for j in 0..3 {
                     let e = cs[j + 1] - cs[j];
