@@ -14,7 +14,7 @@
 //! * q *leaves* the circle (l, s) with centre  Ω = q + R·(−s·sin μ, l·cos μ),
 //!
 //! and a turn from an entering heading θa to a leaving heading θb has deflection
-//! δ = (l·s·(θb − θa)) mod 2π, length [`CcCircle::turn_length`]`(δ)`. A junction q between a
+//! δ = (l·s·(θb − θa)) mod 2π, length [`CcCircle::circle_turn_length`]`(δ)`. A junction q between a
 //! turn on circle 1 and one on circle 2 (a cusp when s1 ≠ s2) therefore fixes
 //! Ω2 − Ω1 = R·rot(θ_q)·((s1 + s2)·sin μ, (l2 − l1)·cos μ); a straight piece between them adds
 //! its signed length along θ_q. This gives closed forms for the families built here:
@@ -205,7 +205,7 @@ impl<'a> Solver<'a> {
             goals: mk(goal, false),
             jang,
             jq,
-            tl0: g.turn_length(0.0),
+            tl0: g.circle_turn_length(0.0),
         }
     }
 
@@ -252,7 +252,7 @@ impl<'a> Solver<'a> {
                         let d2 = deflection(c2.l, c2.s, th, thg);
                         let len = len.max(0.0);
                         out.offer(Candidate::new(
-                            self.g.turn_length(d1) + len + self.g.turn_length(d2),
+                            self.g.circle_turn_length(d1) + len + self.g.circle_turn_length(d2),
                             &[
                                 Piece::Turn {
                                     delta: d1,
@@ -315,18 +315,18 @@ impl<'a> Solver<'a> {
                         let th1 = e12.y.atan2(e12.x) - self.jang[tidx(c1.l, c1.s)][tidx(l2, s2)];
                         let th2 = e23.y.atan2(e23.x) - self.jang[tidx(l2, s2)][tidx(c3.l, c3.s)];
                         let d1 = deflection(c1.l, c1.s, th0, th1);
-                        let t1 = self.g.turn_length(d1);
+                        let t1 = self.g.circle_turn_length(d1);
                         if t1 + 2.0 * self.tl0 >= out.best {
                             continue;
                         }
                         let d2 = deflection(l2, s2, th1, th2);
-                        let t12 = t1 + self.g.turn_length(d2);
+                        let t12 = t1 + self.g.circle_turn_length(d2);
                         if t12 + self.tl0 >= out.best {
                             continue;
                         }
                         let d3 = deflection(c3.l, c3.s, th2, thg);
                         out.offer(Candidate::new(
-                            t12 + self.g.turn_length(d3),
+                            t12 + self.g.circle_turn_length(d3),
                             &[
                                 Piece::Turn {
                                     delta: d1,
@@ -446,7 +446,7 @@ impl<'a> Solver<'a> {
             };
             n += 1;
             out.offer(Candidate {
-                len: self.g.turn_length(d1) + mid_len + len + self.g.turn_length(dn),
+                len: self.g.circle_turn_length(d1) + mid_len + len + self.g.circle_turn_length(dn),
                 n,
                 pieces,
             });
@@ -457,7 +457,7 @@ impl<'a> Solver<'a> {
     /// turns at fixed deflections (Reeds & Shepp's optimal value π/2 and a few around it).
     fn chains(&self, out: &mut Cands) {
         for &dm in &MID_DEFLECTIONS {
-            let tm = self.g.turn_length(dm);
+            let tm = self.g.circle_turn_length(dm);
             for c1 in &self.starts {
                 for cn in &self.goals {
                     if cn.s == -c1.s {
@@ -563,7 +563,10 @@ impl<'a> Solver<'a> {
                 let d4 = deflection(cn.l, cn.s, th[2], self.goal.heading);
                 let g = self.g;
                 out.offer(Candidate::new(
-                    g.turn_length(d1) + g.turn_length(d2) + g.turn_length(d3) + g.turn_length(d4),
+                    g.circle_turn_length(d1)
+                        + g.circle_turn_length(d2)
+                        + g.circle_turn_length(d3)
+                        + g.circle_turn_length(d4),
                     &[
                         Piece::Turn {
                             delta: d1,
@@ -626,6 +629,11 @@ fn valid_params(p: &CurveParams) -> bool {
     p.kappa_max > 0.0 && p.sigma_max > 0.0 && p.kappa_max.is_finite() && p.sigma_max.is_finite()
 }
 
+/// Start and goal equal (1 µm, 1 µrad): the empty path.
+fn same_pose(a: &Pose, b: &Pose) -> bool {
+    (a.pos - b.pos).norm() < 1e-6 && wrap_angle(a.heading - b.heading).abs() < 1e-6
+}
+
 fn finite(p: &Pose) -> bool {
     p.pos.x.is_finite() && p.pos.y.is_finite() && p.heading.is_finite()
 }
@@ -642,6 +650,12 @@ pub fn cc_reeds_shepp_shortest(
 ) -> Option<CurvePath> {
     if !valid_params(params) || !finite(start) || !finite(goal) {
         return None;
+    }
+    if same_pose(start, goal) {
+        return Some(CurvePath {
+            start: *start,
+            segments: Vec::new(),
+        });
     }
     let g = CcCircle::new(params);
     let solver = Solver::new(&g, start, goal);
@@ -667,6 +681,9 @@ pub fn cc_reeds_shepp_shortest(
 pub fn cc_reeds_shepp_length(start: &Pose, goal: &Pose, params: &CurveParams) -> Option<f64> {
     if !valid_params(params) || !finite(start) || !finite(goal) {
         return None;
+    }
+    if same_pose(start, goal) {
+        return Some(0.0);
     }
     let g = CcCircle::new(params);
     let solver = Solver::new(&g, start, goal);
@@ -714,6 +731,18 @@ mod tests {
                 .expect("rs");
             assert!(ab >= rs - 1e-9);
         }
+    }
+
+    #[test]
+    fn same_pose_is_the_empty_path() {
+        let a = Pose::new(3.0, 4.0, 1.0);
+        let path = cc_reeds_shepp_shortest(&a, &a, &P).expect("path");
+        assert!(path.segments.is_empty());
+        assert_eq!(cc_reeds_shepp_length(&a, &a, &P), Some(0.0));
+        // Nearly the same pose still gets a real (valid) path.
+        let b = Pose::new(3.001, 4.0, 1.0);
+        let path = cc_reeds_shepp_shortest(&a, &b, &P).expect("path");
+        assert!((path.end_pose().pos - b.pos).norm() < 1e-6);
     }
 
     #[test]

@@ -88,6 +88,23 @@ impl CcCircle {
         }
     }
 
+    /// Like [`CcCircle::turn_length`], but infinite when the turn would not end on the CC
+    /// circle: an elementary path needing more than σ_max (possible only for long clothoids,
+    /// δ_min = κ_max²/σ_max of the order of π or more), or a non-finite deflection.
+    pub fn circle_turn_length(&self, delta: f64) -> f64 {
+        if !delta.is_finite() {
+            return f64::INFINITY;
+        }
+        if delta > 1e-12 && delta < self.delta_min {
+            let sigma = self.elementary_sharpness(delta);
+            if !(sigma <= self.sigma) {
+                return f64::INFINITY;
+            }
+            return 2.0 * (delta / sigma).sqrt();
+        }
+        self.turn_length(delta)
+    }
+
     /// Segments of a CC turn of absolute heading change `delta` ≥ 0, turning left when
     /// `left` (positive steering curvature), driven in `direction`. Appends to `out`.
     pub fn turn_segments(
