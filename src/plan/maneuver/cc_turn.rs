@@ -97,7 +97,7 @@ impl CcCircle {
         }
         if delta > 1e-12 && delta < self.delta_min {
             let sigma = self.elementary_sharpness(delta);
-            if !(sigma <= self.sigma) {
+            if sigma.is_nan() || sigma > self.sigma {
                 return f64::INFINITY;
             }
             return 2.0 * (delta / sigma).sqrt();
