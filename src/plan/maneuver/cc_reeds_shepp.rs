@@ -96,6 +96,21 @@ impl Cands {
     }
 }
 
+/// An intermediate turn of fixed deflection in a chain.
+#[derive(Debug, Clone, Copy)]
+struct Mid {
+    /// Steering sense ±1.
+    l: f64,
+    /// Direction ±1.
+    s: f64,
+    /// Deflection, rad, with its sine and cosine.
+    delta: f64,
+    sin: f64,
+    cos: f64,
+    /// Turn length, m.
+    len: f64,
+}
+
 /// A CC circle placed in the plane.
 #[derive(Debug, Clone, Copy)]
 struct Circ {
@@ -108,12 +123,6 @@ struct Circ {
 const MID_DEFLECTIONS: [f64; 1] = [0.5 * PI];
 
 const TYPES: [(f64, f64); 4] = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
-
-#[inline]
-fn rot(th: f64, x: f64, y: f64) -> Vec2 {
-    let (s, c) = th.sin_cos();
-    v2(c * x - s * y, s * x + c * y)
-}
 
 #[inline]
 fn deflection(l: f64, s: f64, from: f64, to: f64) -> f64 {
@@ -172,10 +181,12 @@ impl<'a> Solver<'a> {
     fn new(g: &'a CcCircle, start: &Pose, goal: &Pose) -> Self {
         let r = g.radius;
         let mk = |q: &Pose, entering: bool| {
+            let (sn, cs) = q.heading.sin_cos();
             TYPES.map(|(l, s)| {
                 let fx = if entering { s } else { -s };
+                let (x, y) = (r * fx * g.sin_mu, r * l * g.cos_mu);
                 Circ {
-                    c: q.pos + rot(q.heading, r * fx * g.sin_mu, r * l * g.cos_mu),
+                    c: q.pos + v2(cs * x - sn * y, sn * x + cs * y),
                     l,
                     s,
                 }
@@ -360,17 +371,9 @@ impl<'a> Solver<'a> {
     /// frame of the first junction heading is P + X·e (X the signed line length), so
     /// |Ω_goal − Ω_start| gives X from a quadratic and the direction of Ω_goal − Ω_start the
     /// first junction heading.
-    fn chain(
-        &self,
-        c1: &Circ,
-        cn: &Circ,
-        mids: &[(f64, f64, f64, f64)],
-        line_at: usize,
-        sl: f64,
-        out: &mut Cands,
-    ) {
+    fn chain(&self, c1: &Circ, cn: &Circ, mids: &[Mid], line_at: usize, sl: f64, out: &mut Cands) {
         let k = mids.len();
-        let mid_len: f64 = mids.iter().map(|m| m.3).sum();
+        let mid_len: f64 = mids.iter().map(|m| m.len).sum();
         if mid_len + 2.0 * self.tl0 >= out.best {
             return;
         }
@@ -380,7 +383,7 @@ impl<'a> Solver<'a> {
             } else if i == k + 1 {
                 (cn.l, cn.s)
             } else {
-                (mids[i - 1].0, mids[i - 1].1)
+                (mids[i - 1].l, mids[i - 1].s)
             }
         };
         let mut phi = 0.0;
@@ -389,9 +392,11 @@ impl<'a> Solver<'a> {
         let mut e = v2(1.0, 0.0);
         for j in 0..=k {
             if j > 0 {
-                let (l, s, d, _) = mids[j - 1];
-                phi += l * s * d;
-                (sn, cs) = phi.sin_cos();
+                let m = &mids[j - 1];
+                phi += m.l * m.s * m.delta;
+                // Rotate by l·s·δ using the precomputed sin δ, cos δ.
+                let (ms, mc) = (m.l * m.s * m.sin, m.cos);
+                (sn, cs) = (sn * mc + cs * ms, cs * mc - sn * ms);
             }
             let (l1, s1) = ty(j);
             let (l2, s2) = ty(j + 1);
@@ -430,8 +435,12 @@ impl<'a> Solver<'a> {
             n += 1;
             for j in 0..=k {
                 if j > 0 {
-                    let (l, s, d, _) = mids[j - 1];
-                    pieces[n] = Piece::Turn { delta: d, l, s };
+                    let m = &mids[j - 1];
+                    pieces[n] = Piece::Turn {
+                        delta: m.delta,
+                        l: m.l,
+                        s: m.s,
+                    };
                     n += 1;
                 }
                 if j == line_at {
@@ -457,17 +466,26 @@ impl<'a> Solver<'a> {
     /// turns at fixed deflections (Reeds & Shepp's optimal value π/2 and a few around it).
     fn chains(&self, out: &mut Cands) {
         for &dm in &MID_DEFLECTIONS {
-            let tm = self.g.circle_turn_length(dm);
+            let len = self.g.circle_turn_length(dm);
+            let (sin, cos) = dm.sin_cos();
+            let mid = |l: f64, s: f64| Mid {
+                l,
+                s,
+                delta: dm,
+                len,
+                sin,
+                cos,
+            };
             for c1 in &self.starts {
                 for cn in &self.goals {
                     if cn.s == -c1.s {
                         // TcTST: start, cusp, middle (−l1, −s1), straight −s1, goal (·, −s1).
-                        self.chain(c1, cn, &[(-c1.l, -c1.s, dm, tm)], 1, -c1.s, out);
+                        self.chain(c1, cn, &[mid(-c1.l, -c1.s)], 1, -c1.s, out);
                         // TSTcT: start, straight s1, middle (−ln, s1), cusp, goal (ln, −s1).
-                        self.chain(c1, cn, &[(-cn.l, c1.s, dm, tm)], 0, c1.s, out);
+                        self.chain(c1, cn, &[mid(-cn.l, c1.s)], 0, c1.s, out);
                     } else if cn.l == -c1.l {
                         // TcTSTcT: start, cusp, (−l1, −s1), straight, (l1, −s1), cusp, goal.
-                        let mids = [(-c1.l, -c1.s, dm, tm), (c1.l, -c1.s, dm, tm)];
+                        let mids = [mid(-c1.l, -c1.s), mid(c1.l, -c1.s)];
                         self.chain(c1, cn, &mids, 1, -c1.s, out);
                     }
                 }
