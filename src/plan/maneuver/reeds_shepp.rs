@@ -56,7 +56,7 @@ fn mod2pi(x: f64) -> f64 {
 
 #[inline]
 fn polar(x: f64, y: f64) -> (f64, f64) {
-    (x.hypot(y), y.atan2(x))
+    ((x * x + y * y).sqrt(), y.atan2(x))
 }
 
 fn tau_omega(u: f64, v: f64, xi: f64, eta: f64, phi: f64) -> (f64, f64) {
@@ -122,7 +122,7 @@ fn lp_rm_l(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)
 fn lp_rup_lum_rm(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)> {
     let xi = x + sp;
     let eta = y - 1.0 - cp;
-    let rho = 0.25 * (2.0 + xi.hypot(eta));
+    let rho = 0.25 * (2.0 + (xi * xi + eta * eta).sqrt());
     if rho <= 1.0 {
         let u = rho.acos();
         let (t, v) = tau_omega(u, -u, xi, eta, phi);
