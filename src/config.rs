@@ -49,6 +49,23 @@ pub enum JobKind {
     Ab,
     /// A field coverage plan (SPEC §3) made from the field at `job.field_path`.
     Field,
+    /// A manoeuvre with reversing (SPEC §4) from `job.maneuver_from` to `job.maneuver_to` on
+    /// the map at `job.maneuver_map_path`, planned at start-up with `[maneuver]`.
+    Maneuver,
+}
+
+/// In which order the lines of an AB job are driven.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LineOrder {
+    /// The seed-000 order: blocks of `N = 2·ceil(2·r_min/line_width) + a` lines driven in a
+    /// skip order so that every turn is a forward pi turn (SPEC §2).
+    #[default]
+    Blocks,
+    /// Adjacent lines in turn. Lines closer than `2·r_min` are joined by a fishtail turn with
+    /// a reversal (continuous-curvature when `vehicle.max_curvature_rate_per_m2` > 0). Needs a
+    /// finite `line_num`.
+    Sequential,
 }
 
 /// Side of A→B on which the following lines are laid.
@@ -85,6 +102,14 @@ pub struct JobConfig {
     /// configuration), not from the configuration file's directory. Read and planned once
     /// when agsteerd or `agsteer demo` starts.
     pub field_path: String,
+    /// For `kind = "maneuver"`: the map, GeoJSON in local metres (boundary polygon, holes and
+    /// `"obstacle": true` features are obstacles; see `agsteer maneuver`); empty = free space.
+    pub maneuver_map_path: String,
+    /// For `kind = "maneuver"`: start pose [x m, y m, heading degrees CCW from East], local
+    /// ENU about `job.origin_*`.
+    pub maneuver_from: [f64; 3],
+    /// For `kind = "maneuver"`: goal pose [x m, y m, heading degrees].
+    pub maneuver_to: [f64; 3],
     /// Point A of the first work line, local ENU [east, north], m.
     pub point_a_m: [f64; 2],
     /// Point B of the first work line, local ENU [east, north], m.
@@ -95,6 +120,10 @@ pub struct JobConfig {
     pub line_num: u64,
     /// Side of A→B on which further lines are laid: "left" or "right".
     pub side: LineSide,
+    /// For `kind = "ab"`: "blocks" (the seed-000 skip order, forward turns only) or
+    /// "sequential" (adjacent lines in turn, fishtail turns with a reversal where the lines
+    /// are closer than 2·r_min; needs `line_num` ≥ 1).
+    pub line_order: LineOrder,
     /// WGS-84 latitude of the local ENU origin, degrees.
     pub origin_lat_deg: f64,
     /// WGS-84 longitude of the local ENU origin, degrees.
@@ -106,11 +135,15 @@ impl Default for JobConfig {
         JobConfig {
             kind: JobKind::Ab,
             field_path: String::new(),
+            maneuver_map_path: String::new(),
+            maneuver_from: [0.0, 0.0, 0.0],
+            maneuver_to: [20.0, 0.0, 0.0],
             point_a_m: [0.0, 0.0],
             point_b_m: [0.0, 150.0],
             line_width_m: 3.0,
             line_num: 12,
             side: LineSide::Right,
+            line_order: LineOrder::Blocks,
             origin_lat_deg: 52.0,
             origin_lon_deg: 5.0,
         }
@@ -140,6 +173,13 @@ pub struct GuidanceConfig {
     pub stopped_speed_mps: f64,
     /// A vehicle stopped within this distance of a cusp moves on to the next segment, m.
     pub cusp_capture_m: f64,
+    /// Approach paths: when the operator engages at the start of a line too far from it to
+    /// engage (|XTE| ≥ `safety.max_engage_xte_m` or heading error ≥
+    /// `safety.max_engage_heading_error_deg`), plan a continuous-curvature path (reversing
+    /// where shorter, κ_max = 1/`vehicle.r_min_m`, σ_max = `vehicle.max_curvature_rate_per_m2`)
+    /// from the vehicle to the line start, inside the field when the job has one, and drive
+    /// it first. false = refuse to engage there, as without approach paths.
+    pub approach_paths: bool,
 }
 
 impl Default for GuidanceConfig {
@@ -154,6 +194,7 @@ impl Default for GuidanceConfig {
             cusp_decel_mps2: 0.5,
             stopped_speed_mps: 0.05,
             cusp_capture_m: 1.0,
+            approach_paths: true,
         }
     }
 }
@@ -168,6 +209,11 @@ pub struct VehicleConfig {
     pub r_min_m: f64,
     /// Largest front-wheel angle either way, degrees.
     pub max_wheel_angle_deg: f64,
+    /// Largest rate of change of the steering curvature per metre driven, 1/m² (σ_max of
+    /// the continuous-curvature turns and manoeuvres, SPEC §4). It comes from the steering
+    /// speed: about max wheel rate (rad/s) / (wheelbase (m) · speed in turns (m/s)); 30°/s,
+    /// 2.5 m and 6 km/h give 0.13. 0 = turns of arcs only (curvature steps at their ends).
+    pub max_curvature_rate_per_m2: f64,
     /// GNSS antenna position ahead of the rear-axle centre, m.
     pub antenna_forward_m: f64,
     /// GNSS antenna position left of the rear-axle centre, m.
@@ -188,6 +234,7 @@ impl Default for VehicleConfig {
             wheelbase_m: 3.0,
             r_min_m: 5.0,
             max_wheel_angle_deg: 35.0,
+            max_curvature_rate_per_m2: 0.06,
             antenna_forward_m: 1.0,
             antenna_left_m: 0.0,
             antenna_up_m: 3.0,
@@ -766,6 +813,7 @@ impl Config {
             },
             route: f.route,
             small_obstacle_max_m: f.small_obstacle_max_m,
+            max_curvature_rate: self.vehicle.max_curvature_rate_per_m2,
         }
     }
 
@@ -931,6 +979,25 @@ impl Config {
             );
         }
         c.range("job.line_width_m", j.line_width_m, 0.1, 100.0);
+        if j.kind == JobKind::Ab && j.line_order == LineOrder::Sequential && j.line_num == 0 {
+            c.push(
+                "job.line_num",
+                "0".to_string(),
+                "must be at least 1 when job.line_order = \"sequential\" (the whole job is planned at start)",
+            );
+        }
+        for (key, pose) in [
+            ("job.maneuver_from", j.maneuver_from),
+            ("job.maneuver_to", j.maneuver_to),
+        ] {
+            if pose.iter().any(|v| !v.is_finite()) {
+                c.push(
+                    key,
+                    format!("{pose:?}"),
+                    "must be [x m, y m, heading degrees], all finite",
+                );
+            }
+        }
         if j.kind == JobKind::Field && j.field_path.trim().is_empty() {
             c.push(
                 "job.field_path",
@@ -994,6 +1061,12 @@ impl Config {
         let v = &self.vehicle;
         c.range("vehicle.wheelbase_m", v.wheelbase_m, 0.5, 20.0);
         c.range("vehicle.r_min_m", v.r_min_m, 0.5, 100.0);
+        c.range(
+            "vehicle.max_curvature_rate_per_m2",
+            v.max_curvature_rate_per_m2,
+            0.0,
+            10.0,
+        );
         c.range(
             "vehicle.max_wheel_angle_deg",
             v.max_wheel_angle_deg,

@@ -30,15 +30,22 @@ fn pairs(n: usize, seed: u64) -> Vec<(Pose, Pose)> {
 struct Stats {
     none: usize,
     ratios: Vec<f64>,
+    /// (ratio, pair index, CC length, RS length) of the worst pair.
+    worst: (f64, usize, f64, f64),
 }
 
 fn check_all(params: CurveParams) -> Stats {
+    check_n(params, 1000)
+}
+
+fn check_n(params: CurveParams, n: usize) -> Stats {
     let mut samples: Vec<PathSample> = Vec::new();
     let mut stats = Stats {
         none: 0,
         ratios: Vec::new(),
+        worst: (0.0, 0, 0.0, 0.0),
     };
-    for (i, (a, b)) in pairs(1000, 42).into_iter().enumerate() {
+    for (i, (a, b)) in pairs(n, 42).into_iter().enumerate() {
         let Some(path) = cc_reeds_shepp_shortest(&a, &b, &params) else {
             stats.none += 1;
             continue;
@@ -100,7 +107,11 @@ fn check_all(params: CurveParams) -> Stats {
             );
         }
         let rs = reeds_shepp_length(&a, &b, 1.0 / params.kappa_max).expect("rs");
-        stats.ratios.push(path.length() / rs);
+        let ratio = path.length() / rs;
+        if ratio > stats.worst.0 {
+            stats.worst = (ratio, i, path.length(), rs);
+        }
+        stats.ratios.push(ratio);
     }
     stats
 }
@@ -115,6 +126,10 @@ fn report(name: &str, params: CurveParams, mut st: Stats) {
     println!(
         "{name}: κ_max {} /m, σ_max {} /m²: {n} paths, {} without; CC/RS length mean {mean:.4}, p95 {p95:.4}, min {min:.4}, max {max:.4}",
         params.kappa_max, params.sigma_max, st.none
+    );
+    println!(
+        "  worst: pair {} CC {:.3} m vs RS {:.3} m",
+        st.worst.1, st.worst.2, st.worst.3
     );
     assert_eq!(st.none, 0, "{name}: pairs without a path");
     // A CC path is an admissible path with curvature ≤ κ_max, so never shorter than RS.
@@ -141,4 +156,54 @@ fn cc_paths_valid_sigma_1() {
         sigma_max: 1.0,
     };
     report("σ 1", p, check_all(p));
+}
+
+/// With a very large σ_max the clothoids vanish and CC paths must approach plain RS paths
+/// (same families with μ → 0): checks the circle geometry against the independent RS code.
+#[test]
+fn cc_tends_to_rs_for_large_sigma() {
+    let p = CurveParams {
+        kappa_max: 0.2,
+        sigma_max: 1e4,
+    };
+    let mut worst: f64 = 0.0;
+    let mut sum = 0.0;
+    let all = pairs(500, 9);
+    for (a, b) in &all {
+        let cc = cc_reeds_shepp_length(a, b, &p).expect("cc");
+        let rs = reeds_shepp_length(a, b, 1.0 / p.kappa_max).expect("rs");
+        worst = worst.max(cc / rs);
+        sum += cc / rs;
+    }
+    let mean = sum / all.len() as f64;
+    println!("σ 1e4: CC/RS mean {mean:.6}, max {worst:.6}");
+    assert!(mean < 1.0001 && worst < 1.001, "mean {mean}, worst {worst}");
+}
+
+/// Other vehicle limits, including δ_min = κ²/σ close to π (long clothoids): still valid.
+#[test]
+fn cc_paths_valid_other_limits() {
+    for (k, s) in [
+        (0.1, 0.02),
+        (0.25, 0.05),
+        (0.5, 0.1),
+        (0.3, 0.03),
+        (0.15, 5.0),
+        (0.5, 0.05),
+        (0.5, 0.04),
+        (0.5, 0.03),
+    ] {
+        let p = CurveParams {
+            kappa_max: k,
+            sigma_max: s,
+        };
+        let st = check_n(p, 200);
+        println!(
+            "κ {k}, σ {s} (δ_min {:.2} rad): {} without a path",
+            k * k / s,
+            st.none
+        );
+        assert_eq!(st.none, 0);
+        assert!(st.ratios.iter().all(|r| *r >= 1.0 - 1e-9));
+    }
 }

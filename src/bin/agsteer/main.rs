@@ -316,9 +316,32 @@ fn run_demo(
             prepare_field_job(&cfg)
                 .with_context(|| format!("job.kind = \"field\" in {}", config.display()))?,
         ),
-        JobKind::Ab => None,
+        JobKind::Ab | JobKind::Maneuver => None,
     };
-    let job = field.as_ref().map(|(fj, _)| fj.job_plan());
+    let maneuver = match cfg.job.kind {
+        JobKind::Maneuver => {
+            let (r, ms) = plan_cmd::timed("planning the manoeuvre", || {
+                agsteer::daemon::maneuver_file::load(&cfg)
+            });
+            let (mj, map) =
+                r.with_context(|| format!("job.kind = \"maneuver\" in {}", config.display()))?;
+            tracing::info!(
+                "manoeuvre: {:.1} m, {} cusps, {:.1} m in reverse, {} segments, planned in {:.0} ms",
+                mj.path.length(),
+                mj.path.cusps(),
+                mj.path.reverse_length(),
+                mj.job.len(),
+                ms.as_secs_f64() * 1e3
+            );
+            Some((mj, map))
+        }
+        _ => None,
+    };
+    let job = field.as_ref().map(|(fj, _)| fj.job_plan()).or_else(|| {
+        maneuver
+            .as_ref()
+            .map(|(mj, _)| agsteer::guidance::JobPlan::Segments(mj.job.clone()))
+    });
     let expected = match &job {
         Some(plan) => JobDefinition::for_job(&cfg, plan),
         None => JobDefinition::from_config(&cfg),
@@ -363,11 +386,15 @@ fn run_demo(
         stop_after_lines: stop_after,
         record_trace: true,
         job,
-        outlines: field
-            .as_ref()
-            .map(|(fj, _)| fj.outlines())
-            .unwrap_or_default(),
+        outlines: match (&field, &maneuver) {
+            (Some((fj, _)), _) => fj.outlines(),
+            (None, Some((_, Some(map)))) => std::iter::once(map.boundary.clone())
+                .chain(map.obstacles.iter().cloned())
+                .collect(),
+            _ => Vec::new(),
+        },
         origin: field.as_ref().map(|(fj, _)| fj.origin()),
+        field: field.as_ref().map(|(fj, _)| fj.loaded.field.clone()),
         ..Default::default()
     };
     let mut save_error = None;
@@ -450,7 +477,18 @@ fn run_demo(
                     )
                 })
         };
-        if let (Some(rms), Some(max)) = (worst(|s| s.xte_rms_m), worst(|s| s.xte_max_m)) {
+        if maneuver.is_some() {
+            for s in &r.segments {
+                println!(
+                    "segment {} ({:?}, {:.1} m): XTE RMS {:.1} cm, max {:.1} cm",
+                    s.index,
+                    s.direction,
+                    s.length_m,
+                    s.xte_rms_m * 100.0,
+                    s.xte_max_m * 100.0
+                );
+            }
+        } else if let (Some(rms), Some(max)) = (worst(|s| s.xte_rms_m), worst(|s| s.xte_max_m)) {
             println!("worst RMS on {rms}; worst max on {max}");
         }
         if let (Some(pos), Some(hdg)) = (r.goal_position_error_m, r.goal_heading_error_deg) {

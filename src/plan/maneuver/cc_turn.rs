@@ -88,6 +88,23 @@ impl CcCircle {
         }
     }
 
+    /// Like [`CcCircle::turn_length`], but infinite when the turn would not end on the CC
+    /// circle: an elementary path needing more than σ_max (possible only for long clothoids,
+    /// δ_min = κ_max²/σ_max of the order of π or more), or a non-finite deflection.
+    pub fn circle_turn_length(&self, delta: f64) -> f64 {
+        if !delta.is_finite() {
+            return f64::INFINITY;
+        }
+        if delta > 1e-12 && delta < self.delta_min {
+            let sigma = self.elementary_sharpness(delta);
+            if sigma.is_nan() || sigma > self.sigma {
+                return f64::INFINITY;
+            }
+            return 2.0 * (delta / sigma).sqrt();
+        }
+        self.turn_length(delta)
+    }
+
     /// Segments of a CC turn of absolute heading change `delta` ≥ 0, turning left when
     /// `left` (positive steering curvature), driven in `direction`. Appends to `out`.
     pub fn turn_segments(
@@ -259,6 +276,20 @@ mod tests {
         let segs = cc_turn(0.5 * dmin, Direction::Forward, &p);
         assert_eq!(segs.len(), 2);
         assert!(segs[0].sharpness < p.sigma_max);
+    }
+
+    /// The CC-RS search prunes with turn_length(0) as a lower bound for every turn.
+    #[test]
+    fn turn_length_non_decreasing() {
+        for sigma in [0.01, 0.1, 1.0, 10.0] {
+            let cc = CcCircle::new(&params(sigma));
+            let mut last = cc.turn_length(0.0);
+            for i in 1..=4000 {
+                let l = cc.turn_length(i as f64 * 0.0016);
+                assert!(l >= last - 1e-12, "σ {sigma}, δ {}", i as f64 * 0.0016);
+                last = l;
+            }
+        }
     }
 
     #[test]

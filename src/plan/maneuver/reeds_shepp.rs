@@ -38,19 +38,25 @@ impl RsWord {
     }
 }
 
+/// Wraps to (−π, π] (inputs here are within a few turns, so subtraction loops are cheap).
 #[inline]
 fn mod2pi(x: f64) -> f64 {
-    let v = x.rem_euclid(TAU);
-    if v > PI {
-        v - TAU
-    } else {
-        v
+    if !x.is_finite() {
+        return x;
     }
+    let mut v = x;
+    while v > PI {
+        v -= TAU;
+    }
+    while v <= -PI {
+        v += TAU;
+    }
+    v
 }
 
 #[inline]
 fn polar(x: f64, y: f64) -> (f64, f64) {
-    (x.hypot(y), y.atan2(x))
+    ((x * x + y * y).sqrt(), y.atan2(x))
 }
 
 fn tau_omega(u: f64, v: f64, xi: f64, eta: f64, phi: f64) -> (f64, f64) {
@@ -69,8 +75,8 @@ fn tau_omega(u: f64, v: f64, xi: f64, eta: f64, phi: f64) -> (f64, f64) {
 }
 
 // 8.1
-fn lp_sp_lp(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
-    let (u, t) = polar(x - phi.sin(), y - 1.0 + phi.cos());
+fn lp_sp_lp(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)> {
+    let (u, t) = polar(x - sp, y - 1.0 + cp);
     if t >= -ZERO {
         let v = mod2pi(phi - t);
         if v >= -ZERO {
@@ -81,8 +87,8 @@ fn lp_sp_lp(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
 }
 
 // 8.2
-fn lp_sp_rp(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
-    let (u1, t1) = polar(x + phi.sin(), y - 1.0 - phi.cos());
+fn lp_sp_rp(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)> {
+    let (u1, t1) = polar(x + sp, y - 1.0 - cp);
     let u1 = u1 * u1;
     if u1 >= 4.0 {
         let u = (u1 - 4.0).sqrt();
@@ -97,9 +103,9 @@ fn lp_sp_rp(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
 }
 
 // 8.3 / 8.4
-fn lp_rm_l(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
-    let xi = x - phi.sin();
-    let eta = y - 1.0 + phi.cos();
+fn lp_rm_l(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)> {
+    let xi = x - sp;
+    let eta = y - 1.0 + cp;
     let (u1, theta) = polar(xi, eta);
     if u1 <= 4.0 {
         let u = -2.0 * (0.25 * u1).asin();
@@ -113,10 +119,10 @@ fn lp_rm_l(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
 }
 
 // 8.7
-fn lp_rup_lum_rm(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
-    let xi = x + phi.sin();
-    let eta = y - 1.0 - phi.cos();
-    let rho = 0.25 * (2.0 + xi.hypot(eta));
+fn lp_rup_lum_rm(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)> {
+    let xi = x + sp;
+    let eta = y - 1.0 - cp;
+    let rho = 0.25 * (2.0 + (xi * xi + eta * eta).sqrt());
     if rho <= 1.0 {
         let u = rho.acos();
         let (t, v) = tau_omega(u, -u, xi, eta, phi);
@@ -128,9 +134,9 @@ fn lp_rup_lum_rm(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
 }
 
 // 8.8
-fn lp_rum_lum_rp(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
-    let xi = x + phi.sin();
-    let eta = y - 1.0 - phi.cos();
+fn lp_rum_lum_rp(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)> {
+    let xi = x + sp;
+    let eta = y - 1.0 - cp;
     let rho = (20.0 - xi * xi - eta * eta) / 16.0;
     if (0.0..=1.0).contains(&rho) {
         let u = -rho.acos();
@@ -145,9 +151,9 @@ fn lp_rum_lum_rp(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
 }
 
 // 8.9
-fn lp_rm_sm_lm(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
-    let xi = x - phi.sin();
-    let eta = y - 1.0 + phi.cos();
+fn lp_rm_sm_lm(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)> {
+    let xi = x - sp;
+    let eta = y - 1.0 + cp;
     let (rho, theta) = polar(xi, eta);
     if rho >= 2.0 {
         let r = (rho * rho - 4.0).sqrt();
@@ -162,9 +168,9 @@ fn lp_rm_sm_lm(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
 }
 
 // 8.10
-fn lp_rm_sm_rm(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
-    let xi = x + phi.sin();
-    let eta = y - 1.0 - phi.cos();
+fn lp_rm_sm_rm(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)> {
+    let xi = x + sp;
+    let eta = y - 1.0 - cp;
     let (rho, theta) = polar(-eta, xi);
     if rho >= 2.0 {
         let t = theta;
@@ -178,9 +184,9 @@ fn lp_rm_sm_rm(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
 }
 
 // 8.11
-fn lp_rm_s_lm_rp(x: f64, y: f64, phi: f64) -> Option<(f64, f64, f64)> {
-    let xi = x + phi.sin();
-    let eta = y - 1.0 - phi.cos();
+fn lp_rm_s_lm_rp(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64, f64)> {
+    let xi = x + sp;
+    let eta = y - 1.0 - cp;
     let (rho, _) = polar(xi, eta);
     if rho >= 2.0 {
         let u = 4.0 - (rho * rho - 4.0).sqrt();
@@ -218,157 +224,157 @@ impl Best {
     }
 }
 
-fn csc(x: f64, y: f64, phi: f64, b: &mut Best) {
-    if let Some((t, u, v)) = lp_sp_lp(x, y, phi) {
+fn csc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
+    if let Some((t, u, v)) = lp_sp_lp(x, y, phi, sp, cp) {
         b.offer(&[L, S, L], &[t, u, v]);
     }
-    if let Some((t, u, v)) = lp_sp_lp(-x, y, -phi) {
+    if let Some((t, u, v)) = lp_sp_lp(-x, y, -phi, -sp, cp) {
         b.offer(&[L, S, L], &[-t, -u, -v]);
     }
-    if let Some((t, u, v)) = lp_sp_lp(x, -y, -phi) {
+    if let Some((t, u, v)) = lp_sp_lp(x, -y, -phi, -sp, cp) {
         b.offer(&[R, S, R], &[t, u, v]);
     }
-    if let Some((t, u, v)) = lp_sp_lp(-x, -y, phi) {
+    if let Some((t, u, v)) = lp_sp_lp(-x, -y, phi, sp, cp) {
         b.offer(&[R, S, R], &[-t, -u, -v]);
     }
-    if let Some((t, u, v)) = lp_sp_rp(x, y, phi) {
+    if let Some((t, u, v)) = lp_sp_rp(x, y, phi, sp, cp) {
         b.offer(&[L, S, R], &[t, u, v]);
     }
-    if let Some((t, u, v)) = lp_sp_rp(-x, y, -phi) {
+    if let Some((t, u, v)) = lp_sp_rp(-x, y, -phi, -sp, cp) {
         b.offer(&[L, S, R], &[-t, -u, -v]);
     }
-    if let Some((t, u, v)) = lp_sp_rp(x, -y, -phi) {
+    if let Some((t, u, v)) = lp_sp_rp(x, -y, -phi, -sp, cp) {
         b.offer(&[R, S, L], &[t, u, v]);
     }
-    if let Some((t, u, v)) = lp_sp_rp(-x, -y, phi) {
+    if let Some((t, u, v)) = lp_sp_rp(-x, -y, phi, sp, cp) {
         b.offer(&[R, S, L], &[-t, -u, -v]);
     }
 }
 
-fn ccc(x: f64, y: f64, phi: f64, b: &mut Best) {
-    if let Some((t, u, v)) = lp_rm_l(x, y, phi) {
+fn ccc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
+    if let Some((t, u, v)) = lp_rm_l(x, y, phi, sp, cp) {
         b.offer(&[L, R, L], &[t, u, v]);
     }
-    if let Some((t, u, v)) = lp_rm_l(-x, y, -phi) {
+    if let Some((t, u, v)) = lp_rm_l(-x, y, -phi, -sp, cp) {
         b.offer(&[L, R, L], &[-t, -u, -v]);
     }
-    if let Some((t, u, v)) = lp_rm_l(x, -y, -phi) {
+    if let Some((t, u, v)) = lp_rm_l(x, -y, -phi, -sp, cp) {
         b.offer(&[R, L, R], &[t, u, v]);
     }
-    if let Some((t, u, v)) = lp_rm_l(-x, -y, phi) {
+    if let Some((t, u, v)) = lp_rm_l(-x, -y, phi, sp, cp) {
         b.offer(&[R, L, R], &[-t, -u, -v]);
     }
     // Backwards.
-    let xb = x * phi.cos() + y * phi.sin();
-    let yb = x * phi.sin() - y * phi.cos();
-    if let Some((t, u, v)) = lp_rm_l(xb, yb, phi) {
+    let xb = x * cp + y * sp;
+    let yb = x * sp - y * cp;
+    if let Some((t, u, v)) = lp_rm_l(xb, yb, phi, sp, cp) {
         b.offer(&[L, R, L], &[v, u, t]);
     }
-    if let Some((t, u, v)) = lp_rm_l(-xb, yb, -phi) {
+    if let Some((t, u, v)) = lp_rm_l(-xb, yb, -phi, -sp, cp) {
         b.offer(&[L, R, L], &[-v, -u, -t]);
     }
-    if let Some((t, u, v)) = lp_rm_l(xb, -yb, -phi) {
+    if let Some((t, u, v)) = lp_rm_l(xb, -yb, -phi, -sp, cp) {
         b.offer(&[R, L, R], &[v, u, t]);
     }
-    if let Some((t, u, v)) = lp_rm_l(-xb, -yb, phi) {
+    if let Some((t, u, v)) = lp_rm_l(-xb, -yb, phi, sp, cp) {
         b.offer(&[R, L, R], &[-v, -u, -t]);
     }
 }
 
-fn cccc(x: f64, y: f64, phi: f64, b: &mut Best) {
-    if let Some((t, u, v)) = lp_rup_lum_rm(x, y, phi) {
+fn cccc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
+    if let Some((t, u, v)) = lp_rup_lum_rm(x, y, phi, sp, cp) {
         b.offer(&[L, R, L, R], &[t, u, -u, v]);
     }
-    if let Some((t, u, v)) = lp_rup_lum_rm(-x, y, -phi) {
+    if let Some((t, u, v)) = lp_rup_lum_rm(-x, y, -phi, -sp, cp) {
         b.offer(&[L, R, L, R], &[-t, -u, u, -v]);
     }
-    if let Some((t, u, v)) = lp_rup_lum_rm(x, -y, -phi) {
+    if let Some((t, u, v)) = lp_rup_lum_rm(x, -y, -phi, -sp, cp) {
         b.offer(&[R, L, R, L], &[t, u, -u, v]);
     }
-    if let Some((t, u, v)) = lp_rup_lum_rm(-x, -y, phi) {
+    if let Some((t, u, v)) = lp_rup_lum_rm(-x, -y, phi, sp, cp) {
         b.offer(&[R, L, R, L], &[-t, -u, u, -v]);
     }
-    if let Some((t, u, v)) = lp_rum_lum_rp(x, y, phi) {
+    if let Some((t, u, v)) = lp_rum_lum_rp(x, y, phi, sp, cp) {
         b.offer(&[L, R, L, R], &[t, u, u, v]);
     }
-    if let Some((t, u, v)) = lp_rum_lum_rp(-x, y, -phi) {
+    if let Some((t, u, v)) = lp_rum_lum_rp(-x, y, -phi, -sp, cp) {
         b.offer(&[L, R, L, R], &[-t, -u, -u, -v]);
     }
-    if let Some((t, u, v)) = lp_rum_lum_rp(x, -y, -phi) {
+    if let Some((t, u, v)) = lp_rum_lum_rp(x, -y, -phi, -sp, cp) {
         b.offer(&[R, L, R, L], &[t, u, u, v]);
     }
-    if let Some((t, u, v)) = lp_rum_lum_rp(-x, -y, phi) {
+    if let Some((t, u, v)) = lp_rum_lum_rp(-x, -y, phi, sp, cp) {
         b.offer(&[R, L, R, L], &[-t, -u, -u, -v]);
     }
 }
 
-fn ccsc(x: f64, y: f64, phi: f64, b: &mut Best) {
+fn ccsc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
     let h = FRAC_PI_2;
-    if let Some((t, u, v)) = lp_rm_sm_lm(x, y, phi) {
+    if let Some((t, u, v)) = lp_rm_sm_lm(x, y, phi, sp, cp) {
         b.offer(&[L, R, S, L], &[t, -h, u, v]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_lm(-x, y, -phi) {
+    if let Some((t, u, v)) = lp_rm_sm_lm(-x, y, -phi, -sp, cp) {
         b.offer(&[L, R, S, L], &[-t, h, -u, -v]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_lm(x, -y, -phi) {
+    if let Some((t, u, v)) = lp_rm_sm_lm(x, -y, -phi, -sp, cp) {
         b.offer(&[R, L, S, R], &[t, -h, u, v]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_lm(-x, -y, phi) {
+    if let Some((t, u, v)) = lp_rm_sm_lm(-x, -y, phi, sp, cp) {
         b.offer(&[R, L, S, R], &[-t, h, -u, -v]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_rm(x, y, phi) {
+    if let Some((t, u, v)) = lp_rm_sm_rm(x, y, phi, sp, cp) {
         b.offer(&[L, R, S, R], &[t, -h, u, v]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_rm(-x, y, -phi) {
+    if let Some((t, u, v)) = lp_rm_sm_rm(-x, y, -phi, -sp, cp) {
         b.offer(&[L, R, S, R], &[-t, h, -u, -v]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_rm(x, -y, -phi) {
+    if let Some((t, u, v)) = lp_rm_sm_rm(x, -y, -phi, -sp, cp) {
         b.offer(&[R, L, S, L], &[t, -h, u, v]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_rm(-x, -y, phi) {
+    if let Some((t, u, v)) = lp_rm_sm_rm(-x, -y, phi, sp, cp) {
         b.offer(&[R, L, S, L], &[-t, h, -u, -v]);
     }
     // Backwards.
-    let xb = x * phi.cos() + y * phi.sin();
-    let yb = x * phi.sin() - y * phi.cos();
-    if let Some((t, u, v)) = lp_rm_sm_lm(xb, yb, phi) {
+    let xb = x * cp + y * sp;
+    let yb = x * sp - y * cp;
+    if let Some((t, u, v)) = lp_rm_sm_lm(xb, yb, phi, sp, cp) {
         b.offer(&[L, S, R, L], &[v, u, -h, t]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_lm(-xb, yb, -phi) {
+    if let Some((t, u, v)) = lp_rm_sm_lm(-xb, yb, -phi, -sp, cp) {
         b.offer(&[L, S, R, L], &[-v, -u, h, -t]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_lm(xb, -yb, -phi) {
+    if let Some((t, u, v)) = lp_rm_sm_lm(xb, -yb, -phi, -sp, cp) {
         b.offer(&[R, S, L, R], &[v, u, -h, t]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_lm(-xb, -yb, phi) {
+    if let Some((t, u, v)) = lp_rm_sm_lm(-xb, -yb, phi, sp, cp) {
         b.offer(&[R, S, L, R], &[-v, -u, h, -t]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_rm(xb, yb, phi) {
+    if let Some((t, u, v)) = lp_rm_sm_rm(xb, yb, phi, sp, cp) {
         b.offer(&[R, S, R, L], &[v, u, -h, t]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_rm(-xb, yb, -phi) {
+    if let Some((t, u, v)) = lp_rm_sm_rm(-xb, yb, -phi, -sp, cp) {
         b.offer(&[R, S, R, L], &[-v, -u, h, -t]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_rm(xb, -yb, -phi) {
+    if let Some((t, u, v)) = lp_rm_sm_rm(xb, -yb, -phi, -sp, cp) {
         b.offer(&[L, S, L, R], &[v, u, -h, t]);
     }
-    if let Some((t, u, v)) = lp_rm_sm_rm(-xb, -yb, phi) {
+    if let Some((t, u, v)) = lp_rm_sm_rm(-xb, -yb, phi, sp, cp) {
         b.offer(&[L, S, L, R], &[-v, -u, h, -t]);
     }
 }
 
-fn ccscc(x: f64, y: f64, phi: f64, b: &mut Best) {
+fn ccscc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
     let h = FRAC_PI_2;
-    if let Some((t, u, v)) = lp_rm_s_lm_rp(x, y, phi) {
+    if let Some((t, u, v)) = lp_rm_s_lm_rp(x, y, phi, sp, cp) {
         b.offer(&[L, R, S, L, R], &[t, -h, u, -h, v]);
     }
-    if let Some((t, u, v)) = lp_rm_s_lm_rp(-x, y, -phi) {
+    if let Some((t, u, v)) = lp_rm_s_lm_rp(-x, y, -phi, -sp, cp) {
         b.offer(&[L, R, S, L, R], &[-t, h, -u, h, -v]);
     }
-    if let Some((t, u, v)) = lp_rm_s_lm_rp(x, -y, -phi) {
+    if let Some((t, u, v)) = lp_rm_s_lm_rp(x, -y, -phi, -sp, cp) {
         b.offer(&[R, L, S, R, L], &[t, -h, u, -h, v]);
     }
-    if let Some((t, u, v)) = lp_rm_s_lm_rp(-x, -y, phi) {
+    if let Some((t, u, v)) = lp_rm_s_lm_rp(-x, -y, phi, sp, cp) {
         b.offer(&[R, L, S, R, L], &[-t, h, -u, h, -v]);
     }
 }
@@ -387,15 +393,16 @@ pub fn reeds_shepp_word(start: &Pose, goal: &Pose, r_min_m: f64) -> Option<RsWor
     if !(x.is_finite() && y.is_finite() && phi.is_finite()) {
         return None;
     }
+    let (sp, cp) = phi.sin_cos();
     let mut best = Best {
         word: None,
         len: f64::INFINITY,
     };
-    csc(x, y, phi, &mut best);
-    ccc(x, y, phi, &mut best);
-    cccc(x, y, phi, &mut best);
-    ccsc(x, y, phi, &mut best);
-    ccscc(x, y, phi, &mut best);
+    csc(x, y, phi, sp, cp, &mut best);
+    ccc(x, y, phi, sp, cp, &mut best);
+    cccc(x, y, phi, sp, cp, &mut best);
+    ccsc(x, y, phi, sp, cp, &mut best);
+    ccscc(x, y, phi, sp, cp, &mut best);
     best.word
 }
 

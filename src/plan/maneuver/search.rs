@@ -906,10 +906,7 @@ mod tests {
         let mut p = params();
         p.goal_patterns.clear();
         p.search_max_expansions = 1;
-        let (start, goal) = (
-            Pose::new(5.0, 4.5, 0.0),
-            Pose::new(24.8, 13.8, -FRAC_PI_2),
-        );
+        let (start, goal) = (Pose::new(5.0, 4.5, 0.0), Pose::new(24.8, 13.8, -FRAC_PI_2));
         let r = plan_maneuver(&map, &RS, &p, &start, &goal).unwrap();
         assert_eq!(r.method, Some(Method::Fallback), "{:?}", r.stages);
         let path = r.path.unwrap();
