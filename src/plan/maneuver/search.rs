@@ -31,6 +31,11 @@
 //!    leg and points along its last leg (reached from the endpoints by straight driving along
 //!    their headings).
 //!
+//! Budgets: every search counts towards `max_expansions`; a pattern's search stops after
+//! `pattern_max_expansions`, the search of stage 5 after `search_max_expansions`, and the
+//! fallback searches share what is left. Collision checks of primitives use rectangles
+//! precomputed in the primitive's own frame (one rotation per node) and test the end first.
+//!
 //! Pure: no I/O, no clock. All limits are in [`ManeuverParams`] (the `[maneuver]` section).
 
 use super::collision::{Blocked, CollisionMap, Footprint};
