@@ -190,7 +190,7 @@ pub struct CollisionMap {
 /// Most grid cells a map may have; the cell size grows to stay below it.
 const MAX_CELLS: f64 = 250_000.0;
 /// The free-disc table is built only when cells × edges is below this.
-const MAX_FREE_TABLE_WORK: usize = 20_000_000;
+const MAX_FREE_TABLE_WORK: usize = 5_000_000;
 
 impl CollisionMap {
     /// A map from a boundary ring (`None` = unbounded free space) and obstacle rings, with a
