@@ -190,7 +190,9 @@ pub fn run(cfg: &Config, a: &ManeuverArgs) -> Result<u8> {
                 .with_context(|| format!("{} line {}", batch.display(), n + 1))?;
             let pose = |p: [f64; 3]| Pose::new(p[0], p[1], p[2].to_radians());
             let (r, ms) = plan_one(&map, cfg, curve, &pose(req.from), &pose(req.to));
-            println!("{}", serde_json::to_string(&result_out(&r, ms))?);
+            if !say(&serde_json::to_string(&result_out(&r, ms))?)? {
+                return Ok(0);
+            }
         }
         return Ok(0);
     }
@@ -208,9 +210,9 @@ pub fn run(cfg: &Config, a: &ManeuverArgs) -> Result<u8> {
         .with_context(|| format!("writing {}", svg.display()))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        say(&serde_json::to_string_pretty(&out)?)?;
     } else if out.found {
-        println!(
+        say(&format!(
             "found ({}): {:.1} m, {} cusps, {:.1} m in reverse, {} segments, max curvature {:.3} 1/m, max curvature rate {:.3} 1/m²; {} expansions, {:.1} ms",
             out.method.as_deref().unwrap_or("?"),
             out.length_m,
@@ -221,15 +223,27 @@ pub fn run(cfg: &Config, a: &ManeuverArgs) -> Result<u8> {
             out.max_curvature_rate,
             out.expansions,
             out.plan_time_ms
-        );
+        ))?;
     } else {
-        println!(
+        say(&format!(
             "no path: {} ({:.1} ms)",
             out.failure.as_deref().unwrap_or("not found"),
             out.plan_time_ms
-        );
+        ))?;
     }
     Ok(if out.found { 0 } else { 3 })
+}
+
+/// Print a line on stdout. `Ok(false)` when the reader has gone (broken pipe, e.g. `| head`):
+/// stop quietly instead of panicking like `println!`.
+fn say(line: &str) -> Result<bool> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match writeln!(out, "{line}").and_then(|()| out.flush()) {
+        Ok(()) => Ok(true),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(false),
+        Err(e) => Err(e.into()),
+    }
 }
 
 fn svg_points(pts: &[Vec2]) -> String {
