@@ -212,7 +212,8 @@ pub struct VehicleConfig {
     /// Largest rate of change of the steering curvature per metre driven, 1/m² (σ_max of
     /// the continuous-curvature turns and manoeuvres, SPEC §4). It comes from the steering
     /// speed: about max wheel rate (rad/s) / (wheelbase (m) · speed in turns (m/s)); 30°/s,
-    /// 2.5 m and 6 km/h give 0.13. 0 = turns of arcs only (curvature steps at their ends).
+    /// 3 m and 6 km/h give 0.10. 0 = turns of arcs only (curvature steps at their ends; and
+    /// manoeuvres only with `maneuver.curve = "rs"`).
     pub max_curvature_rate_per_m2: f64,
     /// GNSS antenna position ahead of the rear-axle centre, m.
     pub antenna_forward_m: f64,
@@ -234,7 +235,7 @@ impl Default for VehicleConfig {
             wheelbase_m: 3.0,
             r_min_m: 5.0,
             max_wheel_angle_deg: 35.0,
-            max_curvature_rate_per_m2: 0.06,
+            max_curvature_rate_per_m2: 0.1,
             antenna_forward_m: 1.0,
             antenna_left_m: 0.0,
             antenna_up_m: 3.0,
@@ -655,8 +656,6 @@ pub enum CurveChoice {
 pub struct ManeuverConfig {
     /// Curve family: "cc" (continuous curvature, the default) or "rs" (plain Reeds-Shepp).
     pub curve: CurveChoice,
-    /// Largest rate of change of curvature along the path (steering speed limit), 1/m².
-    pub max_curvature_rate_per_m2: f64,
     /// Implement rigidly mounted behind the vehicle: length, m (0 = none), width, m, and
     /// distance of its front edge behind the rear axle, m.
     pub implement_length_m: f64,
@@ -710,7 +709,6 @@ impl Default for ManeuverConfig {
     fn default() -> Self {
         ManeuverConfig {
             curve: CurveChoice::Cc,
-            max_curvature_rate_per_m2: 0.1,
             implement_length_m: 0.0,
             implement_width_m: 0.0,
             implement_hitch_m: 0.5,
@@ -740,11 +738,12 @@ impl Default for ManeuverConfig {
 }
 
 impl Config {
-    /// The curve limits of `[maneuver]`: κ_max = 1 / vehicle.r_min_m, σ_max.
+    /// The curve limits of manoeuvres: κ_max = 1 / vehicle.r_min_m, σ_max =
+    /// vehicle.max_curvature_rate_per_m2.
     pub fn maneuver_curve_params(&self) -> crate::plan::maneuver::steering::CurveParams {
         crate::plan::maneuver::steering::CurveParams {
             kappa_max: 1.0 / self.vehicle.r_min_m,
-            sigma_max: self.maneuver.max_curvature_rate_per_m2,
+            sigma_max: self.vehicle.max_curvature_rate_per_m2,
         }
     }
 
@@ -1336,12 +1335,13 @@ impl Config {
 
     fn validate_maneuver(&self, c: &mut Checker) {
         let m = &self.maneuver;
-        c.range(
-            "maneuver.max_curvature_rate_per_m2",
-            m.max_curvature_rate_per_m2,
-            0.001,
-            10.0,
-        );
+        if m.curve == CurveChoice::Cc && self.vehicle.max_curvature_rate_per_m2 <= 0.0 {
+            c.push(
+                "vehicle.max_curvature_rate_per_m2",
+                fmt_num(self.vehicle.max_curvature_rate_per_m2),
+                "must be > 0 for continuous-curvature manoeuvres (maneuver.curve = \"cc\")",
+            );
+        }
         c.range(
             "maneuver.implement_length_m",
             m.implement_length_m,

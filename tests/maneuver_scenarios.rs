@@ -163,7 +163,7 @@ fn check(name: &str, curve: CurveChoice) {
     assert!(path.max_curvature() <= kappa_max + 1e-6, "{name}");
     if curve == CurveChoice::Cc {
         assert!(
-            path.max_curvature_rate() <= cfg.maneuver.max_curvature_rate_per_m2 + 1e-6,
+            path.max_curvature_rate() <= cfg.vehicle.max_curvature_rate_per_m2 + 1e-6,
             "{name}: curvature rate {}",
             path.max_curvature_rate()
         );
