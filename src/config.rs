@@ -242,6 +242,18 @@ pub struct TrackConfig {
     pub integral_capture_m: f64,
     /// The integral action learns only above this speed, m/s.
     pub integral_min_speed_mps: f64,
+    /// Disturbance observer (predictive tracker only; see
+    /// [`ObserverParams`](crate::estimate::ObserverParams)): time constant of the wheel-angle
+    /// offset estimate, s (0 = off).
+    pub observer_bias_tau_s: f64,
+    /// Time constant of the world-frame drift (slip) estimate, s (0 = off).
+    pub observer_drift_tau_s: f64,
+    /// The observer learns only above this speed, m/s.
+    pub observer_min_speed_mps: f64,
+    /// Largest wheel-angle offset the observer may estimate, degrees.
+    pub observer_bias_limit_deg: f64,
+    /// Largest drift speed the observer may estimate, m/s.
+    pub observer_drift_limit_mps: f64,
 }
 
 impl Default for TrackConfig {
@@ -262,6 +274,11 @@ impl Default for TrackConfig {
             integral_limit_deg: 3.0,
             integral_capture_m: 0.3,
             integral_min_speed_mps: 0.5,
+            observer_bias_tau_s: 20.0,
+            observer_drift_tau_s: 2.0,
+            observer_min_speed_mps: 1.0,
+            observer_bias_limit_deg: 3.0,
+            observer_drift_limit_mps: 0.3,
         }
     }
 }
@@ -896,6 +913,36 @@ impl Config {
             t.integral_min_speed_mps,
             0.0,
             10.0,
+        );
+        c.range(
+            "track.observer_bias_tau_s",
+            t.observer_bias_tau_s,
+            0.0,
+            600.0,
+        );
+        c.range(
+            "track.observer_drift_tau_s",
+            t.observer_drift_tau_s,
+            0.0,
+            600.0,
+        );
+        c.range(
+            "track.observer_min_speed_mps",
+            t.observer_min_speed_mps,
+            0.1,
+            10.0,
+        );
+        c.range(
+            "track.observer_bias_limit_deg",
+            t.observer_bias_limit_deg,
+            0.0,
+            10.0,
+        );
+        c.range(
+            "track.observer_drift_limit_mps",
+            t.observer_drift_limit_mps,
+            0.0,
+            2.0,
         );
 
         let s = &self.sim;

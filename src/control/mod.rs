@@ -6,8 +6,10 @@
 //! progress snapshots it hands out.
 
 use crate::config::{Config, JobKind, LineSide, TrackerChoice};
-use crate::estimate::{AntennaOffset, Estimator, EstimatorParams, GnssFix, VehicleEstimate};
-use crate::geo::{v2, Direction, Pose};
+use crate::estimate::{
+    AntennaOffset, Estimator, EstimatorParams, GnssFix, ObserverParams, VehicleEstimate,
+};
+use crate::geo::{heading_vec, left_normal, v2, Direction, Pose, Vec2};
 use crate::guidance::progress::{JobDefinition, Progress};
 use crate::guidance::{Guidance, GuidanceError, GuidanceParams, JobPlan};
 use crate::plan::abline::{AbParams, AbPlan, Side};
@@ -68,8 +70,9 @@ pub fn tracker_params(cfg: &Config) -> TrackerParams {
     }
 }
 
-/// The estimator's parameters: the predictive tracker compensates latency and dead-reckons,
-/// plain pure pursuit uses the latest fix as it is.
+/// The estimator's parameters: the predictive tracker (and Stanley) compensate latency,
+/// dead-reckon and correct the antenna's lean from the IMU roll; plain pure pursuit uses the
+/// latest fix as it is.
 pub fn estimator_params(cfg: &Config) -> EstimatorParams {
     let predictive = cfg.track.kind != TrackerChoice::PurePursuit;
     EstimatorParams {
@@ -90,7 +93,40 @@ pub fn estimator_params(cfg: &Config) -> EstimatorParams {
         } else {
             0.0
         },
+        roll_compensation: predictive,
+        observer: observer_params(cfg),
     }
+}
+
+/// The disturbance observer from `[track]`: on for the default (predictive) tracker only,
+/// so that pure pursuit and Stanley stay the references they are.
+pub fn observer_params(cfg: &Config) -> ObserverParams {
+    let t = &cfg.track;
+    if t.kind != TrackerChoice::Predictive {
+        return ObserverParams::default();
+    }
+    ObserverParams {
+        bias_tau: t.observer_bias_tau_s,
+        drift_tau: t.observer_drift_tau_s,
+        min_speed: t.observer_min_speed_mps,
+        bias_limit: t.observer_bias_limit_deg.to_radians(),
+        drift_limit: t.observer_drift_limit_mps,
+    }
+}
+
+/// Largest crab angle the drift estimate may turn the steered course by, rad.
+const MAX_CRAB: f64 = 0.2;
+
+/// The travel-direction pose turned onto the course over ground: the heading plus the crab
+/// angle of the estimated `drift` (world m/s) at speed `speed` (m/s, > 0 in the travel
+/// direction). Below `min_speed` the crab is not defined and the pose is returned as is.
+pub fn course_pose(pose: &Pose, drift: Vec2, speed: f64, min_speed: f64) -> Pose {
+    if speed < min_speed || drift == Vec2::zeros() {
+        return *pose;
+    }
+    let lateral = drift.dot(&left_normal(&heading_vec(pose.heading)));
+    let crab = lateral.atan2(speed).clamp(-MAX_CRAB, MAX_CRAB);
+    Pose::new(pose.pos.x, pose.pos.y, pose.heading + crab)
 }
 
 /// The result of one cycle.
@@ -203,6 +239,16 @@ impl Controller {
         self.estimator.on_fix(fix);
     }
 
+    /// Whether the disturbance observer may learn from the next fixes (RTK fixed).
+    pub fn set_observer_learning(&mut self, learn: bool) {
+        self.estimator.set_learning(learn);
+    }
+
+    /// The observer's estimates: wheel-angle offset (rad) and world drift (m/s).
+    pub fn disturbance_estimate(&self) -> (f64, Vec2) {
+        (self.estimator.wheel_offset(), self.estimator.drift())
+    }
+
     pub fn on_wheel_angle(&mut self, t: f64, angle: f64) {
         self.estimator.on_wheel_angle(t, angle);
     }
@@ -232,7 +278,13 @@ impl Controller {
         let direction = self.guidance.direction();
         out.direction = direction;
         // Reverse segments are tracked about the rear axle in the driving direction.
-        let pose = travel_pose(&est.pose, direction);
+        let mut pose = travel_pose(&est.pose, direction);
+        if self.law.kind == TrackerChoice::Predictive {
+            // Steer the course over ground, not the heading, onto the path: the estimated
+            // drift then leaves no standing error.
+            let min = self.estimator.params().observer.min_speed;
+            pose = course_pose(&pose, self.estimator.drift(), est.speed.abs(), min);
+        }
         let local = self.guidance.local_path();
         let law = match self.law.kind {
             TrackerChoice::Stanley => stanley(

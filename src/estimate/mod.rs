@@ -45,7 +45,67 @@ pub struct EstimatorParams {
     pub predict: bool,
     /// Extra prediction horizon past now (about the actuator dead time), s.
     pub lead_time: f64,
+    /// Correct the antenna's lean with the fix's roll (lateral − up·sin roll); the plain
+    /// pure-pursuit reference leaves it out.
+    pub roll_compensation: bool,
+    /// The disturbance observer (off by default).
+    pub observer: ObserverParams,
 }
+
+/// The disturbance observer: a constant-gain (steady-state Kalman) filter on the innovation
+/// of each fix against the pose predicted from the previous fix. Two slowly varying
+/// disturbances are estimated:
+///
+/// * a wheel-angle offset `b` (vehicle frame, rad: measured − true angle), from the heading
+///   innovation: the predicted yaw rate uses v·tan(δ_measured − b)/L, so
+///   Δθ ≈ −v·Δt/(L·cos²δ)·(b − b̂);
+/// * a drift velocity `d` (world frame, m/s, e.g. side-slope slip), from the lateral
+///   innovation Δl ≈ (d − d̂)·n·Δt, n the vehicle's left normal. Only the component along n is
+///   observable on a straight pass; kept as a world vector, a drift that is fixed on the
+///   ground (downhill) keeps its sign when the direction of travel flips, and turns observe it
+///   from every side.
+///
+/// Each update moves the estimate by Δt/τ of the innovation's measurement of its error, a
+/// first-order filter with time constant τ. Both estimates enter the prediction, and the
+/// controller steers the velocity (course) rather than the heading onto the path, which cancels
+/// the drift. The innovation of two consecutive fixes telescopes: white position noise σ leaves
+/// about σ/τ_drift of noise on the drift, heading noise σθ about σθ·L/(v·τ_bias) on the offset.
+/// Reference: the disturbance-observer form of a Kalman filter on the path-relative error model,
+/// e.g. Åström & Murray, *Feedback Systems*, ch. 7 (state estimation with integral
+/// disturbance states).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObserverParams {
+    /// Time constant of the wheel-angle offset estimate, s; 0 = off.
+    pub bias_tau: f64,
+    /// Time constant of the drift estimate, s; 0 = off.
+    pub drift_tau: f64,
+    /// Learns only above this speed, m/s.
+    pub min_speed: f64,
+    /// Largest wheel-angle offset, rad.
+    pub bias_limit: f64,
+    /// Largest drift speed, m/s.
+    pub drift_limit: f64,
+}
+
+impl Default for ObserverParams {
+    fn default() -> Self {
+        ObserverParams {
+            bias_tau: 0.0,
+            drift_tau: 0.0,
+            min_speed: 1.0,
+            bias_limit: 3f64.to_radians(),
+            drift_limit: 0.3,
+        }
+    }
+}
+
+/// Innovations larger than these are a jump (multipath, a new fix source), not a drift:
+/// lateral m, heading rad.
+const GATE_LATERAL: f64 = 0.15;
+const GATE_HEADING: f64 = 0.02;
+/// The offset is learnt only below this wheel angle, rad (the linearisation holds and the
+/// actuator is not slewing through a turn).
+const BIAS_MAX_WHEEL: f64 = 0.2;
 
 /// The estimate handed to guidance and tracking.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,6 +136,12 @@ pub struct Estimator {
     wheel: [(f64, f64); RING],
     wheel_head: usize,
     wheel_len: usize,
+    /// Estimated wheel-angle offset (measured − true), rad.
+    bias: f64,
+    /// Estimated world-frame drift velocity, m/s.
+    drift: Vec2,
+    /// The observer learns from the next fixes (the fix quality vouches for them).
+    learn: bool,
 }
 
 impl Estimator {
@@ -90,6 +156,90 @@ impl Estimator {
             wheel: [(0.0, 0.0); RING],
             wheel_head: 0,
             wheel_len: 0,
+            bias: 0.0,
+            drift: Vec2::zeros(),
+            learn: true,
+        }
+    }
+
+    /// Whether the observer may learn from the following fixes (off while the fix is not RTK
+    /// fixed: a float solution wanders by decimetres and would read as drift).
+    pub fn set_learning(&mut self, learn: bool) {
+        self.learn = learn;
+    }
+
+    /// The estimated wheel-angle offset (measured − true), rad.
+    pub fn wheel_offset(&self) -> f64 {
+        self.bias
+    }
+
+    /// The estimated world-frame drift velocity, m/s.
+    pub fn drift(&self) -> Vec2 {
+        self.drift
+    }
+
+    /// Integrate the bicycle model from `pose` at `t0` over `span` s at speed `v`, with the
+    /// measured wheel angles less the estimated offset and the estimated drift.
+    fn propagate(&self, pose: Pose, v: f64, t0: f64, span: f64) -> Pose {
+        let steps = (span / PREDICT_STEP).ceil() as usize;
+        let (mut x, mut y, mut th) = (pose.pos.x, pose.pos.y, pose.heading);
+        let l = self.params.wheelbase;
+        if steps > 0 {
+            let h = span / steps as f64;
+            for i in 0..steps {
+                // Midpoint rule for the heading keeps the arc accurate at this step.
+                let t_mid = t0 + (i as f64 + 0.5) * h;
+                let rate = v * (self.wheel_angle_at(t_mid) - self.bias).tan() / l;
+                let th_mid = th + 0.5 * h * rate;
+                x += (v * th_mid.cos() + self.drift.x) * h;
+                y += (v * th_mid.sin() + self.drift.y) * h;
+                th += rate * h;
+            }
+        }
+        Pose::new(x, y, th)
+    }
+
+    /// Learn from the innovation of the fix `new` (measured at `t_new`) against the pose
+    /// predicted from the previous fix.
+    fn observe(&mut self, new: &Pose, t_new: f64, v_new: f64) {
+        let o = self.params.observer;
+        if o.bias_tau <= 0.0 && o.drift_tau <= 0.0 {
+            return;
+        }
+        let Some(prev) = self.fix_pose else {
+            return;
+        };
+        let t_prev = self.fix_time - self.params.gnss_latency;
+        let dt = t_new - t_prev;
+        let v = self.fix_speed;
+        if !self.learn
+            || !(dt > 0.0 && dt <= 0.5)
+            || v.abs() < o.min_speed
+            || v_new.abs() < o.min_speed
+        {
+            return;
+        }
+        let pred = self.propagate(prev, v, t_prev, dt);
+        let d_heading = wrap_angle(new.heading - pred.heading);
+        let n = left_normal(&heading_vec(new.heading));
+        let d_lateral = (new.pos - pred.pos).dot(&n);
+        if d_heading.abs() > GATE_HEADING || d_lateral.abs() > GATE_LATERAL {
+            return;
+        }
+        if o.bias_tau > 0.0 {
+            let delta = self.wheel_angle_at(t_prev + 0.5 * dt) - self.bias;
+            if delta.abs() < BIAS_MAX_WHEEL {
+                let c = delta.cos();
+                let step = -d_heading * self.params.wheelbase * c * c / (v * o.bias_tau);
+                self.bias = (self.bias + step).clamp(-o.bias_limit, o.bias_limit);
+            }
+        }
+        if o.drift_tau > 0.0 {
+            self.drift += n * (d_lateral / o.drift_tau);
+            let norm = self.drift.norm();
+            if norm > o.drift_limit {
+                self.drift *= o.drift_limit / norm;
+            }
         }
     }
 
@@ -141,9 +291,15 @@ impl Estimator {
         let Some(heading) = heading else {
             return;
         };
-        let pos =
-            self.antenna_to_rear_axle(&fix.antenna, heading, fix.roll.filter(|r| r.is_finite()));
-        self.fix_pose = Some(Pose::new(pos.x, pos.y, heading));
+        let roll = fix
+            .roll
+            .filter(|r| r.is_finite() && self.params.roll_compensation);
+        let pos = self.antenna_to_rear_axle(&fix.antenna, heading, roll);
+        let pose = Pose::new(pos.x, pos.y, heading);
+        if self.params.predict {
+            self.observe(&pose, fix.t_received - self.params.gnss_latency, fix.speed);
+        }
+        self.fix_pose = Some(pose);
         self.fix_time = fix.t_received;
         self.fix_speed = fix.speed;
     }
@@ -203,24 +359,10 @@ impl Estimator {
         let t0 = self.fix_time - self.params.gnss_latency;
         let t1 = t_now + self.params.lead_time;
         let span = (t1 - t0).clamp(0.0, 2.0);
-        let steps = (span / PREDICT_STEP).ceil() as usize;
-        let (mut x, mut y, mut th) = (pose.pos.x, pose.pos.y, pose.heading);
         let v = self.fix_speed;
-        let l = self.params.wheelbase;
-        if steps > 0 {
-            let h = span / steps as f64;
-            for i in 0..steps {
-                // Midpoint rule for the heading keeps the arc accurate at this step.
-                let t_mid = t0 + (i as f64 + 0.5) * h;
-                let rate = v * self.wheel_angle_at(t_mid).tan() / l;
-                let th_mid = th + 0.5 * h * rate;
-                x += v * th_mid.cos() * h;
-                y += v * th_mid.sin() * h;
-                th += rate * h;
-            }
-        }
+        let pose = self.propagate(pose, v, t0, span);
         Some(VehicleEstimate {
-            pose: Pose::new(x, y, th),
+            pose,
             speed: v,
             fix_age,
         })
@@ -243,6 +385,8 @@ mod tests {
             gnss_latency: 0.05,
             predict,
             lead_time: 0.0,
+            roll_compensation: true,
+            observer: ObserverParams::default(),
         }
     }
 
