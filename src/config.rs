@@ -49,6 +49,10 @@ pub enum JobKind {
     Ab,
     /// A field coverage plan (SPEC §3) made from the field at `job.field_path`.
     Field,
+    /// Concentric circular work lines about `job.point_a_m` (the curved lines of the accuracy
+    /// suite): `job.line_num` arcs from radius `job.arc_radius_m` outwards, `job.line_width_m`
+    /// apart, each sweeping `job.arc_sweep_deg`, joined by headland turns.
+    Arcs,
 }
 
 /// Side of A→B on which the following lines are laid.
@@ -99,6 +103,11 @@ pub struct JobConfig {
     pub origin_lat_deg: f64,
     /// WGS-84 longitude of the local ENU origin, degrees.
     pub origin_lon_deg: f64,
+    /// For `kind = "arcs"`: radius of the first (innermost) line, m.
+    pub arc_radius_m: f64,
+    /// For `kind = "arcs"`: sweep of every line, degrees (the first starts due South of the
+    /// centre, heading East, and runs counter-clockwise).
+    pub arc_sweep_deg: f64,
 }
 
 impl Default for JobConfig {
@@ -113,6 +122,8 @@ impl Default for JobConfig {
             side: LineSide::Right,
             origin_lat_deg: 52.0,
             origin_lon_deg: 5.0,
+            arc_radius_m: 30.0,
+            arc_sweep_deg: 270.0,
         }
     }
 }
@@ -784,6 +795,15 @@ impl Config {
                 "job.field_path",
                 format!("{:?}", j.field_path),
                 "must name a GeoJSON or TASKDATA.XML file when job.kind = \"field\"",
+            );
+        }
+        c.range("job.arc_radius_m", j.arc_radius_m, 1.0, 10_000.0);
+        c.range("job.arc_sweep_deg", j.arc_sweep_deg, 1.0, 359.0);
+        if j.kind == JobKind::Arcs && !(1..=1000).contains(&j.line_num) {
+            c.push(
+                "job.line_num",
+                j.line_num.to_string(),
+                "must be in 1..=1000 when job.kind = \"arcs\"",
             );
         }
         c.range("job.origin_lat_deg", j.origin_lat_deg, -89.0, 89.0);

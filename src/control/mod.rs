@@ -46,6 +46,22 @@ pub fn ab_params(cfg: &Config) -> AbParams {
     }
 }
 
+/// The arcs job (`job.kind = "arcs"`) from the configuration.
+pub fn arcs_plan(cfg: &Config) -> Result<JobPlan, crate::plan::PlanError> {
+    let ab = ab_params(cfg);
+    let job = crate::plan::arcs::arcs_job(&crate::plan::arcs::ArcsParams {
+        centre: ab.point_a,
+        r_inner: cfg.job.arc_radius_m,
+        width: cfg.job.line_width_m,
+        lines: cfg.job.line_num,
+        sweep: cfg.job.arc_sweep_deg.to_radians(),
+        start_angle: -std::f64::consts::FRAC_PI_2,
+        point_spacing: cfg.guidance.point_spacing_m,
+        turn: ab.turn,
+    })?;
+    Ok(JobPlan::Segments(job))
+}
+
 /// The state machine's parameters from the configuration.
 pub fn guidance_params(cfg: &Config) -> GuidanceParams {
     GuidanceParams {
@@ -207,10 +223,11 @@ pub struct Controller {
 impl Controller {
     /// A new job, or the continuation of `resume`.
     pub fn from_config(cfg: &Config, resume: Option<&Progress>) -> Result<Self, ControlError> {
-        if cfg.job.kind == JobKind::Field {
-            return Err(ControlError::NoPlan);
+        match cfg.job.kind {
+            JobKind::Field => Err(ControlError::NoPlan),
+            JobKind::Arcs => Controller::with_job(cfg, arcs_plan(cfg)?, resume),
+            JobKind::Ab => Controller::with_job(cfg, AbPlan::new(ab_params(cfg))?.into(), resume),
         }
-        Controller::with_job(cfg, AbPlan::new(ab_params(cfg))?.into(), resume)
     }
 
     /// A job given by its plan (an AB plan or a segment job such as a field plan), or the

@@ -119,6 +119,10 @@ pub fn prepare_job(cfg: &Config) -> Result<DaemonJob, DaemonError> {
             let plan = AbPlan::new(crate::control::ab_params(cfg)).map_err(ControlError::from)?;
             (JobPlan::from(plan), None)
         }
+        JobKind::Arcs => (
+            crate::control::arcs_plan(cfg).map_err(ControlError::from)?,
+            None,
+        ),
         JobKind::Field => {
             let start = std::time::Instant::now();
             let fj = field_file::load(cfg).map_err(DaemonError::Field)?;

@@ -391,8 +391,12 @@ pub fn run(
         node = node.with_origin(origin);
     }
     let speed = cfg.speed();
+    let segment_job = matches!(
+        node.controller().guidance().job_plan(),
+        JobPlan::Segments(_)
+    );
     let start = match (&opts.resume, &opts.job) {
-        (None, Some(JobPlan::Segments(_))) => node.controller().path_start_pose().map(|p| {
+        (None, _) if segment_job => node.controller().path_start_pose().map(|p| {
             let normal = left_normal(&crate::geo::heading_vec(p.heading));
             let pos = p.pos + normal * cfg.sim.start_offset_m;
             Pose::new(
@@ -430,7 +434,7 @@ pub fn run(
     let dt = cfg.dt();
     let max_time = if cfg.sim.max_time_s > 0.0 {
         cfg.sim.max_time_s
-    } else if let Some(JobPlan::Segments(job)) = &opts.job {
+    } else if let JobPlan::Segments(job) = node.controller().guidance().job_plan() {
         let length: f64 = job.segments().iter().map(|s| s.length()).sum();
         60.0 + 3.0 * length / cfg.speed().max(0.1)
     } else {

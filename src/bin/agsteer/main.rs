@@ -251,7 +251,7 @@ fn run_demo(
             prepare_field_job(&cfg)
                 .with_context(|| format!("job.kind = \"field\" in {}", config.display()))?,
         ),
-        JobKind::Ab => None,
+        JobKind::Ab | JobKind::Arcs => None,
     };
     let job = field.as_ref().map(|(fj, _)| fj.job_plan());
     let expected = match &job {

@@ -39,7 +39,7 @@ pub fn run(
         JobKind::Field => {
             Some(agsteer::daemon::field_file::load(cfg).context("job.kind = \"field\"")?)
         }
-        JobKind::Ab => None,
+        JobKind::Ab | JobKind::Arcs => None,
     };
     let first = field.as_ref().and_then(|f| f.job.segments().first());
     let (a, b) = match first.map(|s| s.points.as_slice()) {
