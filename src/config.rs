@@ -265,6 +265,14 @@ pub struct TrackConfig {
     pub observer_bias_limit_deg: f64,
     /// Largest drift speed the observer may estimate, m/s.
     pub observer_drift_limit_mps: f64,
+    /// Time constant of the slope-slip coefficient (lateral slip per degree of IMU roll), s
+    /// (0 = off).
+    pub observer_slip_tau_s: f64,
+    /// Largest slope-slip coefficient, m/s per degree of roll.
+    pub observer_slip_limit_mps_per_deg: f64,
+    /// Through an RTK-float period, dead-reckon from the last fixed position for at most this
+    /// long instead of following the float positions, s (0 = off).
+    pub observer_coast_max_s: f64,
 }
 
 impl Default for TrackConfig {
@@ -286,10 +294,13 @@ impl Default for TrackConfig {
             integral_capture_m: 0.3,
             integral_min_speed_mps: 0.5,
             observer_bias_tau_s: 20.0,
-            observer_drift_tau_s: 2.0,
+            observer_drift_tau_s: 60.0,
             observer_min_speed_mps: 1.0,
             observer_bias_limit_deg: 3.0,
             observer_drift_limit_mps: 0.3,
+            observer_slip_tau_s: 5.0,
+            observer_slip_limit_mps_per_deg: 0.05,
+            observer_coast_max_s: 30.0,
         }
     }
 }
@@ -963,6 +974,24 @@ impl Config {
             t.observer_drift_limit_mps,
             0.0,
             2.0,
+        );
+        c.range(
+            "track.observer_slip_tau_s",
+            t.observer_slip_tau_s,
+            0.0,
+            600.0,
+        );
+        c.range(
+            "track.observer_slip_limit_mps_per_deg",
+            t.observer_slip_limit_mps_per_deg,
+            0.0,
+            1.0,
+        );
+        c.range(
+            "track.observer_coast_max_s",
+            t.observer_coast_max_s,
+            0.0,
+            600.0,
         );
 
         let s = &self.sim;

@@ -127,6 +127,9 @@ pub fn observer_params(cfg: &Config) -> ObserverParams {
         min_speed: t.observer_min_speed_mps,
         bias_limit: t.observer_bias_limit_deg.to_radians(),
         drift_limit: t.observer_drift_limit_mps,
+        slip_tau: t.observer_slip_tau_s,
+        slip_limit: t.observer_slip_limit_mps_per_deg.to_degrees(),
+        coast_max: t.observer_coast_max_s,
     }
 }
 
@@ -256,9 +259,11 @@ impl Controller {
         self.estimator.on_fix(fix);
     }
 
-    /// Whether the disturbance observer may learn from the next fixes (RTK fixed).
-    pub fn set_observer_learning(&mut self, learn: bool) {
-        self.estimator.set_learning(learn);
+    /// The quality of the next fixes: the disturbance observer learns only from RTK-fixed
+    /// ones and coasts through RTK-float ones.
+    pub fn set_fix_quality(&mut self, fixed: bool, float: bool) {
+        self.estimator.set_learning(fixed);
+        self.estimator.set_coasting(float);
     }
 
     /// The observer's estimates: wheel-angle offset (rad) and world drift (m/s).
@@ -300,7 +305,8 @@ impl Controller {
             // Steer the course over ground, not the heading, onto the path: the estimated
             // drift then leaves no standing error.
             let min = self.estimator.params().observer.min_speed;
-            pose = course_pose(&pose, self.estimator.drift(), est.speed.abs(), min);
+            let drift = self.estimator.drift_velocity(est.pose.heading);
+            pose = course_pose(&pose, drift, est.speed.abs(), min);
         }
         let local = self.guidance.local_path();
         let law = match self.law.kind {

@@ -257,7 +257,8 @@ impl ControllerNode {
                 Some((tq, q)) if t - tq <= QUALITY_MAX_AGE => q,
                 _ => FixQuality::None,
             };
-            self.ctrl.set_observer_learning(q == FixQuality::RtkFixed);
+            self.ctrl
+                .set_fix_quality(q == FixQuality::RtkFixed, q == FixQuality::RtkFloat);
             self.ctrl.on_fix(&GnssFix {
                 t_received: t,
                 antenna,

@@ -61,7 +61,8 @@ pub struct FloatReport {
     pub windows_s: Vec<[f64; 2]>,
     /// Disengagements for the fix quality.
     pub fix_disengagements: u64,
-    /// Largest true |XTE| on work passes while the float lasted, m (`None`: no work samples).
+    /// Largest true |XTE| on work passes (past the acquisition skip) while the float lasted, m
+    /// (`None`: no work samples).
     pub xte_max_during_float_m: Option<f64>,
 }
 
@@ -285,7 +286,7 @@ pub fn evaluate(
                 next = s.along_m + 0.5;
             }
             end = end.max(s.along_m);
-            if in_float(s.t) {
+            if in_float(s.t) && s.along_m >= ACQUISITION_SKIP_M {
                 float_max = Some(float_max.unwrap_or(0.0).max(s.xte_m.abs()));
             }
         }

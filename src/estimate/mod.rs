@@ -65,8 +65,15 @@ pub struct EstimatorParams {
 ///   ground (downhill) keeps its sign when the direction of travel flips, and turns observe it
 ///   from every side.
 ///
+/// * a side-slope slip coefficient `c` (vehicle frame, m/s per rad of roll), see
+///   [`ObserverParams::slip_tau`].
+///
 /// Each update moves the estimate by Δt/τ of the innovation's measurement of its error, a
-/// first-order filter with time constant τ. Both estimates enter the prediction, and the
+/// first-order filter with time constant τ; τ starts at 1 s and grows with the time learnt up
+/// to the configured value, as a Kalman filter's gain falls from its initial covariance to the
+/// steady state. Innovations beyond a gate (5 cm lateral, 0.02 rad heading) are jumps, not
+/// drift: they are not learnt from, and the estimator dead-reckons through them and through
+/// RTK-float periods ([`ObserverParams::coast_max`]). Both estimates enter the prediction, and the
 /// controller steers the velocity (course) rather than the heading onto the path, which cancels
 /// the drift. The innovation of two consecutive fixes telescopes: white position noise σ leaves
 /// about σ/τ_drift of noise on the drift, heading noise σθ about σθ·L/(v·τ_bias) on the offset.
@@ -85,6 +92,18 @@ pub struct ObserverParams {
     pub bias_limit: f64,
     /// Largest drift speed, m/s.
     pub drift_limit: f64,
+    /// Time constant of the slope-slip coefficient estimate, s; 0 = off. Side-slope slip is
+    /// about proportional to the slope: a vehicle-frame lateral velocity −c·sin(roll) (to the
+    /// right, downhill, for positive roll), with c learnt by normalised LMS from the same
+    /// lateral innovation as the drift. It follows a slope that varies along the pass, which a
+    /// drift estimate can only chase, and it keeps doing so while coasting.
+    pub slip_tau: f64,
+    /// Largest slip coefficient, m/s per rad of roll.
+    pub slip_limit: f64,
+    /// While the fix is RTK float, dead-reckon the position from the last fixed one (with the
+    /// measured heading, the measured wheel angles less the offset, and the drift) instead of
+    /// taking the float positions, for at most this long, s; 0 = off.
+    pub coast_max: f64,
 }
 
 impl Default for ObserverParams {
@@ -95,17 +114,51 @@ impl Default for ObserverParams {
             min_speed: 1.0,
             bias_limit: 3f64.to_radians(),
             drift_limit: 0.3,
+            slip_tau: 0.0,
+            slip_limit: 3.0,
+            coast_max: 0.0,
         }
     }
 }
 
-/// Innovations larger than these are a jump (multipath, a new fix source), not a drift:
-/// lateral m, heading rad.
-const GATE_LATERAL: f64 = 0.15;
+/// Innovations larger than these are a jump (multipath, the onset of a float solution), not
+/// a drift: lateral m (about 3.5 σ of the innovation of two fixes with 1 cm noise each),
+/// heading rad. While RTK fixed, the estimator coasts through a jump (dead reckoning) until the
+/// fixes agree with it again, for at most [`ObserverParams::coast_max`].
+const GATE_LATERAL: f64 = 0.05;
 const GATE_HEADING: f64 = 0.02;
+
+/// Why the estimator is dead-reckoning instead of taking the fix positions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Coast {
+    Off,
+    /// Since this time (s): the fix is RTK float.
+    Float(f64),
+    /// Since this time (s): the fixes jumped away from the dead reckoning.
+    Jump(f64),
+    /// Coasted for `coast_max`: fix positions are taken until the cause clears.
+    Expired,
+}
+
+/// A fix against the pose predicted from the previous one.
+#[derive(Debug, Clone, Copy)]
+struct Innovation {
+    predicted: Pose,
+    /// Measurement times of the previous and the new fix, s.
+    t_prev: f64,
+    dt: f64,
+    heading: f64,
+    lateral: f64,
+    normal: Vec2,
+}
 /// The offset is learnt only below this wheel angle, rad (the linearisation holds and the
 /// actuator is not slewing through a turn).
 const BIAS_MAX_WHEEL: f64 = 0.2;
+/// Shortest effective time constant at the start of learning, s.
+const MIN_TAU: f64 = 1.0;
+/// Regularisation of the slip coefficient's normalised LMS step: sin² of about 1°, so that on
+/// flat ground the coefficient is left alone.
+const SLIP_EPS: f64 = 3e-4;
 
 /// The estimate handed to guidance and tracking.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -140,8 +193,19 @@ pub struct Estimator {
     bias: f64,
     /// Estimated world-frame drift velocity, m/s.
     drift: Vec2,
+    /// Estimated slope-slip coefficient, m/s per rad of roll (lateral, to the right).
+    slip: f64,
+    /// Roll of the latest fix, rad (0 without a roll signal).
+    roll: f64,
+    /// Time the observer has learnt for, s: the effective time constants grow with it up to
+    /// the configured ones (as a Kalman filter's gain falls from a large initial covariance).
+    learnt: f64,
     /// The observer learns from the next fixes (the fix quality vouches for them).
     learn: bool,
+    /// The next fixes are RTK float: coast (see [`ObserverParams::coast_max`]).
+    coast: bool,
+    /// Dead reckoning through an RTK float or a position jump.
+    coast_state: Coast,
 }
 
 impl Estimator {
@@ -158,8 +222,24 @@ impl Estimator {
             wheel_len: 0,
             bias: 0.0,
             drift: Vec2::zeros(),
+            slip: 0.0,
+            roll: 0.0,
+            learnt: 0.0,
             learn: true,
+            coast: false,
+            coast_state: Coast::Off,
         }
+    }
+
+    /// Whether the next fixes are RTK float (coast through them, see
+    /// [`ObserverParams::coast_max`]).
+    pub fn set_coasting(&mut self, coast: bool) {
+        self.coast = coast;
+    }
+
+    /// Whether the position is being dead-reckoned through an RTK-float period.
+    pub fn is_coasting(&self) -> bool {
+        matches!(self.coast_state, Coast::Float(_) | Coast::Jump(_))
     }
 
     /// Whether the observer may learn from the following fixes (off while the fix is not RTK
@@ -173,9 +253,20 @@ impl Estimator {
         self.bias
     }
 
-    /// The estimated world-frame drift velocity, m/s.
+    /// The estimated world-frame drift velocity, m/s (without the slope slip).
     pub fn drift(&self) -> Vec2 {
         self.drift
+    }
+
+    /// The estimated slope-slip coefficient, m/s per rad of roll.
+    pub fn slip_coefficient(&self) -> f64 {
+        self.slip
+    }
+
+    /// The whole estimated drift velocity (world frame, m/s) of a vehicle heading `heading`
+    /// (rad) at the latest roll: the world drift plus the slope slip.
+    pub fn drift_velocity(&self, heading: f64) -> Vec2 {
+        self.drift - left_normal(&heading_vec(heading)) * (self.slip * self.roll.sin())
     }
 
     /// Integrate the bicycle model from `pose` at `t0` over `span` s at speed `v`, with the
@@ -191,51 +282,68 @@ impl Estimator {
                 let t_mid = t0 + (i as f64 + 0.5) * h;
                 let rate = v * (self.wheel_angle_at(t_mid) - self.bias).tan() / l;
                 let th_mid = th + 0.5 * h * rate;
-                x += (v * th_mid.cos() + self.drift.x) * h;
-                y += (v * th_mid.sin() + self.drift.y) * h;
+                let drift = self.drift_velocity(th_mid);
+                x += (v * th_mid.cos() + drift.x) * h;
+                y += (v * th_mid.sin() + drift.y) * h;
                 th += rate * h;
             }
         }
         Pose::new(x, y, th)
     }
 
-    /// Learn from the innovation of the fix `new` (measured at `t_new`) against the pose
-    /// predicted from the previous fix.
-    fn observe(&mut self, new: &Pose, t_new: f64, v_new: f64) {
-        let o = self.params.observer;
-        if o.bias_tau <= 0.0 && o.drift_tau <= 0.0 {
-            return;
-        }
-        let Some(prev) = self.fix_pose else {
-            return;
-        };
+    /// The fix `new` (measured at `t_new`) against the pose predicted from the previous fix.
+    fn innovation(&self, new: &Pose, t_new: f64) -> Option<Innovation> {
+        let prev = self.fix_pose?;
         let t_prev = self.fix_time - self.params.gnss_latency;
         let dt = t_new - t_prev;
+        if !(dt > 0.0 && dt <= 1.0) {
+            return None;
+        }
+        let predicted = self.propagate(prev, self.fix_speed, t_prev, dt);
+        let normal = left_normal(&heading_vec(new.heading));
+        Some(Innovation {
+            predicted,
+            t_prev,
+            dt,
+            heading: wrap_angle(new.heading - predicted.heading),
+            lateral: (new.pos - predicted.pos).dot(&normal),
+            normal,
+        })
+    }
+
+    /// Learn the disturbances from an innovation within the gates.
+    fn observe(&mut self, i: &Innovation, v_new: f64) {
+        let o = self.params.observer;
         let v = self.fix_speed;
         if !self.learn
-            || !(dt > 0.0 && dt <= 0.5)
+            || i.dt > 0.5
             || v.abs() < o.min_speed
             || v_new.abs() < o.min_speed
+            || i.heading.abs() > GATE_HEADING
+            || i.lateral.abs() > GATE_LATERAL
         {
             return;
         }
-        let pred = self.propagate(prev, v, t_prev, dt);
-        let d_heading = wrap_angle(new.heading - pred.heading);
-        let n = left_normal(&heading_vec(new.heading));
-        let d_lateral = (new.pos - pred.pos).dot(&n);
-        if d_heading.abs() > GATE_HEADING || d_lateral.abs() > GATE_LATERAL {
-            return;
-        }
+        let (dt, t_prev, d_heading, d_lateral, n) =
+            (i.dt, i.t_prev, i.heading, i.lateral, i.normal);
+        self.learnt += dt;
+        let tau = |configured: f64| configured.min(self.learnt.max(MIN_TAU));
         if o.bias_tau > 0.0 {
             let delta = self.wheel_angle_at(t_prev + 0.5 * dt) - self.bias;
             if delta.abs() < BIAS_MAX_WHEEL {
                 let c = delta.cos();
-                let step = -d_heading * self.params.wheelbase * c * c / (v * o.bias_tau);
+                let step = -d_heading * self.params.wheelbase * c * c / (v * tau(o.bias_tau));
                 self.bias = (self.bias + step).clamp(-o.bias_limit, o.bias_limit);
             }
         }
+        if o.slip_tau > 0.0 {
+            // Normalised LMS on the lateral rate error e = Δl/Δt with regressor −sin(roll).
+            let phi = -self.roll.sin();
+            let step = d_lateral / tau(o.slip_tau) * phi / (phi * phi + SLIP_EPS);
+            self.slip = (self.slip + step).clamp(-o.slip_limit, o.slip_limit);
+        }
         if o.drift_tau > 0.0 {
-            self.drift += n * (d_lateral / o.drift_tau);
+            self.drift += n * (d_lateral / tau(o.drift_tau));
             let norm = self.drift.norm();
             if norm > o.drift_limit {
                 self.drift *= o.drift_limit / norm;
@@ -294,10 +402,45 @@ impl Estimator {
         let roll = fix
             .roll
             .filter(|r| r.is_finite() && self.params.roll_compensation);
+        self.roll = roll.unwrap_or(0.0);
         let pos = self.antenna_to_rear_axle(&fix.antenna, heading, roll);
-        let pose = Pose::new(pos.x, pos.y, heading);
-        if self.params.predict {
-            self.observe(&pose, fix.t_received - self.params.gnss_latency, fix.speed);
+        let mut pose = Pose::new(pos.x, pos.y, heading);
+        let t_meas = fix.t_received - self.params.gnss_latency;
+        let o = self.params.observer;
+        let innovation = if self.params.predict
+            && (o.bias_tau > 0.0 || o.drift_tau > 0.0 || o.coast_max > 0.0)
+        {
+            self.innovation(&pose, t_meas)
+        } else {
+            None
+        };
+        let jump = innovation
+            .is_some_and(|i| i.lateral.abs() > GATE_LATERAL || i.heading.abs() > GATE_HEADING);
+        let t = fix.t_received;
+        let expired = |since: f64| t - since > o.coast_max;
+        self.coast_state = match (innovation.is_some() && o.coast_max > 0.0, self.coast_state) {
+            (false, _) => Coast::Off,
+            (true, Coast::Off) if self.coast => Coast::Float(t),
+            (true, Coast::Off) if jump && self.learn => Coast::Jump(t),
+            (true, Coast::Off) => Coast::Off,
+            (true, Coast::Float(_)) if !self.coast => Coast::Off,
+            (true, Coast::Float(s)) if expired(s) => Coast::Expired,
+            (true, Coast::Float(s)) => Coast::Float(s),
+            (true, Coast::Jump(s)) if self.coast => Coast::Float(s),
+            (true, Coast::Jump(_)) if !jump => Coast::Off,
+            (true, Coast::Jump(s)) if expired(s) => Coast::Expired,
+            (true, Coast::Jump(s)) => Coast::Jump(s),
+            (true, Coast::Expired) if !self.coast && !jump => Coast::Off,
+            (true, Coast::Expired) => Coast::Expired,
+        };
+        match (self.coast_state, innovation) {
+            (Coast::Float(_) | Coast::Jump(_), Some(i)) => {
+                // Dead reckoning from the previous (coasted or fixed) position; the heading is
+                // measured.
+                pose = Pose::new(i.predicted.pos.x, i.predicted.pos.y, heading);
+            }
+            (_, Some(i)) => self.observe(&i, fix.speed),
+            _ => {}
         }
         self.fix_pose = Some(pose);
         self.fix_time = fix.t_received;
