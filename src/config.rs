@@ -298,7 +298,7 @@ impl Default for TrackConfig {
             observer_min_speed_mps: 1.0,
             observer_bias_limit_deg: 3.0,
             observer_drift_limit_mps: 0.3,
-            observer_slip_tau_s: 5.0,
+            observer_slip_tau_s: 15.0,
             observer_slip_limit_mps_per_deg: 0.05,
             observer_coast_max_s: 30.0,
         }
