@@ -1347,6 +1347,35 @@ mod tests {
     }
 
     #[test]
+    fn observer_and_arcs_keys_parse_and_validate() {
+        let cfg = Config::parse_with(
+            "[track]\nobserver_drift_tau_s = -1\nobserver_min_speed_mps = 0\n\
+             observer_slip_limit_mps_per_deg = 2\nobserver_coast_max_s = 700\n\
+             [job]\nkind = \"arcs\"\narc_sweep_deg = 360\nline_num = 0\n",
+            &[],
+        )
+        .unwrap();
+        assert_eq!(cfg.job.kind, JobKind::Arcs);
+        let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
+        for m in [
+            "track.observer_drift_tau_s = -1: must be in 0..=600",
+            "track.observer_min_speed_mps = 0: must be in 0.1..=10",
+            "track.observer_slip_limit_mps_per_deg = 2: must be in 0..=1",
+            "track.observer_coast_max_s = 700: must be in 0..=600",
+            "job.arc_sweep_deg = 360: must be in 1..=359",
+            "job.line_num = 0: must be in 1..=1000 when job.kind = \"arcs\"",
+        ] {
+            assert!(msgs.contains(&m.to_string()), "{m} not in {msgs:?}");
+        }
+        assert_eq!(msgs.len(), 6, "{msgs:?}");
+        // The observer is on by default (the default tracker uses it).
+        let t = TrackConfig::default();
+        assert!(t.observer_bias_tau_s > 0.0 && t.observer_drift_tau_s > 0.0);
+        assert!(t.observer_slip_tau_s > 0.0 && t.observer_coast_max_s > 0.0);
+        assert!(Config::default().validate().is_empty());
+    }
+
+    #[test]
     fn unknown_keys_are_rejected() {
         let err = Config::parse_with("[control]\ndt = 0.1\n", &[]).unwrap_err();
         assert!(err.to_string().contains("unknown field `dt`"), "{err}");

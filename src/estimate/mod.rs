@@ -637,4 +637,138 @@ mod tests {
         let est = e.estimate(0.5).unwrap();
         assert!((est.pose.heading - std::f64::consts::FRAC_PI_4).abs() < 1e-9);
     }
+
+    /// A vehicle on a straight line with a wheel-angle sensor bias and a world drift, fed to
+    /// an estimator with the observer on: fixes at 10 Hz, wheel angles at 50 Hz, heading and
+    /// position exact. Returns the estimator after `seconds` s driven at 3 m/s along `heading`.
+    fn drive(
+        e: &mut Estimator,
+        t0: f64,
+        seconds: f64,
+        start: Pose,
+        bias: f64,
+        drift: Vec2,
+        float: Option<(f64, f64, Vec2)>,
+    ) -> Pose {
+        let v = 3.0;
+        let (mut x, mut y, th) = (start.pos.x, start.pos.y, start.heading);
+        let steps = (seconds / 0.02).round() as usize;
+        for k in 1..=steps {
+            let t = t0 + k as f64 * 0.02;
+            x += (v * th.cos() + drift.x) * 0.02;
+            y += (v * th.sin() + drift.y) * 0.02;
+            // Straight: true wheel angle 0, the sensor reads the bias.
+            e.on_wheel_angle(t, bias);
+            if k % 5 == 0 {
+                let truth = Pose::new(x, y, th);
+                let mut antenna = antenna_of(e, &truth);
+                let mut in_float = false;
+                if let Some((a, b, err)) = float {
+                    if t >= a && t <= b {
+                        antenna += err;
+                        in_float = true;
+                    }
+                }
+                e.set_learning(!in_float);
+                e.set_coasting(in_float);
+                e.on_fix(&GnssFix {
+                    t_received: t + e.params().gnss_latency,
+                    antenna,
+                    heading: Some(th),
+                    speed: v,
+                    roll: None,
+                });
+            }
+        }
+        Pose::new(x, y, th)
+    }
+
+    fn observer_params() -> EstimatorParams {
+        EstimatorParams {
+            observer: ObserverParams {
+                bias_tau: 5.0,
+                drift_tau: 5.0,
+                coast_max: 30.0,
+                ..ObserverParams::default()
+            },
+            ..params(true)
+        }
+    }
+
+    #[test]
+    fn the_observer_learns_a_sensor_bias_and_a_world_drift_that_keeps_its_sign() {
+        let mut e = Estimator::new(observer_params());
+        let bias = 0.5f64.to_radians();
+        // East drift of 3 cm/s while driving north, then south.
+        let drift = v2(0.03, 0.0);
+        let north = Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+        let end = drive(&mut e, 0.0, 60.0, north, bias, drift, None);
+        assert!(
+            (e.wheel_offset() - bias).abs() < 0.05 * bias,
+            "offset {} vs {bias}",
+            e.wheel_offset()
+        );
+        assert!((e.drift() - drift).norm() < 0.003, "drift {:?}", e.drift());
+        // Turned about (the drift is on the other side of the vehicle now): the estimate is
+        // still right from the first fix, and the prediction carries it.
+        let south = Pose::new(end.pos.x + 3.0, end.pos.y, -std::f64::consts::FRAC_PI_2);
+        let t = 61.0;
+        drive(&mut e, t, 1.0, south, bias, drift, None);
+        assert!((e.drift() - drift).norm() < 0.003, "drift {:?}", e.drift());
+        // Without the observer the same drive leaves both at zero.
+        let mut off = Estimator::new(params(true));
+        drive(&mut off, 0.0, 20.0, north, bias, drift, None);
+        assert_eq!((off.wheel_offset(), off.drift()), (0.0, Vec2::zeros()));
+    }
+
+    #[test]
+    fn the_estimator_coasts_through_rtk_float_and_a_position_jump() {
+        let mut e = Estimator::new(observer_params());
+        let north = Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+        // A 20 cm float error from 30 s to 40 s: the estimate dead-reckons and stays on the
+        // true track instead.
+        let err = v2(0.2, 0.0);
+        let truth = drive(
+            &mut e,
+            0.0,
+            35.0,
+            north,
+            0.0,
+            Vec2::zeros(),
+            Some((30.0, 40.0, err)),
+        );
+        assert!(e.is_coasting());
+        let est = e.estimate(35.0).expect("an estimate").pose;
+        assert!(
+            (est.pos.x - truth.pos.x).abs() < 0.01,
+            "{est:?} vs {truth:?}"
+        );
+        // Fixed again: the fixes are taken at once.
+        let truth = drive(
+            &mut e,
+            35.0,
+            10.0,
+            truth,
+            0.0,
+            Vec2::zeros(),
+            Some((30.0, 40.0, err)),
+        );
+        assert!(!e.is_coasting());
+        let est = e.estimate(45.0).expect("an estimate").pose;
+        assert!((est.pos.x - truth.pos.x).abs() < 0.01);
+        // A 10 cm jump of a fixed solution (multipath) is not followed either, nor learnt.
+        let truth = drive(&mut e, 45.0, 5.0, truth, 0.0, Vec2::zeros(), None);
+        let before = e.drift();
+        let jump = v2(0.1, 0.0);
+        let ant = antenna_of(&e, &truth) + jump;
+        e.on_fix(&GnssFix {
+            t_received: 50.1,
+            antenna: ant,
+            heading: Some(truth.heading),
+            speed: 3.0,
+            roll: None,
+        });
+        assert!(e.is_coasting());
+        assert_eq!(e.drift(), before);
+    }
 }
