@@ -282,7 +282,7 @@ impl Default for TrackConfig {
             ld_min_m: 3.0,
             ld_gain_s: 1.2,
             local_nodes_before: 1,
-            local_nodes_after: 6,
+            local_nodes_after: 10,
             tangent_length_m: 0.25,
             local_spacing_m: 0.1,
             gnss_latency_s: 0.05,
