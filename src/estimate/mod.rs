@@ -121,10 +121,11 @@ impl Default for ObserverParams {
     }
 }
 
-/// Innovations larger than these are a jump (multipath, the onset of a float solution), not
-/// a drift: lateral m (about 3.5 σ of the innovation of two fixes with 1 cm noise each),
-/// heading rad. While RTK fixed, the estimator coasts through a jump (dead reckoning) until the
-/// fixes agree with it again, for at most [`ObserverParams::coast_max`].
+/// Innovations larger than these are not learnt from: lateral m (about 3.5 σ of the innovation
+/// of two fixes with 1 cm noise each), heading rad. A lateral one while moving is a jump
+/// (multipath, the onset of a float solution): while RTK fixed, the estimator coasts through
+/// it (dead reckoning) until the fixes agree with it again, for at most
+/// [`ObserverParams::coast_max`].
 const GATE_LATERAL: f64 = 0.05;
 const GATE_HEADING: f64 = 0.02;
 
@@ -414,8 +415,10 @@ impl Estimator {
         } else {
             None
         };
-        let jump = innovation
-            .is_some_and(|i| i.lateral.abs() > GATE_LATERAL || i.heading.abs() > GATE_HEADING);
+        // A jump is a lateral step of the position while moving: a heading that jumps (course
+        // from successive fixes at low speed) is not a reason to distrust the position.
+        let moving = self.fix_speed.abs() >= o.min_speed && fix.speed.abs() >= o.min_speed;
+        let jump = moving && innovation.is_some_and(|i| i.lateral.abs() > GATE_LATERAL);
         let t = fix.t_received;
         let expired = |since: f64| t - since > o.coast_max;
         self.coast_state = match (innovation.is_some() && o.coast_max > 0.0, self.coast_state) {
