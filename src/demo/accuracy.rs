@@ -371,8 +371,8 @@ pub fn xte_svg(title: &str, series: &[(&str, &XteSeries)]) -> String {
         r#"<text x="5" y="{:.1}">+{y_cm}</text><text x="5" y="{:.1}">-{y_cm}</text><text x="{:.1}" y="{:.1}">±2.5 cm</text><text x="{:.1}" y="{}">{x_max:.0} m</text>"#,
         py(y_cm / 100.0) + 4.0,
         py(-y_cm / 100.0) + 4.0,
-        W - M + 2.0,
-        py(0.025) + 4.0,
+        W - M - 60.0,
+        py(0.025) - 3.0,
         W - M - 40.0,
         H - 10.0
     );
