@@ -49,6 +49,7 @@ fn params() -> CoverageParams {
         swath_angle: SwathAngle::MinTurns,
         route: RouteOrder::Auto,
         small_obstacle_max_m: 0.0,
+        max_curvature_rate: 0.0,
     }
 }
 

@@ -53,6 +53,23 @@ pub enum JobKind {
     /// suite): `job.line_num` arcs from radius `job.arc_radius_m` outwards, `job.line_width_m`
     /// apart, each sweeping `job.arc_sweep_deg`, joined by headland turns.
     Arcs,
+    /// A manoeuvre with reversing (SPEC §4) from `job.maneuver_from` to `job.maneuver_to` on
+    /// the map at `job.maneuver_map_path`, planned at start-up with `[maneuver]`.
+    Maneuver,
+}
+
+/// In which order the lines of an AB job are driven.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LineOrder {
+    /// The seed-000 order: blocks of `N = 2·ceil(2·r_min/line_width) + a` lines driven in a
+    /// skip order so that every turn is a forward pi turn (SPEC §2).
+    #[default]
+    Blocks,
+    /// Adjacent lines in turn. Lines closer than `2·r_min` are joined by a fishtail turn with
+    /// a reversal (continuous-curvature when `vehicle.max_curvature_rate_per_m2` > 0). Needs a
+    /// finite `line_num`.
+    Sequential,
 }
 
 /// Side of A→B on which the following lines are laid.
@@ -89,6 +106,14 @@ pub struct JobConfig {
     /// configuration), not from the configuration file's directory. Read and planned once
     /// when agsteerd or `agsteer demo` starts.
     pub field_path: String,
+    /// For `kind = "maneuver"`: the map, GeoJSON in local metres (boundary polygon, holes and
+    /// `"obstacle": true` features are obstacles; see `agsteer maneuver`); empty = free space.
+    pub maneuver_map_path: String,
+    /// For `kind = "maneuver"`: start pose [x m, y m, heading degrees CCW from East], local
+    /// ENU about `job.origin_*`.
+    pub maneuver_from: [f64; 3],
+    /// For `kind = "maneuver"`: goal pose [x m, y m, heading degrees].
+    pub maneuver_to: [f64; 3],
     /// Point A of the first work line, local ENU [east, north], m.
     pub point_a_m: [f64; 2],
     /// Point B of the first work line, local ENU [east, north], m.
@@ -99,6 +124,10 @@ pub struct JobConfig {
     pub line_num: u64,
     /// Side of A→B on which further lines are laid: "left" or "right".
     pub side: LineSide,
+    /// For `kind = "ab"`: "blocks" (the seed-000 skip order, forward turns only) or
+    /// "sequential" (adjacent lines in turn, fishtail turns with a reversal where the lines
+    /// are closer than 2·r_min; needs `line_num` ≥ 1).
+    pub line_order: LineOrder,
     /// WGS-84 latitude of the local ENU origin, degrees.
     pub origin_lat_deg: f64,
     /// WGS-84 longitude of the local ENU origin, degrees.
@@ -115,11 +144,15 @@ impl Default for JobConfig {
         JobConfig {
             kind: JobKind::Ab,
             field_path: String::new(),
+            maneuver_map_path: String::new(),
+            maneuver_from: [0.0, 0.0, 0.0],
+            maneuver_to: [20.0, 0.0, 0.0],
             point_a_m: [0.0, 0.0],
             point_b_m: [0.0, 150.0],
             line_width_m: 3.0,
             line_num: 12,
             side: LineSide::Right,
+            line_order: LineOrder::Blocks,
             origin_lat_deg: 52.0,
             origin_lon_deg: 5.0,
             arc_radius_m: 30.0,
@@ -151,6 +184,13 @@ pub struct GuidanceConfig {
     pub stopped_speed_mps: f64,
     /// A vehicle stopped within this distance of a cusp moves on to the next segment, m.
     pub cusp_capture_m: f64,
+    /// Approach paths: when the operator engages at the start of a line too far from it to
+    /// engage (|XTE| ≥ `safety.max_engage_xte_m` or heading error ≥
+    /// `safety.max_engage_heading_error_deg`), plan a continuous-curvature path (reversing
+    /// where shorter, κ_max = 1/`vehicle.r_min_m`, σ_max = `vehicle.max_curvature_rate_per_m2`)
+    /// from the vehicle to the line start, inside the field when the job has one, and drive
+    /// it first. false = refuse to engage there, as without approach paths.
+    pub approach_paths: bool,
 }
 
 impl Default for GuidanceConfig {
@@ -165,6 +205,7 @@ impl Default for GuidanceConfig {
             cusp_decel_mps2: 0.5,
             stopped_speed_mps: 0.05,
             cusp_capture_m: 1.0,
+            approach_paths: true,
         }
     }
 }
@@ -179,12 +220,23 @@ pub struct VehicleConfig {
     pub r_min_m: f64,
     /// Largest front-wheel angle either way, degrees.
     pub max_wheel_angle_deg: f64,
+    /// Largest rate of change of the steering curvature per metre driven, 1/m² (σ_max of
+    /// the continuous-curvature turns and manoeuvres, SPEC §4). It comes from the steering
+    /// speed: about max wheel rate (rad/s) / (wheelbase (m) · speed in turns (m/s)); 30°/s,
+    /// 2.5 m and 6 km/h give 0.13. 0 = turns of arcs only (curvature steps at their ends).
+    pub max_curvature_rate_per_m2: f64,
     /// GNSS antenna position ahead of the rear-axle centre, m.
     pub antenna_forward_m: f64,
     /// GNSS antenna position left of the rear-axle centre, m.
     pub antenna_left_m: f64,
     /// GNSS antenna height above the rear-axle centre, m.
     pub antenna_up_m: f64,
+    /// Overall length of the vehicle rectangle (manoeuvre collision checks), m.
+    pub length_m: f64,
+    /// Overall width of the vehicle rectangle, m.
+    pub width_m: f64,
+    /// Distance of the rear axle ahead of the vehicle's rear edge, m.
+    pub rear_axle_from_rear_m: f64,
 }
 
 impl Default for VehicleConfig {
@@ -193,9 +245,13 @@ impl Default for VehicleConfig {
             wheelbase_m: 3.0,
             r_min_m: 5.0,
             max_wheel_angle_deg: 35.0,
+            max_curvature_rate_per_m2: 0.06,
             antenna_forward_m: 1.0,
             antenna_left_m: 0.0,
             antenna_up_m: 3.0,
+            length_m: 4.5,
+            width_m: 2.5,
+            rear_axle_from_rear_m: 1.0,
         }
     }
 }
@@ -618,6 +674,160 @@ impl Default for FieldConfig {
     }
 }
 
+/// Which curves `[maneuver]` plans with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum CurveChoice {
+    /// Continuous curvature: clothoid turns, CC Reeds-Shepp connections.
+    #[default]
+    Cc,
+    /// Plain Reeds-Shepp: arcs and lines (curvature jumps where they meet).
+    Rs,
+}
+
+/// `[maneuver]`: manoeuvres with reversing in tight spaces (`agsteer maneuver`, SPEC §4). The
+/// vehicle rectangle is `vehicle.length_m` × `vehicle.width_m` with the rear axle
+/// `vehicle.rear_axle_from_rear_m` ahead of its rear edge; the largest curvature is
+/// 1 / `vehicle.r_min_m`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ManeuverConfig {
+    /// Curve family: "cc" (continuous curvature, the default) or "rs" (plain Reeds-Shepp).
+    pub curve: CurveChoice,
+    /// Largest rate of change of curvature along the path (steering speed limit), 1/m².
+    pub max_curvature_rate_per_m2: f64,
+    /// Implement rigidly mounted behind the vehicle: length, m (0 = none), width, m, and
+    /// distance of its front edge behind the rear axle, m.
+    pub implement_length_m: f64,
+    pub implement_width_m: f64,
+    pub implement_hitch_m: f64,
+    /// Clearance kept around the vehicle (and implement) rectangle, m. Must be at least half
+    /// of `sample_tolerance_m` so that sampled checks cover the continuous sweep.
+    pub clearance_m: f64,
+    /// Largest distance any point of the vehicle moves between two collision samples, m.
+    pub sample_tolerance_m: f64,
+    /// Cell size of the collision broad-phase grid, m.
+    pub grid_cell_m: f64,
+    /// Straight-line expansion: leg length, m; join distance, m; most levels; most legs per
+    /// tree.
+    pub expansion_step_m: f64,
+    pub expansion_join_m: f64,
+    pub expansion_max_depth: usize,
+    pub expansion_max_legs: usize,
+    /// Reversing patterns tried at the goal, written for an arrival from the goal's left
+    /// (mirrored l ↔ r for the right): curves l/r, `_`, directions p (forward) / n (reverse).
+    /// Empty = no pattern stage.
+    pub goal_patterns: Vec<String>,
+    /// Search primitives: heading-change step, degrees; largest heading change, degrees;
+    /// length of the straight primitive, m.
+    pub heading_step_deg: f64,
+    pub primitive_max_deg: f64,
+    pub straight_step_m: f64,
+    /// Cost factor on reverse driving (≥ 1) and cost of each change of direction, m.
+    pub reverse_penalty: f64,
+    pub cusp_penalty_m: f64,
+    /// Duplicate-detection grid of the search: position cell, m; heading cell, degrees.
+    pub xy_resolution_m: f64,
+    pub heading_resolution_deg: f64,
+    /// Most node expansions over all searches of one plan.
+    pub max_expansions: usize,
+    /// Most expansions of the search to one goal pattern's start (part of max_expansions).
+    pub pattern_max_expansions: usize,
+    /// Try the analytic connection to the goal every this many expansions (1 = each).
+    pub analytic_every: usize,
+    /// Expansions spent after the first solution looking for a cheaper one.
+    pub extra_expansions: usize,
+    /// Points per leg tried by the fallback (search between the rough route's first and last
+    /// legs).
+    pub fallback_points: usize,
+}
+
+impl Default for ManeuverConfig {
+    fn default() -> Self {
+        ManeuverConfig {
+            curve: CurveChoice::Cc,
+            max_curvature_rate_per_m2: 0.1,
+            implement_length_m: 0.0,
+            implement_width_m: 0.0,
+            implement_hitch_m: 0.5,
+            clearance_m: 0.15,
+            sample_tolerance_m: 0.3,
+            grid_cell_m: 2.0,
+            expansion_step_m: 5.0,
+            expansion_join_m: 0.5,
+            expansion_max_depth: 8,
+            expansion_max_legs: 200,
+            goal_patterns: vec!["lrlr_pnpn".to_string(), "lr_pn".to_string()],
+            heading_step_deg: 10.0,
+            primitive_max_deg: 90.0,
+            straight_step_m: 2.0,
+            reverse_penalty: 1.5,
+            cusp_penalty_m: 5.0,
+            xy_resolution_m: 1.0,
+            heading_resolution_deg: 10.0,
+            max_expansions: 4000,
+            pattern_max_expansions: 600,
+            analytic_every: 1,
+            extra_expansions: 40,
+            fallback_points: 3,
+        }
+    }
+}
+
+impl Config {
+    /// The curve limits of `[maneuver]`: κ_max = 1 / vehicle.r_min_m, σ_max.
+    pub fn maneuver_curve_params(&self) -> crate::plan::maneuver::steering::CurveParams {
+        crate::plan::maneuver::steering::CurveParams {
+            kappa_max: 1.0 / self.vehicle.r_min_m,
+            sigma_max: self.maneuver.max_curvature_rate_per_m2,
+        }
+    }
+
+    /// The manoeuvre planner's parameters from `[maneuver]` and `[vehicle]`, SI.
+    pub fn maneuver_params(&self) -> crate::plan::maneuver::search::ManeuverParams {
+        use crate::plan::maneuver::collision::{Footprint, ImplementBox, VehicleBox};
+        use crate::plan::maneuver::expansion::ExpansionParams;
+        let m = &self.maneuver;
+        let v = &self.vehicle;
+        crate::plan::maneuver::search::ManeuverParams {
+            footprint: Footprint {
+                vehicle: VehicleBox {
+                    length_m: v.length_m,
+                    width_m: v.width_m,
+                    rear_axle_from_rear_m: v.rear_axle_from_rear_m,
+                },
+                implement: (m.implement_length_m > 0.0).then_some(ImplementBox {
+                    length_m: m.implement_length_m,
+                    width_m: m.implement_width_m,
+                    hitch_offset_m: m.implement_hitch_m,
+                }),
+                margin_m: m.clearance_m,
+            },
+            sample_tolerance_m: m.sample_tolerance_m,
+            grid_cell_m: m.grid_cell_m,
+            expansion: ExpansionParams {
+                step_m: m.expansion_step_m,
+                join_m: m.expansion_join_m,
+                max_depth: m.expansion_max_depth,
+                max_legs: m.expansion_max_legs,
+            },
+            goal_patterns: m.goal_patterns.clone(),
+            heading_step_rad: m.heading_step_deg.to_radians(),
+            primitive_max_rad: m.primitive_max_deg.to_radians(),
+            straight_step_m: m.straight_step_m,
+            reverse_penalty: m.reverse_penalty,
+            cusp_penalty_m: m.cusp_penalty_m,
+            xy_resolution_m: m.xy_resolution_m,
+            heading_resolution_rad: m.heading_resolution_deg.to_radians(),
+            max_expansions: m.max_expansions,
+            pattern_max_expansions: m.pattern_max_expansions,
+            analytic_every: m.analytic_every,
+            extra_expansions: m.extra_expansions,
+            fallback_points: m.fallback_points,
+        }
+    }
+}
+
 impl Config {
     /// Coverage planner parameters from `[field]`, `job`, `vehicle` and `guidance`.
     pub fn coverage_params(&self) -> crate::plan::coverage::CoverageParams {
@@ -637,6 +847,7 @@ impl Config {
             },
             route: f.route,
             small_obstacle_max_m: f.small_obstacle_max_m,
+            max_curvature_rate: self.vehicle.max_curvature_rate_per_m2,
         }
     }
 
@@ -670,6 +881,7 @@ pub struct Config {
     pub safety: SafetyConfig,
     pub daemon: DaemonConfig,
     pub field: FieldConfig,
+    pub maneuver: ManeuverConfig,
 }
 
 /// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
@@ -801,6 +1013,25 @@ impl Config {
             );
         }
         c.range("job.line_width_m", j.line_width_m, 0.1, 100.0);
+        if j.kind == JobKind::Ab && j.line_order == LineOrder::Sequential && j.line_num == 0 {
+            c.push(
+                "job.line_num",
+                "0".to_string(),
+                "must be at least 1 when job.line_order = \"sequential\" (the whole job is planned at start)",
+            );
+        }
+        for (key, pose) in [
+            ("job.maneuver_from", j.maneuver_from),
+            ("job.maneuver_to", j.maneuver_to),
+        ] {
+            if pose.iter().any(|v| !v.is_finite()) {
+                c.push(
+                    key,
+                    format!("{pose:?}"),
+                    "must be [x m, y m, heading degrees], all finite",
+                );
+            }
+        }
         if j.kind == JobKind::Field && j.field_path.trim().is_empty() {
             c.push(
                 "job.field_path",
@@ -873,6 +1104,12 @@ impl Config {
         let v = &self.vehicle;
         c.range("vehicle.wheelbase_m", v.wheelbase_m, 0.5, 20.0);
         c.range("vehicle.r_min_m", v.r_min_m, 0.5, 100.0);
+        c.range(
+            "vehicle.max_curvature_rate_per_m2",
+            v.max_curvature_rate_per_m2,
+            0.0,
+            10.0,
+        );
         c.range(
             "vehicle.max_wheel_angle_deg",
             v.max_wheel_angle_deg,
@@ -1152,6 +1389,22 @@ impl Config {
             1.0,
             500.0,
         );
+        c.range("vehicle.length_m", v.length_m, 0.5, 40.0);
+        c.range("vehicle.width_m", v.width_m, 0.3, 20.0);
+        c.range(
+            "vehicle.rear_axle_from_rear_m",
+            v.rear_axle_from_rear_m,
+            0.0,
+            40.0,
+        );
+        if v.rear_axle_from_rear_m > v.length_m {
+            c.push(
+                "vehicle.rear_axle_from_rear_m",
+                fmt_num(v.rear_axle_from_rear_m),
+                "must be at most vehicle.length_m",
+            );
+        }
+        self.validate_maneuver(&mut c);
         if !["error", "warn", "info", "debug", "trace"].contains(&self.daemon.log_level.as_str()) {
             c.push(
                 "daemon.log_level",
@@ -1170,6 +1423,115 @@ impl Config {
             c.push("progress.state_dir", "\"\"".into(), "must not be empty");
         }
         c.problems
+    }
+
+    fn validate_maneuver(&self, c: &mut Checker) {
+        let m = &self.maneuver;
+        c.range(
+            "maneuver.max_curvature_rate_per_m2",
+            m.max_curvature_rate_per_m2,
+            0.001,
+            10.0,
+        );
+        c.range(
+            "maneuver.implement_length_m",
+            m.implement_length_m,
+            0.0,
+            40.0,
+        );
+        if m.implement_length_m > 0.0 {
+            c.range("maneuver.implement_width_m", m.implement_width_m, 0.1, 60.0);
+        }
+        c.range("maneuver.implement_hitch_m", m.implement_hitch_m, 0.0, 20.0);
+        c.range("maneuver.clearance_m", m.clearance_m, 0.0, 5.0);
+        c.range(
+            "maneuver.sample_tolerance_m",
+            m.sample_tolerance_m,
+            0.01,
+            2.0,
+        );
+        if m.clearance_m.is_finite() && m.clearance_m < 0.5 * m.sample_tolerance_m {
+            c.push(
+                "maneuver.clearance_m",
+                fmt_num(m.clearance_m),
+                "must be at least half of maneuver.sample_tolerance_m, or sampled checks may miss a corner cut between samples",
+            );
+        }
+        c.range("maneuver.grid_cell_m", m.grid_cell_m, 0.1, 1000.0);
+        c.range("maneuver.expansion_step_m", m.expansion_step_m, 0.5, 100.0);
+        c.range("maneuver.expansion_join_m", m.expansion_join_m, 0.0, 20.0);
+        let count = |c: &mut Checker, key: &str, v: usize, lo: usize, hi: usize| {
+            if !(lo..=hi).contains(&v) {
+                c.push(
+                    key,
+                    v.to_string(),
+                    &format!("must be an integer in {lo}..={hi}"),
+                );
+            }
+        };
+        count(
+            c,
+            "maneuver.expansion_max_depth",
+            m.expansion_max_depth,
+            1,
+            100,
+        );
+        count(
+            c,
+            "maneuver.expansion_max_legs",
+            m.expansion_max_legs,
+            2,
+            100_000,
+        );
+        for (i, pat) in m.goal_patterns.iter().enumerate() {
+            if crate::plan::maneuver::search::parse_pattern(pat).is_err() {
+                c.push(
+                    &format!("maneuver.goal_patterns[{i}]"),
+                    format!("{pat:?}"),
+                    "must be curves l/r, `_`, then as many directions p/n, e.g. \"lrlr_pnpn\"",
+                );
+            }
+        }
+        c.range("maneuver.heading_step_deg", m.heading_step_deg, 1.0, 90.0);
+        c.range(
+            "maneuver.primitive_max_deg",
+            m.primitive_max_deg,
+            0.0,
+            180.0,
+        );
+        c.range("maneuver.straight_step_m", m.straight_step_m, 0.1, 50.0);
+        c.range("maneuver.reverse_penalty", m.reverse_penalty, 1.0, 100.0);
+        c.range("maneuver.cusp_penalty_m", m.cusp_penalty_m, 0.0, 1000.0);
+        c.range("maneuver.xy_resolution_m", m.xy_resolution_m, 0.05, 50.0);
+        c.range(
+            "maneuver.heading_resolution_deg",
+            m.heading_resolution_deg,
+            1.0,
+            90.0,
+        );
+        count(
+            c,
+            "maneuver.max_expansions",
+            m.max_expansions,
+            1,
+            10_000_000,
+        );
+        count(
+            c,
+            "maneuver.pattern_max_expansions",
+            m.pattern_max_expansions,
+            0,
+            10_000_000,
+        );
+        count(c, "maneuver.analytic_every", m.analytic_every, 1, 10_000);
+        count(
+            c,
+            "maneuver.extra_expansions",
+            m.extra_expansions,
+            0,
+            10_000_000,
+        );
+        count(c, "maneuver.fallback_points", m.fallback_points, 1, 100);
     }
 
     /// The keys that cannot change while the daemon runs a job: those defining the job (the
@@ -1460,6 +1822,40 @@ mod tests {
             .iter()
             .any(|p| p.key == "field.boundary_tolerance_m"));
         assert!(Config::parse_with("[field]\nswath_angle = \"diagonal\"\n", &[]).is_err());
+    }
+
+    #[test]
+    fn maneuver_section_parses_validates_and_builds_params() {
+        let cfg = Config::parse_with(
+            "[maneuver]\ncurve = \"rs\"\nimplement_length_m = 2.0\nimplement_width_m = 3.0\n\
+             goal_patterns = [\"rlr_pnp\"]\n[vehicle]\nlength_m = 5.0\n",
+            &["maneuver.heading_step_deg=5".into()],
+        )
+        .unwrap();
+        assert!(cfg.validate().is_empty(), "{:?}", cfg.validate());
+        assert_eq!(cfg.maneuver.curve, CurveChoice::Rs);
+        let p = cfg.maneuver_params();
+        assert_eq!(p.footprint.vehicle.length_m, 5.0);
+        assert_eq!(p.footprint.implement.map(|i| i.width_m), Some(3.0));
+        assert!((p.heading_step_rad - 5f64.to_radians()).abs() < 1e-12);
+        assert!((cfg.maneuver_curve_params().kappa_max - 1.0 / cfg.vehicle.r_min_m).abs() < 1e-12);
+        let bad = Config::parse_with(
+            "[maneuver]\ngoal_patterns = [\"lrx_pn\"]\nclearance_m = 0.05\nsample_tolerance_m = 0.3\n\
+             max_expansions = 0\nreverse_penalty = 0.5\n[vehicle]\nrear_axle_from_rear_m = 9\n",
+            &[],
+        )
+        .unwrap();
+        let keys: Vec<String> = bad.validate().into_iter().map(|p| p.key).collect();
+        for k in [
+            "maneuver.goal_patterns[0]",
+            "maneuver.clearance_m",
+            "maneuver.max_expansions",
+            "maneuver.reverse_penalty",
+            "vehicle.rear_axle_from_rear_m",
+        ] {
+            assert!(keys.iter().any(|x| x == k), "{k} in {keys:?}");
+        }
+        assert!(Config::parse_with("[maneuver]\ncurve = \"dubins\"\n", &[]).is_err());
     }
 
     #[test]

@@ -158,6 +158,114 @@ fn frames_table_is_up_to_date() {
 }
 
 #[test]
+fn maneuver_single_batch_and_bad_endpoint() {
+    // Single: the three-point turn scenario, JSON.
+    let (code, out, err) = agsteer(
+        &[
+            "maneuver",
+            "--config",
+            "config/demo.toml",
+            "--map",
+            "tools/maneuvers/three_point_turn.geojson",
+            "--from",
+            "20,3.5,0",
+            "--to",
+            "20,8.5,180",
+            "--json",
+        ],
+        "",
+    );
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["found"], true);
+    assert!(v["cusps"].as_u64().unwrap() >= 1, "{v}");
+    assert!(v["reverse_length_m"].as_f64().unwrap() > 0.0);
+    let segs = v["segments"].as_array().unwrap();
+    let sum: f64 = segs.iter().map(|s| s["length_m"].as_f64().unwrap()).sum();
+    assert!((sum - v["length_m"].as_f64().unwrap()).abs() < 1e-6);
+    assert!(segs.iter().any(|s| s["direction"] == "reverse"));
+    assert!(v["max_curvature"].as_f64().unwrap() <= 0.2 + 1e-9);
+    assert!(v["max_curvature_rate"].as_f64().unwrap() <= 0.1 + 1e-9);
+    assert!(v["plan_time_ms"].as_f64().unwrap() >= 0.0);
+    // --set reaches the planner: a larger radius is reported in the curvature.
+    let (code, out, err) = agsteer(
+        &[
+            "maneuver",
+            "--from",
+            "0,0,0",
+            "--to",
+            "40,-20,-90",
+            "--json",
+            "--set",
+            "vehicle.r_min_m=8",
+            "--curve",
+            "rs",
+        ],
+        "",
+    );
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(
+        (v["max_curvature"].as_f64().unwrap() - 0.125).abs() < 1e-9,
+        "{v}"
+    );
+    assert_eq!(v["max_curvature_rate"], 0.0);
+
+    // Batch: one JSON result per line, a bad endpoint reported in its line.
+    let dir = tempfile::tempdir().unwrap();
+    let batch = dir.path().join("b.jsonl");
+    std::fs::write(
+        &batch,
+        "{\"from\":[20,3.5,0],\"to\":[20,8.5,180]}\n\n{\"from\":[5,6,0],\"to\":[40,6,0]}\n{\"from\":[5,6,0],\"to\":[59,6,0]}\n",
+    )
+    .unwrap();
+    let (code, out, err) = agsteer(
+        &[
+            "maneuver",
+            "--map",
+            "tools/maneuvers/three_point_turn.geojson",
+            "--batch",
+            batch.to_str().unwrap(),
+        ],
+        "",
+    );
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<serde_json::Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 3);
+    assert_eq!(lines[0]["found"], true);
+    assert_eq!(lines[1]["found"], true);
+    assert_eq!(lines[1]["cusps"], 0);
+    assert!((lines[1]["length_m"].as_f64().unwrap() - 35.0).abs() < 1e-6);
+    assert_eq!(lines[2]["found"], false);
+    assert_eq!(
+        lines[2]["error"],
+        "goal pose is invalid: the vehicle is not inside the map boundary"
+    );
+
+    // Single with a bad start: an error naming the endpoint, exit status 1.
+    let (code, _, err) = agsteer(
+        &[
+            "maneuver",
+            "--map",
+            "tools/maneuvers/obstacle_slalom.geojson",
+            "--from",
+            "18,3,90",
+            "--to",
+            "66,10.5,0",
+        ],
+        "",
+    );
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("start pose is invalid: the vehicle touches obstacle 0"),
+        "{err}"
+    );
+}
+
+#[test]
 fn accuracy_runs_the_chosen_scenarios_and_writes_json_and_svgs() {
     let out = std::env::temp_dir().join(format!("agsteer-accuracy-{}", std::process::id()));
     let out_s = out.to_string_lossy().into_owned();

@@ -5,7 +5,7 @@
 //! allocation-free per cycle and never does I/O: callers feed it inputs and persist the
 //! progress snapshots it hands out.
 
-use crate::config::{Config, JobKind, LineSide, TrackerChoice};
+use crate::config::{Config, JobKind, LineOrder, LineSide, TrackerChoice};
 use crate::estimate::{
     AntennaOffset, Estimator, EstimatorParams, GnssFix, ObserverParams, VehicleEstimate,
 };
@@ -42,6 +42,7 @@ pub fn ab_params(cfg: &Config) -> AbParams {
             merge_distance: cfg.guidance.turn_merge_distance_m,
             point_spacing: cfg.guidance.point_spacing_m,
             max_points: cfg.guidance.turn_max_points,
+            max_curvature_rate: cfg.vehicle.max_curvature_rate_per_m2,
         },
     }
 }
@@ -60,6 +61,29 @@ pub fn arcs_plan(cfg: &Config) -> Result<JobPlan, crate::plan::PlanError> {
         turn: ab.turn,
     })?;
     Ok(JobPlan::Segments(job))
+}
+
+/// The AB job configured by `cfg`: the seed-000 block plan, or (`job.line_order =
+/// "sequential"`) every line and turn in turn as a segment job.
+pub fn ab_job_plan(cfg: &Config) -> Result<JobPlan, ControlError> {
+    let params = ab_params(cfg);
+    Ok(match cfg.job.line_order {
+        LineOrder::Blocks => AbPlan::new(params)?.into(),
+        LineOrder::Sequential => {
+            let segments = crate::plan::abline::sequential_segments(&params)?;
+            JobPlan::Segments(crate::guidance::segments::SegmentJob::new(
+                segments
+                    .into_iter()
+                    .map(|s| crate::guidance::segments::JobSegment {
+                        kind: s.kind,
+                        direction: s.direction,
+                        cell: s.cell,
+                        points: s.points,
+                    })
+                    .collect(),
+            )?)
+        }
+    })
 }
 
 /// The state machine's parameters from the configuration.
@@ -172,7 +196,7 @@ pub enum ControlError {
     Guidance(#[from] GuidanceError),
     #[error("cannot plan the job: {0}")]
     Plan(#[from] crate::plan::PlanError),
-    #[error("job.kind = \"field\" needs its field plan: load it first (the daemon and `agsteer demo` read job.field_path)")]
+    #[error("job.kind = \"field\" or \"maneuver\" needs its plan: load it first (the daemon and `agsteer demo` read job.field_path or job.maneuver_map_path)")]
     NoPlan,
 }
 
@@ -221,15 +245,52 @@ pub struct Controller {
     integral: IntegralAction,
     /// Time of the previous tick, s.
     last_tick: Option<f64>,
+    /// Approach paths (`guidance.approach_paths`), `None` when off.
+    approach: Option<ApproachSettings>,
+}
+
+/// Whether a sampled approach path keeps the vehicle inside the field and off its obstacles.
+pub type ClearanceCheck =
+    std::sync::Arc<dyn Fn(&crate::plan::maneuver::path::CurvePath) -> bool + Send + Sync>;
+
+/// How approach paths are planned (issue 6 part 5b).
+#[derive(Clone)]
+pub struct ApproachSettings {
+    pub curve: crate::plan::maneuver::path::CurveParams,
+    /// Spacing of the approach path's points, m.
+    pub spacing: f64,
+    /// An approach is planned when |XTE| or the heading error reach these (the engage
+    /// limits), m and rad.
+    pub max_xte: f64,
+    pub max_heading_error: f64,
+    /// The field check, when the job has a field.
+    pub clear: Option<ClearanceCheck>,
+}
+
+/// Approach settings from the configuration (`None` when `guidance.approach_paths` is off or
+/// `vehicle.max_curvature_rate_per_m2` is 0).
+pub fn approach_settings(cfg: &Config) -> Option<ApproachSettings> {
+    (cfg.guidance.approach_paths && cfg.vehicle.max_curvature_rate_per_m2 > 0.0).then(|| {
+        ApproachSettings {
+            curve: crate::plan::maneuver::path::CurveParams {
+                kappa_max: 1.0 / cfg.vehicle.r_min_m,
+                sigma_max: cfg.vehicle.max_curvature_rate_per_m2,
+            },
+            spacing: cfg.guidance.point_spacing_m.min(0.5),
+            max_xte: cfg.safety.max_engage_xte_m,
+            max_heading_error: cfg.safety.max_engage_heading_error_deg.to_radians(),
+            clear: None,
+        }
+    })
 }
 
 impl Controller {
     /// A new job, or the continuation of `resume`.
     pub fn from_config(cfg: &Config, resume: Option<&Progress>) -> Result<Self, ControlError> {
         match cfg.job.kind {
-            JobKind::Field => Err(ControlError::NoPlan),
+            JobKind::Field | JobKind::Maneuver => Err(ControlError::NoPlan),
             JobKind::Arcs => Controller::with_job(cfg, arcs_plan(cfg)?, resume),
-            JobKind::Ab => Controller::with_job(cfg, AbPlan::new(ab_params(cfg))?.into(), resume),
+            JobKind::Ab => Controller::with_job(cfg, ab_job_plan(cfg)?, resume),
         }
     }
 
@@ -252,7 +313,65 @@ impl Controller {
             law: law_params(cfg),
             integral: integral_action(cfg, 0.0),
             last_tick: None,
+            approach: approach_settings(cfg),
         })
+    }
+
+    /// Check approach paths against the job's field (see [`ClearanceCheck`]).
+    pub fn set_approach_clearance(&mut self, clear: ClearanceCheck) {
+        if let Some(a) = &mut self.approach {
+            a.clear = Some(clear);
+        }
+    }
+
+    /// On an engage request at time `t`: when the job has not finished a line yet and the
+    /// vehicle is too far from the first line to engage, plan an approach path to the line
+    /// start and drive it first. `None` when no approach is needed (or approaches are off);
+    /// else the number of parts (1 + cusps) or why none could be planned. Runs the analytic
+    /// connection and the field check only (well under a millisecond).
+    pub fn plan_approach(
+        &mut self,
+        t: f64,
+    ) -> Option<Result<usize, crate::plan::maneuver::approach::ApproachError>> {
+        let a = self.approach.as_ref()?;
+        let g = &self.guidance;
+        if g.is_finished()
+            || g.is_approaching()
+            || g.phase() != crate::guidance::progress::Phase::Work
+            || g.lines_done() > 0
+        {
+            return None;
+        }
+        let est = self.estimator.estimate(t)?;
+        let (xte, heading_error) = g.errors(&est.pose)?;
+        if xte.abs() < a.max_xte && heading_error.abs() < a.max_heading_error {
+            return None;
+        }
+        let to = self.path_start_pose()?;
+        let always = |_: &crate::plan::maneuver::path::CurvePath| true;
+        let clear: &dyn Fn(&crate::plan::maneuver::path::CurvePath) -> bool = match &a.clear {
+            Some(c) => c.as_ref(),
+            None => &always,
+        };
+        let result = crate::plan::maneuver::approach::approach_path(
+            &est.pose, &to, &a.curve, a.spacing, clear,
+        )
+        .map(|(_, parts)| {
+            let n = parts.len();
+            // Accepted: the conditions above are the guidance's own.
+            let segments = parts
+                .into_iter()
+                .map(|p| crate::guidance::segments::JobSegment {
+                    kind: crate::plan::coverage::SegmentKind::Transit,
+                    direction: p.direction,
+                    cell: 0,
+                    points: p.points,
+                })
+                .collect();
+            self.guidance.set_approach(segments);
+            n
+        });
+        Some(result)
     }
 
     pub fn on_fix(&mut self, fix: &GnssFix) {

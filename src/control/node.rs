@@ -73,6 +73,8 @@ pub struct ControllerNode {
     /// A stop for a change of direction is under way (from the stop request until the vehicle
     /// moves the new way at the minimum speed).
     cusp: bool,
+    /// The last approach request was refused (already logged).
+    approach_refused: bool,
     last_request: Option<f64>,
 }
 
@@ -163,6 +165,7 @@ impl ControllerNode {
                 min_speed: cfg.safety.min_speed_kmh / 3.6,
             },
             cusp: false,
+            approach_refused: false,
             last_request: None,
             status: NodeStatus {
                 state: SafetyState::Disengaged,
@@ -304,6 +307,18 @@ impl ControllerNode {
         } else if let Some(m) = d.to::<OperatorCommand>() {
             match m.command {
                 c if c == operator::ENGAGE || c == operator::RESUME => {
+                    match self.ctrl.plan_approach(t) {
+                        Some(Ok(parts)) => {
+                            self.approach_refused = false;
+                            tracing::info!(parts, "approach path to the line start planned")
+                        }
+                        // Logged once per run of refusals (an operator may hold the button).
+                        Some(Err(e)) if !self.approach_refused => {
+                            self.approach_refused = true;
+                            tracing::warn!("no approach path: {e}")
+                        }
+                        _ => {}
+                    }
                     self.supervisor.request_engage()
                 }
                 c if c == operator::DISENGAGE || c == operator::PAUSE => {
@@ -314,15 +329,19 @@ impl ControllerNode {
         }
     }
 
-    /// The direction to request this period, for segment jobs (AB jobs are driven forward
-    /// throughout and send none). Before a cusp: stop once within the stopping distance; when
+    /// The direction to request this period, for segment jobs and approach paths (AB jobs
+    /// are driven forward and send none unless an approach path came first). Before a cusp: stop once within the stopping distance; when
     /// stopped near the cusp, move on to the next segment and request its direction.
     fn direction_request(&mut self, c: &super::ControlOutput) -> Option<f64> {
         use crate::geo::Direction;
         use direction_request::STOP;
         let p = self.cusps;
         let g = self.ctrl.guidance();
-        if !matches!(g.job_plan(), crate::guidance::JobPlan::Segments(_)) {
+        // AB jobs send none, unless an approach path has made the node ask for a direction.
+        if !matches!(g.job_plan(), crate::guidance::JobPlan::Segments(_))
+            && !g.is_approaching()
+            && self.last_request.is_none()
+        {
             return None;
         }
         if g.is_finished() {

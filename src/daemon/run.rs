@@ -16,7 +16,6 @@ use crate::control::ControlError;
 use crate::geo::wgs84::LatLon;
 use crate::guidance::progress::{JobDefinition, Progress};
 use crate::guidance::JobPlan;
-use crate::plan::abline::AbPlan;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
@@ -38,6 +37,8 @@ pub enum DaemonError {
     Control(#[from] ControlError),
     #[error("job.kind = \"field\": cannot prepare the field job")]
     Field(#[source] crate::field::job::FieldJobError),
+    #[error("job.kind = \"maneuver\": cannot prepare the manoeuvre")]
+    Maneuver(#[source] super::maneuver_file::ManeuverFileError),
     #[error("runtime: {0}")]
     Runtime(std::io::Error),
 }
@@ -109,16 +110,16 @@ pub struct DaemonJob {
     pub definition: JobDefinition,
     /// ENU origin of the plan's coordinates when it is not `job.origin_*` (a field plan).
     pub origin: Option<LatLon>,
+    /// The field (local ENU about `origin`), which approach paths must stay in.
+    pub field: Option<crate::plan::coverage::Field>,
 }
 
 /// Prepare the configured job. For `job.kind = "field"` this reads `job.field_path` and plans
 /// its coverage: blocking work, done once at start-up, never in the control loop.
 pub fn prepare_job(cfg: &Config) -> Result<DaemonJob, DaemonError> {
+    let mut field = None;
     let (plan, origin) = match cfg.job.kind {
-        JobKind::Ab => {
-            let plan = AbPlan::new(crate::control::ab_params(cfg)).map_err(ControlError::from)?;
-            (JobPlan::from(plan), None)
-        }
+        JobKind::Ab => (crate::control::ab_job_plan(cfg)?, None),
         JobKind::Arcs => (
             crate::control::arcs_plan(cfg).map_err(ControlError::from)?,
             None,
@@ -138,13 +139,25 @@ pub fn prepare_job(cfg: &Config) -> Result<DaemonJob, DaemonError> {
                 "field job planned from {}",
                 fj.path.display()
             );
+            field = Some(fj.loaded.field.clone());
             (fj.job_plan(), Some(fj.origin()))
+        }
+        JobKind::Maneuver => {
+            let (mj, _) = super::maneuver_file::load(cfg).map_err(DaemonError::Maneuver)?;
+            tracing::info!(
+                length_m = format_args!("{:.1}", mj.path.length()),
+                cusps = mj.path.cusps(),
+                segments = mj.job.len(),
+                "manoeuvre planned"
+            );
+            (JobPlan::Segments(mj.job), None)
         }
     };
     Ok(DaemonJob {
         definition: JobDefinition::for_job(cfg, &plan),
         plan,
         origin,
+        field,
     })
 }
 
@@ -154,7 +167,13 @@ pub fn build_node(
     job: &DaemonJob,
     resume: Option<&Progress>,
 ) -> Result<ControllerNode, ControlError> {
-    let node = ControllerNode::with_job(cfg, job.plan.clone(), resume)?;
+    let mut node = ControllerNode::with_job(cfg, job.plan.clone(), resume)?;
+    if let Some(field) = &job.field {
+        match crate::plan::maneuver::job::field_clearance(cfg, field) {
+            Ok(clear) => node.controller_mut().set_approach_clearance(clear),
+            Err(e) => tracing::warn!("approach paths are not checked against the field: {e}"),
+        }
+    }
     Ok(match job.origin {
         Some(origin) => node.with_origin(origin),
         None => node,

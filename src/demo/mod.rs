@@ -245,6 +245,8 @@ pub struct DemoOptions {
     /// Record every work pass's nominal path and the true XTE at every control period (for
     /// the accuracy report: pass-to-pass, acquisition, XTE over distance).
     pub record_work: bool,
+    /// The field approach paths must stay in (local ENU, as the job).
+    pub field: Option<crate::plan::coverage::Field>,
 }
 
 /// One work pass as driven (recorded with [`DemoOptions::record_work`]).
@@ -412,12 +414,32 @@ pub fn run(
     on_event: &mut dyn FnMut(f64, &Event),
 ) -> Result<DemoRun, ControlError> {
     let wall = std::time::Instant::now();
+    // A sequential AB job is a segment job: plan it here so its segments are scored.
+    let sequential;
+    let opts = if opts.job.is_none()
+        && cfg.job.kind == crate::config::JobKind::Ab
+        && cfg.job.line_order == crate::config::LineOrder::Sequential
+    {
+        sequential = DemoOptions {
+            job: Some(crate::control::ab_job_plan(cfg)?),
+            ..opts.clone()
+        };
+        &sequential
+    } else {
+        opts
+    };
     let mut node = match &opts.job {
         Some(job) => ControllerNode::with_job(cfg, job.clone(), opts.resume.as_ref())?,
         None => ControllerNode::new(cfg, opts.resume.as_ref())?,
     };
     if let Some(origin) = opts.origin {
         node = node.with_origin(origin);
+    }
+    if let Some(field) = &opts.field {
+        match crate::plan::maneuver::job::field_clearance(cfg, field) {
+            Ok(clear) => node.controller_mut().set_approach_clearance(clear),
+            Err(e) => tracing::warn!("approach paths are not checked against the field: {e}"),
+        }
     }
     let speed = cfg.speed();
     let segment_job = matches!(
@@ -616,7 +638,10 @@ pub fn run(
         last_wheel = truth.wheel_angle;
         let g = node.controller().guidance();
         let mut xte_abs = None;
-        if let Some(score) = segment_scores.get_mut(g.index_rank()) {
+        let scored_segment = (!g.is_approaching())
+            .then(|| segment_scores.get_mut(g.index_rank()))
+            .flatten();
+        if let Some(score) = scored_segment {
             if !segment_path.is_current(g) {
                 segment_path.set(g);
             }

@@ -1,7 +1,8 @@
-//! GeoJSON (RFC 7946, WGS-84 `[lon, lat]`) field reader.
+//! GeoJSON field reader: RFC 7946 (WGS-84 `[lon, lat]`) for fields, or local metres `[x, y]`
+//! for manoeuvre maps (the same structure, another coordinate check).
 
 use super::{check_coordinate, FieldError, Parsed, RawPolygon};
-use crate::geo::wgs84::LatLon;
+use crate::geo::Vec2;
 use serde_json::Value;
 
 fn label(index: Option<usize>, feature: &Value) -> String {
@@ -27,7 +28,10 @@ fn label(index: Option<usize>, feature: &Value) -> String {
     s
 }
 
-fn ring(feature: &str, value: &Value) -> Result<Vec<LatLon>, FieldError> {
+/// Turns a position's two numbers into a coordinate, or says why not.
+type Coord<C> = fn(&str, f64, f64) -> Result<C, FieldError>;
+
+fn ring<C>(feature: &str, value: &Value, coord: Coord<C>) -> Result<Vec<C>, FieldError> {
     let bad = |detail: String| FieldError::BadCoordinates {
         feature: feature.to_string(),
         detail,
@@ -40,23 +44,23 @@ fn ring(feature: &str, value: &Value) -> Result<Vec<LatLon>, FieldError> {
         .enumerate()
         .map(|(k, p)| {
             let pos = p.as_array().filter(|a| a.len() >= 2);
-            let (lon, lat) = match pos.map(|a| (a[0].as_f64(), a[1].as_f64())) {
-                Some((Some(lon), Some(lat))) => (lon, lat),
-                _ => return Err(bad(format!("position {k} is not [lon, lat]: {p}"))),
+            let (first, second) = match pos.map(|a| (a[0].as_f64(), a[1].as_f64())) {
+                Some((Some(a), Some(b))) => (a, b),
+                _ => return Err(bad(format!("position {k} is not two numbers: {p}"))),
             };
-            check_coordinate(feature, lat, lon)
+            coord(feature, first, second)
         })
         .collect()
 }
 
-fn polygon(feature: &str, rings: &Value) -> Result<RawPolygon, FieldError> {
+fn polygon<C>(feature: &str, rings: &Value, coord: Coord<C>) -> Result<RawPolygon<C>, FieldError> {
     let rings = rings.as_array().ok_or_else(|| FieldError::BadCoordinates {
         feature: feature.to_string(),
         detail: "polygon coordinates are not an array of rings".into(),
     })?;
     let mut it = rings.iter();
     let exterior = match it.next() {
-        Some(r) => ring(feature, r)?,
+        Some(r) => ring(feature, r, coord)?,
         None => {
             return Err(FieldError::TooFewPoints {
                 feature: feature.to_string(),
@@ -65,7 +69,9 @@ fn polygon(feature: &str, rings: &Value) -> Result<RawPolygon, FieldError> {
             })
         }
     };
-    let holes = it.map(|r| ring(feature, r)).collect::<Result<_, _>>()?;
+    let holes = it
+        .map(|r| ring(feature, r, coord))
+        .collect::<Result<_, _>>()?;
     Ok(RawPolygon {
         label: feature.to_string(),
         exterior,
@@ -74,11 +80,15 @@ fn polygon(feature: &str, rings: &Value) -> Result<RawPolygon, FieldError> {
 }
 
 /// Polygons of one geometry object.
-fn geometry(feature: &str, geom: &Value) -> Result<Vec<RawPolygon>, FieldError> {
+fn geometry<C>(
+    feature: &str,
+    geom: &Value,
+    coord: Coord<C>,
+) -> Result<Vec<RawPolygon<C>>, FieldError> {
     let kind = geom.get("type").and_then(Value::as_str).unwrap_or("");
     let coords = geom.get("coordinates");
     match (kind, coords) {
-        ("Polygon", Some(c)) => Ok(vec![polygon(feature, c)?]),
+        ("Polygon", Some(c)) => Ok(vec![polygon(feature, c, coord)?]),
         ("MultiPolygon", Some(Value::Array(polys))) => {
             let many = polys.len() > 1;
             polys
@@ -90,7 +100,7 @@ fn geometry(feature: &str, geom: &Value) -> Result<Vec<RawPolygon>, FieldError> 
                     } else {
                         feature.to_string()
                     };
-                    polygon(&name, c)
+                    polygon(&name, c, coord)
                 })
                 .collect()
         }
@@ -125,7 +135,28 @@ fn feature_name(feature: &Value) -> Option<String> {
         .map(str::to_string)
 }
 
+/// A WGS-84 GeoJSON document (`[lon, lat]` positions).
 pub(crate) fn parse(text: &str) -> Result<Parsed, FieldError> {
+    parse_with(text, |feature, lon, lat| {
+        check_coordinate(feature, lat, lon)
+    })
+}
+
+/// A GeoJSON document in local metres (`[x, y]` positions, any finite numbers).
+pub(crate) fn parse_local(text: &str) -> Result<Parsed<Vec2>, FieldError> {
+    parse_with(text, |feature, x, y| {
+        if x.is_finite() && y.is_finite() {
+            Ok(Vec2::new(x, y))
+        } else {
+            Err(FieldError::BadCoordinates {
+                feature: feature.to_string(),
+                detail: format!("[{x}, {y}] is not finite"),
+            })
+        }
+    })
+}
+
+fn parse_with<C>(text: &str, coord: Coord<C>) -> Result<Parsed<C>, FieldError> {
     let root: Value = serde_json::from_str(text).map_err(|e| FieldError::Json(e.to_string()))?;
     let mut out = Parsed {
         name: None,
@@ -138,7 +169,7 @@ pub(crate) fn parse(text: &str) -> Result<Parsed, FieldError> {
             feature: name.clone(),
             detail: "feature without geometry".into(),
         })?;
-        let polys = geometry(&name, geom)?;
+        let polys = geometry(&name, geom, coord)?;
         if is_obstacle(feature) {
             out.obstacles.extend(polys);
         } else {

@@ -127,13 +127,69 @@ pub enum FieldError {
     SeveralBoundaries { count: usize, features: String },
 }
 
+/// A map in local metres for manoeuvres: GeoJSON with `[x, y]` positions in metres (no
+/// projection). Exactly one Polygon (or single-polygon MultiPolygon) without `"obstacle": true`
+/// is the boundary: its exterior ring bounds the map and its holes are obstacles; every
+/// Feature with `"obstacle": true` is an obstacle too. Obstacles may cross the boundary.
+/// Rings are cleaned as field rings are (duplicates and collinear points dropped, CCW), with
+/// no fitting of short edges.
+pub fn load_local_map(text: &str) -> Result<Field, FieldError> {
+    let parsed = geojson::parse_local(text)?;
+    let mut boundaries = parsed.boundaries;
+    let boundary = match boundaries.len() {
+        0 => return Err(FieldError::NoBoundary),
+        1 => boundaries.remove(0),
+        count => {
+            return Err(FieldError::SeveralBoundaries {
+                count,
+                features: boundaries
+                    .iter()
+                    .map(|b| b.label.clone())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+        }
+    };
+    let clean = |ring: &[Vec2], feature: &str| -> Result<Vec<Vec2>, FieldError> {
+        let c = clean_ring(ring, 0.0);
+        if c.ring.len() < 3 || c.area_before_m2 < 1e-9 {
+            return Err(FieldError::TooFewPoints {
+                feature: feature.to_string(),
+                ring: "exterior ring".into(),
+                points: c.distinct_points,
+            });
+        }
+        if let Some((a, b)) = c.self_intersection {
+            return Err(FieldError::SelfIntersection {
+                feature: feature.to_string(),
+                ring: "exterior ring".into(),
+                edge_a: a,
+                edge_b: b,
+            });
+        }
+        Ok(c.ring)
+    };
+    let outer = clean(&boundary.exterior, &boundary.label)?;
+    let mut obstacles = Vec::new();
+    for (k, hole) in boundary.holes.iter().enumerate() {
+        obstacles.push(clean(hole, &format!("{} (hole {k})", boundary.label))?);
+    }
+    for o in &parsed.obstacles {
+        obstacles.push(clean(&o.exterior, &o.label)?);
+    }
+    Ok(Field {
+        boundary: outer,
+        obstacles,
+    })
+}
+
 /// A polygon as read, before projection: exterior plus holes in lat/lon, with a label for
 /// error messages.
 #[derive(Debug, Clone)]
-pub(crate) struct RawPolygon {
+pub(crate) struct RawPolygon<C = LatLon> {
     pub label: String,
-    pub exterior: Vec<LatLon>,
-    pub holes: Vec<Vec<LatLon>>,
+    pub exterior: Vec<C>,
+    pub holes: Vec<Vec<C>>,
 }
 
 /// Load a field from GeoJSON or TASKDATA text, chosen by the first non-blank character.
@@ -157,10 +213,10 @@ pub fn load_taskdata(text: &str, options: &LoadOptions) -> Result<LoadedField, F
     assemble(parsed.name, parsed.boundaries, parsed.obstacles, options)
 }
 
-pub(crate) struct Parsed {
+pub(crate) struct Parsed<C = LatLon> {
     pub name: Option<String>,
-    pub boundaries: Vec<RawPolygon>,
-    pub obstacles: Vec<RawPolygon>,
+    pub boundaries: Vec<RawPolygon<C>>,
+    pub obstacles: Vec<RawPolygon<C>>,
 }
 
 pub(crate) fn check_coordinate(feature: &str, lat: f64, lon: f64) -> Result<LatLon, FieldError> {

@@ -6,7 +6,7 @@
 //! and events are pushed only when something changes.
 
 use super::progress::{JobDefinition, Phase, Progress, PROGRESS_VERSION};
-use super::segments::SegmentJob;
+use super::segments::{JobSegment, SegmentJob};
 use crate::geo::{signed_offset, wrap_angle, Direction, PathPoint, Pose, Tag, Vec2};
 use crate::plan::abline::AbPlan;
 use crate::plan::PlanError;
@@ -98,6 +98,11 @@ pub struct Guidance {
     index_global: usize,
     local: LocalPath,
     events: Vec<Event>,
+    /// An approach path driven before the current line (SPEC §4, issue 6 part 5b): segments
+    /// split at cusps, from the vehicle to the line start. Not part of the job: never saved.
+    approach: Vec<JobSegment>,
+    /// The approach segment being driven, while approaching.
+    approach_index: Option<usize>,
 }
 
 impl Guidance {
@@ -120,6 +125,8 @@ impl Guidance {
             index_global: 0,
             local,
             events: Vec::with_capacity(16),
+            approach: Vec::new(),
+            approach_index: None,
         };
         g.start_work_line()?;
         Ok(g)
@@ -182,6 +189,7 @@ impl Guidance {
         if self.near_end(&pose.pos) {
             match self.phase {
                 Phase::Finished => {}
+                _ if self.approach_index.is_some() => self.finish_approach_segment()?,
                 _ if matches!(self.plan, JobPlan::Segments(_)) => self.finish_segment(),
                 Phase::Turn => self.start_work_line()?,
                 Phase::Work => self.finish_line()?,
@@ -387,7 +395,12 @@ impl Guidance {
         }
         let dir = d / len;
         let xte = signed_offset(&pose.pos, &a, &dir);
-        Some((xte, wrap_angle(pose.heading - dir.y.atan2(dir.x))))
+        // Driven in reverse, the vehicle faces against the direction of travel.
+        let facing = match self.path[i].direction {
+            Direction::Forward => dir.y.atan2(dir.x),
+            Direction::Reverse => (-dir.y).atan2(-dir.x),
+        };
+        Some((xte, wrap_angle(pose.heading - facing)))
     }
 
     /// The AB plan, when this is an AB job.
@@ -438,12 +451,26 @@ impl Guidance {
             .unwrap_or_default()
     }
 
-    /// Driving direction of the next segment of a segment job (`None` at the last one and for
-    /// AB jobs, which are driven forward throughout).
+    /// Driving direction of the next segment of a segment job or an approach (`None` at the
+    /// last one; forward for AB jobs, whose lines and turns are all driven forward, until they
+    /// finish).
     pub fn next_direction(&self) -> Option<Direction> {
+        if let Some(i) = self.approach_index {
+            return Some(match self.approach.get(i + 1) {
+                Some(s) => s.direction,
+                None => match &self.plan {
+                    JobPlan::Segments(job) => job
+                        .segments()
+                        .get(self.index_rank)
+                        .map(|s| s.direction)
+                        .unwrap_or_default(),
+                    JobPlan::Ab(_) => Direction::Forward,
+                },
+            });
+        }
         match &self.plan {
             JobPlan::Segments(job) => job.segments().get(self.index_rank + 1).map(|s| s.direction),
-            JobPlan::Ab(_) => None,
+            JobPlan::Ab(_) => (!self.is_finished()).then_some(Direction::Forward),
         }
     }
 
@@ -473,9 +500,64 @@ impl Guidance {
     /// segment as if its end had been reached. Does nothing unless a segment job's next
     /// segment exists.
     pub fn advance_segment(&mut self) {
+        if self.approach_index.is_some() {
+            // Errors here come from regenerating an AB line that was generated before.
+            let _ = self.finish_approach_segment();
+            return;
+        }
         if matches!(self.plan, JobPlan::Segments(_)) && self.phase != Phase::Finished {
             self.finish_segment();
         }
+    }
+
+    /// Drive `segments` (an approach path from the vehicle to the start of the current line,
+    /// split at its cusps) before the line, which is then driven from its start. Only on a
+    /// work line before any line is done, and not while approaching; `false` when refused. An
+    /// empty list is accepted and changes nothing.
+    pub fn set_approach(&mut self, segments: Vec<JobSegment>) -> bool {
+        if self.approach_index.is_some() || self.phase != Phase::Work || self.lines_done > 0 {
+            return false;
+        }
+        if segments.is_empty() {
+            return true;
+        }
+        self.approach = segments;
+        self.load_approach_segment(0);
+        true
+    }
+
+    /// Whether an approach path is being driven.
+    pub fn is_approaching(&self) -> bool {
+        self.approach_index.is_some()
+    }
+
+    fn load_approach_segment(&mut self, i: usize) {
+        let Some(s) = self.approach.get(i) else {
+            return;
+        };
+        self.path.clear();
+        self.path.extend(s.points.iter().map(|&pos| PathPoint {
+            pos,
+            tag: Tag::Turn,
+            direction: s.direction,
+        }));
+        self.approach_index = Some(i);
+        self.phase = Phase::Turn;
+        self.index_global = 0;
+    }
+
+    /// An approach segment is done: load the next one, or the line it leads to.
+    fn finish_approach_segment(&mut self) -> Result<(), GuidanceError> {
+        let Some(i) = self.approach_index else {
+            return Ok(());
+        };
+        if i + 1 < self.approach.len() {
+            self.load_approach_segment(i + 1);
+            return Ok(());
+        }
+        self.approach_index = None;
+        self.approach.clear();
+        self.start_work_line()
     }
 
     /// Tag of the path being driven.

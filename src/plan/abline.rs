@@ -14,9 +14,11 @@
 //! fail: the order has the fewest such "short" moves, then the shortest distance, and the
 //! short moves are driven with bulb turns.
 
+use super::coverage::turns::TurnCache;
+use super::coverage::{PlanSegment, SegmentKind};
 use super::turns::{bulb_turn, pi_turn, TurnParams};
 use super::PlanError;
-use crate::geo::{left_normal, PathPoint, Vec2};
+use crate::geo::{left_normal, Direction, PathPoint, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// Largest block solved exactly (Held–Karp over subsets); larger blocks use a bounded search.
@@ -639,6 +641,53 @@ impl AbPlan {
     }
 }
 
+/// The lines of a finite AB job driven in turn (line 0, 1, 2, … alternating direction), as
+/// segments: work lines and the turns between them, solved once in the canonical frame and
+/// reused (pi turn when `line_width ≥ 2·r_min`, else a fishtail with a reversal). This is the
+/// operator's "sequential" order; [`AbPlan`] is the seed-000 block order.
+pub fn sequential_segments(params: &AbParams) -> Result<Vec<PlanSegment>, PlanError> {
+    let plan = AbPlan::new(AbParams {
+        line_num: params.line_num,
+        ..params.clone()
+    })?;
+    if params.line_num == 0 {
+        return Err(PlanError::Invalid {
+            name: "line_num",
+            value: 0.0,
+            rule: "must be at least 1 for sequential lines",
+        });
+    }
+    let spacing = params.point_spacing;
+    let mut cache = TurnCache::default();
+    let mut out: Vec<PlanSegment> = Vec::new();
+    let push = |out: &mut Vec<PlanSegment>, kind, direction, points: Vec<Vec2>| {
+        let index = out.len();
+        out.push(PlanSegment {
+            kind,
+            direction,
+            index,
+            cell: 0,
+            points,
+        });
+    };
+    for line in 0..params.line_num {
+        let (s, e) = plan.line_endpoints(line, line % 2 == 1);
+        if line > 0 {
+            let (ps, pe) = plan.line_endpoints(line - 1, (line - 1) % 2 == 1);
+            let dir = (pe - ps) / plan.length;
+            for part in cache.turn(pe, dir, s, &params.turn)? {
+                push(&mut out, SegmentKind::Turn, part.direction, part.points);
+            }
+        }
+        let n = ((plan.length / spacing).ceil() as usize).max(1);
+        let points = (0..=n)
+            .map(|i| s + (e - s) * (i as f64 / n as f64))
+            .collect();
+        push(&mut out, SegmentKind::Work, Direction::Forward, points);
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -660,6 +709,7 @@ mod tests {
                 merge_distance: 0.05,
                 point_spacing: 1.0,
                 max_points: 500,
+                max_curvature_rate: 0.0,
             },
         }
     }

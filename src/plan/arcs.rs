@@ -128,6 +128,7 @@ mod tests {
                 merge_distance: 0.5,
                 point_spacing: 1.0,
                 max_points: 100,
+                max_curvature_rate: 0.0,
             },
         }
     }

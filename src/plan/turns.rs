@@ -30,6 +30,10 @@ pub struct TurnParams {
     pub point_spacing: f64,
     /// Cap on the number of interior points of a straight.
     pub max_points: usize,
+    /// Largest curvature rate per metre driven for continuous-curvature turns, 1/m²; 0 =
+    /// turns made of arcs only (curvature steps at their ends). Used by the fishtail turns
+    /// of sequential lines (see `plan::coverage::turns`).
+    pub max_curvature_rate: f64,
 }
 
 impl TurnParams {
@@ -49,6 +53,11 @@ impl TurnParams {
             "point_spacing",
             self.point_spacing,
             self.point_spacing > 0.0,
+        )?;
+        PlanError::check(
+            "max_curvature_rate",
+            self.max_curvature_rate,
+            self.max_curvature_rate >= 0.0,
         )?;
         if self.max_points < 1 {
             return Err(PlanError::Invalid {
@@ -247,6 +256,7 @@ mod tests {
             merge_distance: 0.05,
             point_spacing: 1.0,
             max_points: 500,
+            max_curvature_rate: 0.0,
         }
     }
 

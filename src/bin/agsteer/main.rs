@@ -2,6 +2,7 @@
 
 mod accuracy_cmd;
 mod dbc_cmd;
+mod maneuver_cmd;
 mod plan_cmd;
 mod sim_cmd;
 
@@ -137,6 +138,38 @@ enum Command {
         #[command(flatten)]
         cfg: ConfigArgs,
     },
+    /// Plan a manoeuvre with reversing between two poses (local metres) on a map: prints the
+    /// path's length, cusps and segments; exit status 3 when no path is found.
+    Maneuver {
+        /// Configuration file ([maneuver], [vehicle]).
+        #[arg(long, default_value = "config/demo.toml")]
+        config: PathBuf,
+        /// Map: GeoJSON in local metres; a Polygon's exterior is the boundary, its holes and
+        /// Features with "obstacle": true are obstacles. Without it the space is free.
+        #[arg(long)]
+        map: Option<PathBuf>,
+        /// Start pose x,y,heading_deg (metres, degrees CCW from East).
+        #[arg(long, allow_hyphen_values = true, required_unless_present = "batch")]
+        from: Option<String>,
+        /// Goal pose x,y,heading_deg.
+        #[arg(long, allow_hyphen_values = true, required_unless_present = "batch")]
+        to: Option<String>,
+        /// Curve family: cc (continuous curvature) or rs (plain Reeds-Shepp); default
+        /// maneuver.curve.
+        #[arg(long, value_parser = parse_curve)]
+        curve: Option<agsteer::config::CurveChoice>,
+        /// Draw the map and path into this SVG file.
+        #[arg(long)]
+        svg: Option<PathBuf>,
+        /// Print the result as JSON.
+        #[arg(long)]
+        json: bool,
+        /// JSON lines {"from":[x,y,deg],"to":[x,y,deg]}: one JSON result per line on stdout.
+        #[arg(long, conflicts_with_all = ["from", "to", "svg"])]
+        batch: Option<PathBuf>,
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    },
     /// Validate a configuration: print it resolved, or every problem (exit status 2).
     CheckConfig {
         /// Configuration file.
@@ -185,6 +218,30 @@ fn main() -> ExitCode {
             cfg,
         } => load_config(&config, &cfg.set).and_then(|c| run_plan(&field, &c, &out, json)),
         Command::Dbc { cmd } => dbc_cmd::run(cmd),
+        Command::Maneuver {
+            config,
+            map,
+            from,
+            to,
+            curve,
+            svg,
+            json,
+            batch,
+            cfg,
+        } => load_config(&config, &cfg.set).and_then(|c| {
+            maneuver_cmd::run(
+                &c,
+                &maneuver_cmd::ManeuverArgs {
+                    map: map.as_deref(),
+                    from: from.as_deref(),
+                    to: to.as_deref(),
+                    curve,
+                    svg: svg.as_deref(),
+                    json,
+                    batch: batch.as_deref(),
+                },
+            )
+        }),
         Command::Sim {
             iface,
             config,
@@ -223,6 +280,14 @@ fn main() -> ExitCode {
 
 fn run_plan(field: &Path, cfg: &Config, out: &Path, json: bool) -> Result<u8> {
     plan_cmd::run(field, cfg, out, json, agsteer::plan::coverage::plan_field)
+}
+
+fn parse_curve(s: &str) -> Result<agsteer::config::CurveChoice, String> {
+    match s {
+        "cc" => Ok(agsteer::config::CurveChoice::Cc),
+        "rs" => Ok(agsteer::config::CurveChoice::Rs),
+        other => Err(format!("`{other}`: expected cc or rs")),
+    }
 }
 
 fn load_config(path: &Path, set: &[String]) -> Result<Config> {
@@ -283,9 +348,32 @@ fn run_demo(
             prepare_field_job(&cfg)
                 .with_context(|| format!("job.kind = \"field\" in {}", config.display()))?,
         ),
-        JobKind::Ab | JobKind::Arcs => None,
+        JobKind::Ab | JobKind::Arcs | JobKind::Maneuver => None,
     };
-    let job = field.as_ref().map(|(fj, _)| fj.job_plan());
+    let maneuver = match cfg.job.kind {
+        JobKind::Maneuver => {
+            let (r, ms) = plan_cmd::timed("planning the manoeuvre", || {
+                agsteer::daemon::maneuver_file::load(&cfg)
+            });
+            let (mj, map) =
+                r.with_context(|| format!("job.kind = \"maneuver\" in {}", config.display()))?;
+            tracing::info!(
+                "manoeuvre: {:.1} m, {} cusps, {:.1} m in reverse, {} segments, planned in {:.0} ms",
+                mj.path.length(),
+                mj.path.cusps(),
+                mj.path.reverse_length(),
+                mj.job.len(),
+                ms.as_secs_f64() * 1e3
+            );
+            Some((mj, map))
+        }
+        _ => None,
+    };
+    let job = field.as_ref().map(|(fj, _)| fj.job_plan()).or_else(|| {
+        maneuver
+            .as_ref()
+            .map(|(mj, _)| agsteer::guidance::JobPlan::Segments(mj.job.clone()))
+    });
     let expected = match &job {
         Some(plan) => JobDefinition::for_job(&cfg, plan),
         None => JobDefinition::from_config(&cfg),
@@ -330,11 +418,15 @@ fn run_demo(
         stop_after_lines: stop_after,
         record_trace: true,
         job,
-        outlines: field
-            .as_ref()
-            .map(|(fj, _)| fj.outlines())
-            .unwrap_or_default(),
+        outlines: match (&field, &maneuver) {
+            (Some((fj, _)), _) => fj.outlines(),
+            (None, Some((_, Some(map)))) => std::iter::once(map.boundary.clone())
+                .chain(map.obstacles.iter().cloned())
+                .collect(),
+            _ => Vec::new(),
+        },
         origin: field.as_ref().map(|(fj, _)| fj.origin()),
+        field: field.as_ref().map(|(fj, _)| fj.loaded.field.clone()),
         ..Default::default()
     };
     let mut save_error = None;
@@ -417,7 +509,18 @@ fn run_demo(
                     )
                 })
         };
-        if let (Some(rms), Some(max)) = (worst(|s| s.xte_rms_m), worst(|s| s.xte_max_m)) {
+        if maneuver.is_some() {
+            for s in &r.segments {
+                println!(
+                    "segment {} ({:?}, {:.1} m): XTE RMS {:.1} cm, max {:.1} cm",
+                    s.index,
+                    s.direction,
+                    s.length_m,
+                    s.xte_rms_m * 100.0,
+                    s.xte_max_m * 100.0
+                );
+            }
+        } else if let (Some(rms), Some(max)) = (worst(|s| s.xte_rms_m), worst(|s| s.xte_max_m)) {
             println!("worst RMS on {rms}; worst max on {max}");
         }
         if let (Some(pos), Some(hdg)) = (r.goal_position_error_m, r.goal_heading_error_deg) {

@@ -34,14 +34,23 @@ pub fn run(
         }
         None => Scenario::default(),
     };
-    // A field job (as agsteerd drives it): the plan's frame, starting on its first segment.
-    let field = match cfg.job.kind {
+    // A field or manoeuvre job (as agsteerd drives it): the plan's frame, starting on its
+    // first segment.
+    let (field, segment_job) = match cfg.job.kind {
         JobKind::Field => {
-            Some(agsteer::daemon::field_file::load(cfg).context("job.kind = \"field\"")?)
+            let f = agsteer::daemon::field_file::load(cfg).context("job.kind = \"field\"")?;
+            let job = f.job.clone();
+            (Some(f), Some(job))
         }
-        JobKind::Ab | JobKind::Arcs => None,
+        JobKind::Ab => (None, None),
+        JobKind::Maneuver => {
+            let (mj, _) =
+                agsteer::daemon::maneuver_file::load(cfg).context("job.kind = \"maneuver\"")?;
+            (None, Some(mj.job))
+        }
+        JobKind::Arcs => (None, None),
     };
-    let first = field.as_ref().and_then(|f| f.job.segments().first());
+    let first = segment_job.as_ref().and_then(|j| j.segments().first());
     let (a, b) = match first.map(|s| s.points.as_slice()) {
         Some([a, b, ..]) => (*a, *b),
         _ => (

@@ -175,6 +175,7 @@ mod tests {
             swath_angle: Default::default(),
             route: Default::default(),
             small_obstacle_max_m: 20.0,
+            max_curvature_rate: 0.0,
         }
     }
 

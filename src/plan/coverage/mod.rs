@@ -103,6 +103,9 @@ pub struct CoverageParams {
     /// detours (the swaths run through them; each blocked stretch becomes a smooth path round
     /// the obstacle); larger ones get headland passes and split the swaths, m.
     pub small_obstacle_max_m: f64,
+    /// Largest curvature rate per metre driven, 1/m², for continuous-curvature fishtail turns
+    /// (clothoid + arc + clothoid); 0 = fishtails of arcs only.
+    pub max_curvature_rate: f64,
 }
 
 /// A complete field plan: segments in driving order plus the areas they were made for.
@@ -209,6 +212,11 @@ impl CoverageParams {
             self.point_spacing > 0.0,
         )?;
         PlanError::check(
+            "max_curvature_rate",
+            self.max_curvature_rate,
+            self.max_curvature_rate >= 0.0,
+        )?;
+        PlanError::check(
             "small_obstacle_max_m",
             self.small_obstacle_max_m,
             self.small_obstacle_max_m >= 0.0,
@@ -223,6 +231,7 @@ impl CoverageParams {
             merge_distance: 0.05,
             point_spacing: self.point_spacing,
             max_points: 100_000,
+            max_curvature_rate: self.max_curvature_rate,
         }
     }
 }
@@ -899,6 +908,7 @@ mod tests {
             swath_angle: SwathAngle::MinTurns,
             route: RouteOrder::Auto,
             small_obstacle_max_m: 0.0,
+            max_curvature_rate: 0.0,
         }
     }
 

@@ -27,6 +27,8 @@ pub fn canonical_turn(g: f64, left: bool, p: &TurnParams) -> Result<Vec<TurnPart
             direction: Direction::Forward,
             points: out.iter().map(|q| q.pos).collect(),
         }]
+    } else if p.max_curvature_rate > 0.0 {
+        cc_fishtail(g, p)
     } else {
         // Fishtail: forward quarter arc about (0, r) to (r, r) heading +y; reverse down the
         // transition line x = r to (r, g − r); forward quarter arc about (0, g − r) to (0, g).
@@ -78,6 +80,48 @@ pub fn canonical_turn(g: f64, left: bool, p: &TurnParams) -> Result<Vec<TurnPart
             })
             .collect()
     })
+}
+
+/// The continuous-curvature fishtail to the left (SPEC §4): a forward CC quarter turn
+/// (clothoid + arc + clothoid at κ_max = 1/r_min and σ_max) from the origin heading +x ends at
+/// (d, d) heading +y (a symmetric quarter turn ends as far along as across); reverse straight
+/// down x = d to (d, g − d); a second forward CC quarter turn ends at (0, g) heading −x.
+/// Curvature is zero at both cusps and both ends, so the steering never has to jump.
+fn cc_fishtail(g: f64, p: &TurnParams) -> Vec<TurnPart> {
+    use crate::geo::Pose;
+    use crate::plan::maneuver::cc_turn::cc_turn;
+    use crate::plan::maneuver::drive::split_at_cusps;
+    use crate::plan::maneuver::path::{CurveParams, CurvePath, CurveSegment};
+    use std::f64::consts::FRAC_PI_2;
+    let params = CurveParams {
+        kappa_max: 1.0 / p.r_min,
+        sigma_max: p.max_curvature_rate,
+    };
+    let quarter = cc_turn(FRAC_PI_2, Direction::Forward, &params);
+    let d = CurvePath {
+        start: Pose::new(0.0, 0.0, 0.0),
+        segments: quarter.clone(),
+    }
+    .end_pose()
+    .pos
+    .x;
+    let mut segments = quarter.clone();
+    segments.push(CurveSegment::line(
+        Direction::Reverse,
+        (2.0 * d - g).max(0.0),
+    ));
+    segments.extend(quarter);
+    let path = CurvePath {
+        start: Pose::new(0.0, 0.0, 0.0),
+        segments,
+    };
+    split_at_cusps(&path, p.point_spacing.min(0.5))
+        .into_iter()
+        .map(|part| TurnPart {
+            direction: part.direction,
+            points: part.points,
+        })
+        .collect()
 }
 
 /// Canonical turns solved once per (gap, side) and reused.
@@ -135,6 +179,35 @@ mod tests {
             merge_distance: 0.05,
             point_spacing: 1.0,
             max_points: 500,
+            max_curvature_rate: 0.0,
+        }
+    }
+
+    #[test]
+    fn cc_fishtail_ends_on_the_next_line_with_zero_curvature_cusps() {
+        let mut p = params(6.0);
+        p.max_curvature_rate = 0.06;
+        for left in [true, false] {
+            let f = canonical_turn(6.0, left, &p).unwrap();
+            assert_eq!(f.len(), 3, "fishtail");
+            assert_eq!(f[1].direction, Direction::Reverse);
+            let side = if left { 1.0 } else { -1.0 };
+            let end = *f[2].points.last().unwrap();
+            assert!((end - v2(0.0, 6.0 * side)).norm() < 1e-6, "{end:?}");
+            // The reverse leg is straight and the parts meet exactly.
+            assert!((f[0].points.last().unwrap() - f[1].points[0]).norm() < 1e-9);
+            assert!((f[1].points.last().unwrap() - f[2].points[0]).norm() < 1e-9);
+            let r = &f[1].points;
+            assert!(r.iter().all(|q| (q.x - r[0].x).abs() < 1e-9));
+            // Clothoids make the quarter turn reach further than an arc: d > r_min.
+            assert!(f[0].points.last().unwrap().x > 6.0);
+            // Headings: +y at the first cusp (three-point check of the last points).
+            let a = &f[0].points;
+            let dir = a[a.len() - 1] - a[a.len() - 2];
+            assert!(
+                dir.x.abs() < 0.01 * dir.norm() && dir.y * side > 0.0,
+                "{dir:?}"
+            );
         }
     }
 

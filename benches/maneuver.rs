@@ -1,0 +1,62 @@
+//! Manoeuvre planning (SPEC §4): the whole seed-004 planner on each scenario of
+//! tools/maneuvers/ with the default configuration plus the scenario's overlay, continuous
+//! curvature. Target: < 100 ms each.
+
+use agsteer::config::Config;
+use agsteer::field::load_local_map;
+use agsteer::geo::Pose;
+use agsteer::plan::maneuver::collision::CollisionMap;
+use agsteer::plan::maneuver::search::plan_maneuver;
+use agsteer::plan::maneuver::steering::CcSteering;
+use criterion::{criterion_group, criterion_main, Criterion};
+use std::hint::black_box;
+use std::path::PathBuf;
+
+#[derive(serde::Deserialize)]
+struct Scenario {
+    map: String,
+    from: [f64; 3],
+    to: [f64; 3],
+    set: Vec<String>,
+}
+
+fn bench(c: &mut Criterion) {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/maneuvers");
+    let mut g = c.benchmark_group("maneuver");
+    for name in [
+        "three_point_turn",
+        "bay",
+        "headland_fishtail",
+        "field_gate",
+        "obstacle_slalom",
+    ] {
+        let text = std::fs::read_to_string(dir.join(format!("{name}.toml"))).expect("scenario");
+        let s: Scenario = toml::from_str(&text).expect("scenario TOML");
+        let cfg = Config::parse_with("", &s.set).expect("overlay");
+        let field = load_local_map(&std::fs::read_to_string(dir.join(&s.map)).expect("map"))
+            .expect("map GeoJSON");
+        let map = CollisionMap::new(
+            Some(field.boundary),
+            field.obstacles,
+            cfg.maneuver.grid_cell_m,
+        )
+        .expect("map");
+        let steer = CcSteering {
+            params: cfg.maneuver_curve_params(),
+        };
+        let params = cfg.maneuver_params();
+        let pose = |p: [f64; 3]| Pose::new(p[0], p[1], p[2].to_radians());
+        let (from, to) = (pose(s.from), pose(s.to));
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let r = plan_maneuver(&map, &steer, &params, &from, &to).expect("valid");
+                assert!(r.path.is_some());
+                black_box(r)
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
