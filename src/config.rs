@@ -49,6 +49,10 @@ pub enum JobKind {
     Ab,
     /// A field coverage plan (SPEC §3) made from the field at `job.field_path`.
     Field,
+    /// Concentric circular work lines about `job.point_a_m` (the curved lines of the accuracy
+    /// suite): `job.line_num` arcs from radius `job.arc_radius_m` outwards, `job.line_width_m`
+    /// apart, each sweeping `job.arc_sweep_deg`, joined by headland turns.
+    Arcs,
     /// A manoeuvre with reversing (SPEC §4) from `job.maneuver_from` to `job.maneuver_to` on
     /// the map at `job.maneuver_map_path`, planned at start-up with `[maneuver]`.
     Maneuver,
@@ -128,6 +132,11 @@ pub struct JobConfig {
     pub origin_lat_deg: f64,
     /// WGS-84 longitude of the local ENU origin, degrees.
     pub origin_lon_deg: f64,
+    /// For `kind = "arcs"`: radius of the first (innermost) line, m.
+    pub arc_radius_m: f64,
+    /// For `kind = "arcs"`: sweep of every line, degrees (the first starts due South of the
+    /// centre, heading East, and runs counter-clockwise).
+    pub arc_sweep_deg: f64,
 }
 
 impl Default for JobConfig {
@@ -146,6 +155,8 @@ impl Default for JobConfig {
             line_order: LineOrder::Blocks,
             origin_lat_deg: 52.0,
             origin_lon_deg: 5.0,
+            arc_radius_m: 30.0,
+            arc_sweep_deg: 270.0,
         }
     }
 }
@@ -299,6 +310,26 @@ pub struct TrackConfig {
     pub integral_capture_m: f64,
     /// The integral action learns only above this speed, m/s.
     pub integral_min_speed_mps: f64,
+    /// Disturbance observer (predictive tracker only; see
+    /// [`ObserverParams`](crate::estimate::ObserverParams)): time constant of the wheel-angle
+    /// offset estimate, s (0 = off).
+    pub observer_bias_tau_s: f64,
+    /// Time constant of the world-frame drift (slip) estimate, s (0 = off).
+    pub observer_drift_tau_s: f64,
+    /// The observer learns only above this speed, m/s.
+    pub observer_min_speed_mps: f64,
+    /// Largest wheel-angle offset the observer may estimate, degrees.
+    pub observer_bias_limit_deg: f64,
+    /// Largest drift speed the observer may estimate, m/s.
+    pub observer_drift_limit_mps: f64,
+    /// Time constant of the slope-slip coefficient (lateral slip per degree of IMU roll), s
+    /// (0 = off).
+    pub observer_slip_tau_s: f64,
+    /// Largest slope-slip coefficient, m/s per degree of roll.
+    pub observer_slip_limit_mps_per_deg: f64,
+    /// Through an RTK-float period, dead-reckon from the last fixed position for at most this
+    /// long instead of following the float positions, s (0 = off).
+    pub observer_coast_max_s: f64,
 }
 
 impl Default for TrackConfig {
@@ -308,7 +339,7 @@ impl Default for TrackConfig {
             ld_min_m: 3.0,
             ld_gain_s: 1.2,
             local_nodes_before: 1,
-            local_nodes_after: 6,
+            local_nodes_after: 10,
             tangent_length_m: 0.25,
             local_spacing_m: 0.1,
             gnss_latency_s: 0.05,
@@ -319,6 +350,14 @@ impl Default for TrackConfig {
             integral_limit_deg: 3.0,
             integral_capture_m: 0.3,
             integral_min_speed_mps: 0.5,
+            observer_bias_tau_s: 20.0,
+            observer_drift_tau_s: 60.0,
+            observer_min_speed_mps: 1.0,
+            observer_bias_limit_deg: 3.0,
+            observer_drift_limit_mps: 0.3,
+            observer_slip_tau_s: 15.0,
+            observer_slip_limit_mps_per_deg: 0.05,
+            observer_coast_max_s: 30.0,
         }
     }
 }
@@ -1004,6 +1043,15 @@ impl Config {
                 "must name a GeoJSON or TASKDATA.XML file when job.kind = \"field\"",
             );
         }
+        c.range("job.arc_radius_m", j.arc_radius_m, 1.0, 10_000.0);
+        c.range("job.arc_sweep_deg", j.arc_sweep_deg, 1.0, 359.0);
+        if j.kind == JobKind::Arcs && !(1..=1000).contains(&j.line_num) {
+            c.push(
+                "job.line_num",
+                j.line_num.to_string(),
+                "must be in 1..=1000 when job.kind = \"arcs\"",
+            );
+        }
         c.range("job.origin_lat_deg", j.origin_lat_deg, -89.0, 89.0);
         c.range("job.origin_lon_deg", j.origin_lon_deg, -180.0, 180.0);
         let fc = &self.field;
@@ -1137,6 +1185,54 @@ impl Config {
             t.integral_min_speed_mps,
             0.0,
             10.0,
+        );
+        c.range(
+            "track.observer_bias_tau_s",
+            t.observer_bias_tau_s,
+            0.0,
+            600.0,
+        );
+        c.range(
+            "track.observer_drift_tau_s",
+            t.observer_drift_tau_s,
+            0.0,
+            600.0,
+        );
+        c.range(
+            "track.observer_min_speed_mps",
+            t.observer_min_speed_mps,
+            0.1,
+            10.0,
+        );
+        c.range(
+            "track.observer_bias_limit_deg",
+            t.observer_bias_limit_deg,
+            0.0,
+            10.0,
+        );
+        c.range(
+            "track.observer_drift_limit_mps",
+            t.observer_drift_limit_mps,
+            0.0,
+            2.0,
+        );
+        c.range(
+            "track.observer_slip_tau_s",
+            t.observer_slip_tau_s,
+            0.0,
+            600.0,
+        );
+        c.range(
+            "track.observer_slip_limit_mps_per_deg",
+            t.observer_slip_limit_mps_per_deg,
+            0.0,
+            1.0,
+        );
+        c.range(
+            "track.observer_coast_max_s",
+            t.observer_coast_max_s,
+            0.0,
+            600.0,
         );
 
         let s = &self.sim;
@@ -1622,6 +1718,35 @@ mod tests {
         assert!(d.imu_rate_hz == 0.0 && d.slip_mps == 0.0 && d.slip_per_roll_mps_per_deg == 0.0);
         assert!(d.was_bias_deg == 0.0);
         assert!(d.actuator_deadband_deg == 0.0 && d.actuator_backlash_deg == 0.0);
+    }
+
+    #[test]
+    fn observer_and_arcs_keys_parse_and_validate() {
+        let cfg = Config::parse_with(
+            "[track]\nobserver_drift_tau_s = -1\nobserver_min_speed_mps = 0\n\
+             observer_slip_limit_mps_per_deg = 2\nobserver_coast_max_s = 700\n\
+             [job]\nkind = \"arcs\"\narc_sweep_deg = 360\nline_num = 0\n",
+            &[],
+        )
+        .unwrap();
+        assert_eq!(cfg.job.kind, JobKind::Arcs);
+        let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
+        for m in [
+            "track.observer_drift_tau_s = -1: must be in 0..=600",
+            "track.observer_min_speed_mps = 0: must be in 0.1..=10",
+            "track.observer_slip_limit_mps_per_deg = 2: must be in 0..=1",
+            "track.observer_coast_max_s = 700: must be in 0..=600",
+            "job.arc_sweep_deg = 360: must be in 1..=359",
+            "job.line_num = 0: must be in 1..=1000 when job.kind = \"arcs\"",
+        ] {
+            assert!(msgs.contains(&m.to_string()), "{m} not in {msgs:?}");
+        }
+        assert_eq!(msgs.len(), 6, "{msgs:?}");
+        // The observer is on by default (the default tracker uses it).
+        let t = TrackConfig::default();
+        assert!(t.observer_bias_tau_s > 0.0 && t.observer_drift_tau_s > 0.0);
+        assert!(t.observer_slip_tau_s > 0.0 && t.observer_coast_max_s > 0.0);
+        assert!(Config::default().validate().is_empty());
     }
 
     #[test]

@@ -264,3 +264,44 @@ fn maneuver_single_batch_and_bad_endpoint() {
         "{err}"
     );
 }
+
+#[test]
+fn accuracy_runs_the_chosen_scenarios_and_writes_json_and_svgs() {
+    let out = std::env::temp_dir().join(format!("agsteer-accuracy-{}", std::process::id()));
+    let out_s = out.to_string_lossy().into_owned();
+    let (code, stdout, err) = agsteer(
+        &[
+            "accuracy",
+            "--config",
+            "tools/scenarios/straight_4kmh.toml",
+            "--tracker",
+            "all",
+            "--json",
+            "--out",
+            &out_s,
+            "--set",
+            "job.line_num=3",
+        ],
+        "",
+    );
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("JSON on stdout");
+    let rows = v.as_array().expect("an array");
+    let trackers: Vec<&str> = rows.iter().filter_map(|r| r["tracker"].as_str()).collect();
+    assert_eq!(trackers, ["predictive", "pure_pursuit", "stanley"]);
+    for r in rows {
+        assert_eq!(r["scenario"], "straight_4kmh");
+        assert!(
+            r["xte_rms_m"].as_f64().is_some_and(|x| x > 0.0 && x < 0.05),
+            "{r}"
+        );
+        assert!(r["pass_to_pass_p95_m"].as_f64().is_some(), "{r}");
+    }
+    let svg = std::fs::read_to_string(out.join("straight_4kmh.svg")).expect("the SVG");
+    assert_eq!(svg.matches("<path").count(), 3);
+    assert!(out.join("accuracy.json").exists());
+    let (code, _, err) = agsteer(&["accuracy", "--tracker", "nope", "--out", &out_s], "");
+    assert_eq!(code, 1);
+    assert!(err.contains("unknown tracker"), "{err}");
+    let _ = std::fs::remove_dir_all(&out);
+}

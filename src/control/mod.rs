@@ -6,8 +6,10 @@
 //! progress snapshots it hands out.
 
 use crate::config::{Config, JobKind, LineOrder, LineSide, TrackerChoice};
-use crate::estimate::{AntennaOffset, Estimator, EstimatorParams, GnssFix, VehicleEstimate};
-use crate::geo::{v2, Direction, Pose};
+use crate::estimate::{
+    AntennaOffset, Estimator, EstimatorParams, GnssFix, ObserverParams, VehicleEstimate,
+};
+use crate::geo::{heading_vec, left_normal, v2, Direction, Pose, Vec2};
 use crate::guidance::progress::{JobDefinition, Progress};
 use crate::guidance::{Guidance, GuidanceError, GuidanceParams, JobPlan};
 use crate::plan::abline::{AbParams, AbPlan, Side};
@@ -43,6 +45,22 @@ pub fn ab_params(cfg: &Config) -> AbParams {
             max_curvature_rate: cfg.vehicle.max_curvature_rate_per_m2,
         },
     }
+}
+
+/// The arcs job (`job.kind = "arcs"`) from the configuration.
+pub fn arcs_plan(cfg: &Config) -> Result<JobPlan, crate::plan::PlanError> {
+    let ab = ab_params(cfg);
+    let job = crate::plan::arcs::arcs_job(&crate::plan::arcs::ArcsParams {
+        centre: ab.point_a,
+        r_inner: cfg.job.arc_radius_m,
+        width: cfg.job.line_width_m,
+        lines: cfg.job.line_num,
+        sweep: cfg.job.arc_sweep_deg.to_radians(),
+        start_angle: -std::f64::consts::FRAC_PI_2,
+        point_spacing: cfg.guidance.point_spacing_m,
+        turn: ab.turn,
+    })?;
+    Ok(JobPlan::Segments(job))
 }
 
 /// The AB job configured by `cfg`: the seed-000 block plan, or (`job.line_order =
@@ -92,8 +110,9 @@ pub fn tracker_params(cfg: &Config) -> TrackerParams {
     }
 }
 
-/// The estimator's parameters: the predictive tracker compensates latency and dead-reckons,
-/// plain pure pursuit uses the latest fix as it is.
+/// The estimator's parameters: the predictive tracker (and Stanley) compensate latency,
+/// dead-reckon and correct the antenna's lean from the IMU roll; plain pure pursuit uses the
+/// latest fix as it is.
 pub fn estimator_params(cfg: &Config) -> EstimatorParams {
     let predictive = cfg.track.kind != TrackerChoice::PurePursuit;
     EstimatorParams {
@@ -114,7 +133,43 @@ pub fn estimator_params(cfg: &Config) -> EstimatorParams {
         } else {
             0.0
         },
+        roll_compensation: predictive,
+        observer: observer_params(cfg),
     }
+}
+
+/// The disturbance observer from `[track]`: on for the default (predictive) tracker only,
+/// so that pure pursuit and Stanley stay the references they are.
+pub fn observer_params(cfg: &Config) -> ObserverParams {
+    let t = &cfg.track;
+    if t.kind != TrackerChoice::Predictive {
+        return ObserverParams::default();
+    }
+    ObserverParams {
+        bias_tau: t.observer_bias_tau_s,
+        drift_tau: t.observer_drift_tau_s,
+        min_speed: t.observer_min_speed_mps,
+        bias_limit: t.observer_bias_limit_deg.to_radians(),
+        drift_limit: t.observer_drift_limit_mps,
+        slip_tau: t.observer_slip_tau_s,
+        slip_limit: t.observer_slip_limit_mps_per_deg.to_degrees(),
+        coast_max: t.observer_coast_max_s,
+    }
+}
+
+/// Largest crab angle the drift estimate may turn the steered course by, rad.
+const MAX_CRAB: f64 = 0.2;
+
+/// The travel-direction pose turned onto the course over ground: the heading plus the crab
+/// angle of the estimated `drift` (world m/s) at speed `speed` (m/s, > 0 in the travel
+/// direction). Below `min_speed` the crab is not defined and the pose is returned as is.
+pub fn course_pose(pose: &Pose, drift: Vec2, speed: f64, min_speed: f64) -> Pose {
+    if speed < min_speed || drift == Vec2::zeros() {
+        return *pose;
+    }
+    let lateral = drift.dot(&left_normal(&heading_vec(pose.heading)));
+    let crab = lateral.atan2(speed).clamp(-MAX_CRAB, MAX_CRAB);
+    Pose::new(pose.pos.x, pose.pos.y, pose.heading + crab)
 }
 
 /// The result of one cycle.
@@ -232,10 +287,11 @@ pub fn approach_settings(cfg: &Config) -> Option<ApproachSettings> {
 impl Controller {
     /// A new job, or the continuation of `resume`.
     pub fn from_config(cfg: &Config, resume: Option<&Progress>) -> Result<Self, ControlError> {
-        if matches!(cfg.job.kind, JobKind::Field | JobKind::Maneuver) {
-            return Err(ControlError::NoPlan);
+        match cfg.job.kind {
+            JobKind::Field | JobKind::Maneuver => Err(ControlError::NoPlan),
+            JobKind::Arcs => Controller::with_job(cfg, arcs_plan(cfg)?, resume),
+            JobKind::Ab => Controller::with_job(cfg, ab_job_plan(cfg)?, resume),
         }
-        Controller::with_job(cfg, ab_job_plan(cfg)?, resume)
     }
 
     /// A job given by its plan (an AB plan or a segment job such as a field plan), or the
@@ -322,6 +378,18 @@ impl Controller {
         self.estimator.on_fix(fix);
     }
 
+    /// The quality of the next fixes: the disturbance observer learns only from RTK-fixed
+    /// ones and coasts through RTK-float ones.
+    pub fn set_fix_quality(&mut self, fixed: bool, float: bool) {
+        self.estimator.set_learning(fixed);
+        self.estimator.set_coasting(float);
+    }
+
+    /// The observer's estimates: wheel-angle offset (rad) and world drift (m/s).
+    pub fn disturbance_estimate(&self) -> (f64, Vec2) {
+        (self.estimator.wheel_offset(), self.estimator.drift())
+    }
+
     pub fn on_wheel_angle(&mut self, t: f64, angle: f64) {
         self.estimator.on_wheel_angle(t, angle);
     }
@@ -351,7 +419,14 @@ impl Controller {
         let direction = self.guidance.direction();
         out.direction = direction;
         // Reverse segments are tracked about the rear axle in the driving direction.
-        let pose = travel_pose(&est.pose, direction);
+        let mut pose = travel_pose(&est.pose, direction);
+        if self.law.kind == TrackerChoice::Predictive {
+            // Steer the course over ground, not the heading, onto the path: the estimated
+            // drift then leaves no standing error.
+            let min = self.estimator.params().observer.min_speed;
+            let drift = self.estimator.drift_velocity(est.pose.heading);
+            pose = course_pose(&pose, drift, est.speed.abs(), min);
+        }
         let local = self.guidance.local_path();
         let law = match self.law.kind {
             TrackerChoice::Stanley => stanley(

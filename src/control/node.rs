@@ -256,6 +256,12 @@ impl ControllerNode {
                 .heading
                 .filter(|(th, _)| t - th <= HEADING_MAX_AGE)
                 .map(|(_, h)| h);
+            let q = match self.quality {
+                Some((tq, q)) if t - tq <= QUALITY_MAX_AGE => q,
+                _ => FixQuality::None,
+            };
+            self.ctrl
+                .set_fix_quality(q == FixQuality::RtkFixed, q == FixQuality::RtkFloat);
             self.ctrl.on_fix(&GnssFix {
                 t_received: t,
                 antenna,
@@ -266,10 +272,6 @@ impl ControllerNode {
                     .filter(|(tr, _)| t - tr <= ROLL_MAX_AGE)
                     .map(|(_, r)| r),
             });
-            let q = match self.quality {
-                Some((tq, q)) if t - tq <= QUALITY_MAX_AGE => q,
-                _ => FixQuality::None,
-            };
             self.status.fix = q;
             self.supervisor.on_gnss(t, q);
         } else if let Some(m) = d.to::<ImuAttitude>() {

@@ -120,6 +120,10 @@ pub fn prepare_job(cfg: &Config) -> Result<DaemonJob, DaemonError> {
     let mut field = None;
     let (plan, origin) = match cfg.job.kind {
         JobKind::Ab => (crate::control::ab_job_plan(cfg)?, None),
+        JobKind::Arcs => (
+            crate::control::arcs_plan(cfg).map_err(ControlError::from)?,
+            None,
+        ),
         JobKind::Field => {
             let start = std::time::Instant::now();
             let fj = field_file::load(cfg).map_err(DaemonError::Field)?;

@@ -4,6 +4,7 @@
 //! Memory does not grow with the job: XTE statistics use a fixed histogram, and the trace for
 //! the SVG is recorded only on request.
 
+pub mod accuracy;
 pub mod svg;
 
 use crate::can::bus::{CanBus, MemBus};
@@ -241,8 +242,34 @@ pub struct DemoOptions {
     /// ENU origin of the job's coordinates when it is not `job.origin_*` (a field plan:
     /// [`FieldJob::origin`](crate::field::job::FieldJob::origin)).
     pub origin: Option<crate::geo::wgs84::LatLon>,
+    /// Record every work pass's nominal path and the true XTE at every control period (for
+    /// the accuracy report: pass-to-pass, acquisition, XTE over distance).
+    pub record_work: bool,
     /// The field approach paths must stay in (local ENU, as the job).
     pub field: Option<crate::plan::coverage::Field>,
+}
+
+/// One work pass as driven (recorded with [`DemoOptions::record_work`]).
+#[derive(Debug, Clone, Default)]
+pub struct WorkPass {
+    /// The nominal path, local ENU m, in driving order.
+    pub nominal: Vec<Vec2>,
+    /// The pass began after a turn (not the job's first line).
+    pub after_turn: bool,
+    pub samples: Vec<WorkSample>,
+}
+
+/// The true pose against a work pass, one control period.
+#[derive(Debug, Clone, Copy)]
+pub struct WorkSample {
+    /// Simulated time, s.
+    pub t: f64,
+    /// Distance along the nominal path, m.
+    pub along_m: f64,
+    /// Signed cross-track error, m (positive = left of the path).
+    pub xte_m: f64,
+    /// True rear-axle position, local ENU m.
+    pub pos: Vec2,
 }
 
 /// A recorded point of the true trajectory.
@@ -350,9 +377,11 @@ pub struct DemoRun {
     pub progress: Progress,
     /// Every end of an engagement: (simulated time s, fault).
     pub disengage_events: Vec<(f64, String)>,
+    /// The work passes driven, when [`DemoOptions::record_work`].
+    pub work: Vec<WorkPass>,
 }
 
-fn tracker_name(kind: TrackerChoice) -> &'static str {
+pub(crate) fn tracker_name(kind: TrackerChoice) -> &'static str {
     match kind {
         TrackerChoice::Predictive => "predictive",
         TrackerChoice::PurePursuit => "pure_pursuit",
@@ -413,8 +442,12 @@ pub fn run(
         }
     }
     let speed = cfg.speed();
+    let segment_job = matches!(
+        node.controller().guidance().job_plan(),
+        JobPlan::Segments(_)
+    );
     let start = match (&opts.resume, &opts.job) {
-        (None, Some(JobPlan::Segments(_))) => node.controller().path_start_pose().map(|p| {
+        (None, _) if segment_job => node.controller().path_start_pose().map(|p| {
             let normal = left_normal(&crate::geo::heading_vec(p.heading));
             let pos = p.pos + normal * cfg.sim.start_offset_m;
             Pose::new(
@@ -452,7 +485,7 @@ pub fn run(
     let dt = cfg.dt();
     let max_time = if cfg.sim.max_time_s > 0.0 {
         cfg.sim.max_time_s
-    } else if let Some(JobPlan::Segments(job)) = &opts.job {
+    } else if let JobPlan::Segments(job) = node.controller().guidance().job_plan() {
         let length: f64 = job.segments().iter().map(|s| s.length()).sum();
         60.0 + 3.0 * length / cfg.speed().max(0.1)
     } else {
@@ -480,6 +513,7 @@ pub fn run(
         outlines: opts.outlines.clone(),
         ..Trace::default()
     };
+    let mut work: Vec<WorkPass> = Vec::new();
     let mut distance = 0.0;
     let mut next_trace_at = 0.0;
     let mut max_wheel: f64 = 0.0;
@@ -623,8 +657,23 @@ pub fn run(
                 if opts.record_trace {
                     trace.lines.push(scored_path.points.clone());
                 }
+                if opts.record_work {
+                    work.push(WorkPass {
+                        nominal: scored_path.points.clone(),
+                        after_turn,
+                        samples: Vec::new(),
+                    });
+                }
             }
             if let Some((along, xte)) = scored_path.locate(&truth.pose.pos, g.index_global()) {
+                if let Some(pass) = work.last_mut().filter(|_| opts.record_work) {
+                    pass.samples.push(WorkSample {
+                        t,
+                        along_m: along,
+                        xte_m: xte,
+                        pos: truth.pose.pos,
+                    });
+                }
                 if (ACQUISITION_SKIP_M..=scored_path.length()).contains(&along) {
                     stats.add(xte);
                     if after_turn && along <= ACQUISITION_END_M {
@@ -717,5 +766,6 @@ pub fn run(
         finished_lines,
         progress: ctrl.guidance().progress(),
         disengage_events,
+        work,
     })
 }

@@ -45,7 +45,121 @@ pub struct EstimatorParams {
     pub predict: bool,
     /// Extra prediction horizon past now (about the actuator dead time), s.
     pub lead_time: f64,
+    /// Correct the antenna's lean with the fix's roll (lateral − up·sin roll); the plain
+    /// pure-pursuit reference leaves it out.
+    pub roll_compensation: bool,
+    /// The disturbance observer (off by default).
+    pub observer: ObserverParams,
 }
+
+/// The disturbance observer: a constant-gain (steady-state Kalman) filter on the innovation
+/// of each fix against the pose predicted from the previous fix. Two slowly varying
+/// disturbances are estimated:
+///
+/// * a wheel-angle offset `b` (vehicle frame, rad: measured − true angle), from the heading
+///   innovation: the predicted yaw rate uses v·tan(δ_measured − b)/L, so
+///   Δθ ≈ −v·Δt/(L·cos²δ)·(b − b̂);
+/// * a drift velocity `d` (world frame, m/s, e.g. side-slope slip), from the lateral
+///   innovation Δl ≈ (d − d̂)·n·Δt, n the vehicle's left normal. Only the component along n is
+///   observable on a straight pass; kept as a world vector, a drift that is fixed on the
+///   ground (downhill) keeps its sign when the direction of travel flips, and turns observe it
+///   from every side.
+///
+/// * a side-slope slip coefficient `c` (vehicle frame, m/s per rad of roll), see
+///   [`ObserverParams::slip_tau`].
+///
+/// Each update moves the estimate by Δt/τ of the innovation's measurement of its error, a
+/// first-order filter with time constant τ; τ starts at 1 s and grows with the time learnt up
+/// to the configured value, as a Kalman filter's gain falls from its initial covariance to the
+/// steady state. Innovations beyond a gate (5 cm lateral, 0.02 rad heading) are jumps, not
+/// drift: they are not learnt from, and the estimator dead-reckons through them and through
+/// RTK-float periods ([`ObserverParams::coast_max`]). Both estimates enter the prediction, and the
+/// controller steers the velocity (course) rather than the heading onto the path, which cancels
+/// the drift. The innovation of two consecutive fixes telescopes: white position noise σ leaves
+/// about σ/τ_drift of noise on the drift, heading noise σθ about σθ·L/(v·τ_bias) on the offset.
+/// Reference: the disturbance-observer form of a Kalman filter on the path-relative error model,
+/// e.g. Åström & Murray, *Feedback Systems*, ch. 7 (state estimation with integral
+/// disturbance states).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObserverParams {
+    /// Time constant of the wheel-angle offset estimate, s; 0 = off.
+    pub bias_tau: f64,
+    /// Time constant of the drift estimate, s; 0 = off.
+    pub drift_tau: f64,
+    /// Learns only above this speed, m/s.
+    pub min_speed: f64,
+    /// Largest wheel-angle offset, rad.
+    pub bias_limit: f64,
+    /// Largest drift speed, m/s.
+    pub drift_limit: f64,
+    /// Time constant of the slope-slip coefficient estimate, s; 0 = off. Side-slope slip is
+    /// about proportional to the slope: a vehicle-frame lateral velocity −c·sin(roll) (to the
+    /// right, downhill, for positive roll), with c learnt by normalised LMS from the same
+    /// lateral innovation as the drift. It follows a slope that varies along the pass, which a
+    /// drift estimate can only chase, and it keeps doing so while coasting.
+    pub slip_tau: f64,
+    /// Largest slip coefficient, m/s per rad of roll.
+    pub slip_limit: f64,
+    /// While the fix is RTK float, dead-reckon the position from the last fixed one (with the
+    /// measured heading, the measured wheel angles less the offset, and the drift) instead of
+    /// taking the float positions, for at most this long, s; 0 = off.
+    pub coast_max: f64,
+}
+
+impl Default for ObserverParams {
+    fn default() -> Self {
+        ObserverParams {
+            bias_tau: 0.0,
+            drift_tau: 0.0,
+            min_speed: 1.0,
+            bias_limit: 3f64.to_radians(),
+            drift_limit: 0.3,
+            slip_tau: 0.0,
+            slip_limit: 3.0,
+            coast_max: 0.0,
+        }
+    }
+}
+
+/// Innovations larger than these are not learnt from: lateral m (about 3.5 σ of the innovation
+/// of two fixes with 1 cm noise each), heading rad. A lateral one while moving is a jump
+/// (multipath, the onset of a float solution): while RTK fixed, the estimator coasts through
+/// it (dead reckoning) until the fixes agree with it again, for at most
+/// [`ObserverParams::coast_max`].
+const GATE_LATERAL: f64 = 0.05;
+const GATE_HEADING: f64 = 0.02;
+
+/// Why the estimator is dead-reckoning instead of taking the fix positions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Coast {
+    Off,
+    /// Since this time (s): the fix is RTK float.
+    Float(f64),
+    /// Since this time (s): the fixes jumped away from the dead reckoning.
+    Jump(f64),
+    /// Coasted for `coast_max`: fix positions are taken until the cause clears.
+    Expired,
+}
+
+/// A fix against the pose predicted from the previous one.
+#[derive(Debug, Clone, Copy)]
+struct Innovation {
+    predicted: Pose,
+    /// Measurement times of the previous and the new fix, s.
+    t_prev: f64,
+    dt: f64,
+    heading: f64,
+    lateral: f64,
+    normal: Vec2,
+}
+/// The offset is learnt only below this wheel angle, rad (the linearisation holds and the
+/// actuator is not slewing through a turn).
+const BIAS_MAX_WHEEL: f64 = 0.2;
+/// Shortest effective time constant at the start of learning, s.
+const MIN_TAU: f64 = 1.0;
+/// Regularisation of the slip coefficient's normalised LMS step: sin² of about 1°, so that on
+/// flat ground the coefficient is left alone.
+const SLIP_EPS: f64 = 3e-4;
 
 /// The estimate handed to guidance and tracking.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,6 +190,23 @@ pub struct Estimator {
     wheel: [(f64, f64); RING],
     wheel_head: usize,
     wheel_len: usize,
+    /// Estimated wheel-angle offset (measured − true), rad.
+    bias: f64,
+    /// Estimated world-frame drift velocity, m/s.
+    drift: Vec2,
+    /// Estimated slope-slip coefficient, m/s per rad of roll (lateral, to the right).
+    slip: f64,
+    /// Roll of the latest fix, rad (0 without a roll signal).
+    roll: f64,
+    /// Time the observer has learnt for, s: the effective time constants grow with it up to
+    /// the configured ones (as a Kalman filter's gain falls from a large initial covariance).
+    learnt: f64,
+    /// The observer learns from the next fixes (the fix quality vouches for them).
+    learn: bool,
+    /// The next fixes are RTK float: coast (see [`ObserverParams::coast_max`]).
+    coast: bool,
+    /// Dead reckoning through an RTK float or a position jump.
+    coast_state: Coast,
 }
 
 impl Estimator {
@@ -90,6 +221,134 @@ impl Estimator {
             wheel: [(0.0, 0.0); RING],
             wheel_head: 0,
             wheel_len: 0,
+            bias: 0.0,
+            drift: Vec2::zeros(),
+            slip: 0.0,
+            roll: 0.0,
+            learnt: 0.0,
+            learn: true,
+            coast: false,
+            coast_state: Coast::Off,
+        }
+    }
+
+    /// Whether the next fixes are RTK float (coast through them, see
+    /// [`ObserverParams::coast_max`]).
+    pub fn set_coasting(&mut self, coast: bool) {
+        self.coast = coast;
+    }
+
+    /// Whether the position is being dead-reckoned through an RTK-float period.
+    pub fn is_coasting(&self) -> bool {
+        matches!(self.coast_state, Coast::Float(_) | Coast::Jump(_))
+    }
+
+    /// Whether the observer may learn from the following fixes (off while the fix is not RTK
+    /// fixed: a float solution wanders by decimetres and would read as drift).
+    pub fn set_learning(&mut self, learn: bool) {
+        self.learn = learn;
+    }
+
+    /// The estimated wheel-angle offset (measured − true), rad.
+    pub fn wheel_offset(&self) -> f64 {
+        self.bias
+    }
+
+    /// The estimated world-frame drift velocity, m/s (without the slope slip).
+    pub fn drift(&self) -> Vec2 {
+        self.drift
+    }
+
+    /// The estimated slope-slip coefficient, m/s per rad of roll.
+    pub fn slip_coefficient(&self) -> f64 {
+        self.slip
+    }
+
+    /// The whole estimated drift velocity (world frame, m/s) of a vehicle heading `heading`
+    /// (rad) at the latest roll: the world drift plus the slope slip.
+    pub fn drift_velocity(&self, heading: f64) -> Vec2 {
+        self.drift - left_normal(&heading_vec(heading)) * (self.slip * self.roll.sin())
+    }
+
+    /// Integrate the bicycle model from `pose` at `t0` over `span` s at speed `v`, with the
+    /// measured wheel angles less the estimated offset and the estimated drift.
+    fn propagate(&self, pose: Pose, v: f64, t0: f64, span: f64) -> Pose {
+        let steps = (span / PREDICT_STEP).ceil() as usize;
+        let (mut x, mut y, mut th) = (pose.pos.x, pose.pos.y, pose.heading);
+        let l = self.params.wheelbase;
+        if steps > 0 {
+            let h = span / steps as f64;
+            for i in 0..steps {
+                // Midpoint rule for the heading keeps the arc accurate at this step.
+                let t_mid = t0 + (i as f64 + 0.5) * h;
+                let rate = v * (self.wheel_angle_at(t_mid) - self.bias).tan() / l;
+                let th_mid = th + 0.5 * h * rate;
+                let drift = self.drift_velocity(th_mid);
+                x += (v * th_mid.cos() + drift.x) * h;
+                y += (v * th_mid.sin() + drift.y) * h;
+                th += rate * h;
+            }
+        }
+        Pose::new(x, y, th)
+    }
+
+    /// The fix `new` (measured at `t_new`) against the pose predicted from the previous fix.
+    fn innovation(&self, new: &Pose, t_new: f64) -> Option<Innovation> {
+        let prev = self.fix_pose?;
+        let t_prev = self.fix_time - self.params.gnss_latency;
+        let dt = t_new - t_prev;
+        if !(dt > 0.0 && dt <= 1.0) {
+            return None;
+        }
+        let predicted = self.propagate(prev, self.fix_speed, t_prev, dt);
+        let normal = left_normal(&heading_vec(new.heading));
+        Some(Innovation {
+            predicted,
+            t_prev,
+            dt,
+            heading: wrap_angle(new.heading - predicted.heading),
+            lateral: (new.pos - predicted.pos).dot(&normal),
+            normal,
+        })
+    }
+
+    /// Learn the disturbances from an innovation within the gates.
+    fn observe(&mut self, i: &Innovation, v_new: f64) {
+        let o = self.params.observer;
+        let v = self.fix_speed;
+        if !self.learn
+            || i.dt > 0.5
+            || v.abs() < o.min_speed
+            || v_new.abs() < o.min_speed
+            || i.heading.abs() > GATE_HEADING
+            || i.lateral.abs() > GATE_LATERAL
+        {
+            return;
+        }
+        let (dt, t_prev, d_heading, d_lateral, n) =
+            (i.dt, i.t_prev, i.heading, i.lateral, i.normal);
+        self.learnt += dt;
+        let tau = |configured: f64| configured.min(self.learnt.max(MIN_TAU));
+        if o.bias_tau > 0.0 {
+            let delta = self.wheel_angle_at(t_prev + 0.5 * dt) - self.bias;
+            if delta.abs() < BIAS_MAX_WHEEL {
+                let c = delta.cos();
+                let step = -d_heading * self.params.wheelbase * c * c / (v * tau(o.bias_tau));
+                self.bias = (self.bias + step).clamp(-o.bias_limit, o.bias_limit);
+            }
+        }
+        if o.slip_tau > 0.0 {
+            // Normalised LMS on the lateral rate error e = Δl/Δt with regressor −sin(roll).
+            let phi = -self.roll.sin();
+            let step = d_lateral / tau(o.slip_tau) * phi / (phi * phi + SLIP_EPS);
+            self.slip = (self.slip + step).clamp(-o.slip_limit, o.slip_limit);
+        }
+        if o.drift_tau > 0.0 {
+            self.drift += n * (d_lateral / tau(o.drift_tau));
+            let norm = self.drift.norm();
+            if norm > o.drift_limit {
+                self.drift *= o.drift_limit / norm;
+            }
         }
     }
 
@@ -141,9 +400,52 @@ impl Estimator {
         let Some(heading) = heading else {
             return;
         };
-        let pos =
-            self.antenna_to_rear_axle(&fix.antenna, heading, fix.roll.filter(|r| r.is_finite()));
-        self.fix_pose = Some(Pose::new(pos.x, pos.y, heading));
+        let roll = fix
+            .roll
+            .filter(|r| r.is_finite() && self.params.roll_compensation);
+        self.roll = roll.unwrap_or(0.0);
+        let pos = self.antenna_to_rear_axle(&fix.antenna, heading, roll);
+        let mut pose = Pose::new(pos.x, pos.y, heading);
+        let t_meas = fix.t_received - self.params.gnss_latency;
+        let o = self.params.observer;
+        let innovation = if self.params.predict
+            && (o.bias_tau > 0.0 || o.drift_tau > 0.0 || o.coast_max > 0.0)
+        {
+            self.innovation(&pose, t_meas)
+        } else {
+            None
+        };
+        // A jump is a lateral step of the position while moving: a heading that jumps (course
+        // from successive fixes at low speed) is not a reason to distrust the position.
+        let moving = self.fix_speed.abs() >= o.min_speed && fix.speed.abs() >= o.min_speed;
+        let jump = moving && innovation.is_some_and(|i| i.lateral.abs() > GATE_LATERAL);
+        let t = fix.t_received;
+        let expired = |since: f64| t - since > o.coast_max;
+        self.coast_state = match (innovation.is_some() && o.coast_max > 0.0, self.coast_state) {
+            (false, _) => Coast::Off,
+            (true, Coast::Off) if self.coast => Coast::Float(t),
+            (true, Coast::Off) if jump && self.learn => Coast::Jump(t),
+            (true, Coast::Off) => Coast::Off,
+            (true, Coast::Float(_)) if !self.coast => Coast::Off,
+            (true, Coast::Float(s)) if expired(s) => Coast::Expired,
+            (true, Coast::Float(s)) => Coast::Float(s),
+            (true, Coast::Jump(s)) if self.coast => Coast::Float(s),
+            (true, Coast::Jump(_)) if !jump => Coast::Off,
+            (true, Coast::Jump(s)) if expired(s) => Coast::Expired,
+            (true, Coast::Jump(s)) => Coast::Jump(s),
+            (true, Coast::Expired) if !self.coast && !jump => Coast::Off,
+            (true, Coast::Expired) => Coast::Expired,
+        };
+        match (self.coast_state, innovation) {
+            (Coast::Float(_) | Coast::Jump(_), Some(i)) => {
+                // Dead reckoning from the previous (coasted or fixed) position; the heading is
+                // measured.
+                pose = Pose::new(i.predicted.pos.x, i.predicted.pos.y, heading);
+            }
+            (_, Some(i)) => self.observe(&i, fix.speed),
+            _ => {}
+        }
+        self.fix_pose = Some(pose);
         self.fix_time = fix.t_received;
         self.fix_speed = fix.speed;
     }
@@ -203,24 +505,10 @@ impl Estimator {
         let t0 = self.fix_time - self.params.gnss_latency;
         let t1 = t_now + self.params.lead_time;
         let span = (t1 - t0).clamp(0.0, 2.0);
-        let steps = (span / PREDICT_STEP).ceil() as usize;
-        let (mut x, mut y, mut th) = (pose.pos.x, pose.pos.y, pose.heading);
         let v = self.fix_speed;
-        let l = self.params.wheelbase;
-        if steps > 0 {
-            let h = span / steps as f64;
-            for i in 0..steps {
-                // Midpoint rule for the heading keeps the arc accurate at this step.
-                let t_mid = t0 + (i as f64 + 0.5) * h;
-                let rate = v * self.wheel_angle_at(t_mid).tan() / l;
-                let th_mid = th + 0.5 * h * rate;
-                x += v * th_mid.cos() * h;
-                y += v * th_mid.sin() * h;
-                th += rate * h;
-            }
-        }
+        let pose = self.propagate(pose, v, t0, span);
         Some(VehicleEstimate {
-            pose: Pose::new(x, y, th),
+            pose,
             speed: v,
             fix_age,
         })
@@ -243,6 +531,8 @@ mod tests {
             gnss_latency: 0.05,
             predict,
             lead_time: 0.0,
+            roll_compensation: true,
+            observer: ObserverParams::default(),
         }
     }
 
@@ -349,5 +639,139 @@ mod tests {
         }
         let est = e.estimate(0.5).unwrap();
         assert!((est.pose.heading - std::f64::consts::FRAC_PI_4).abs() < 1e-9);
+    }
+
+    /// A vehicle on a straight line with a wheel-angle sensor bias and a world drift, fed to
+    /// an estimator with the observer on: fixes at 10 Hz, wheel angles at 50 Hz, heading and
+    /// position exact. Returns the estimator after `seconds` s driven at 3 m/s along `heading`.
+    fn drive(
+        e: &mut Estimator,
+        t0: f64,
+        seconds: f64,
+        start: Pose,
+        bias: f64,
+        drift: Vec2,
+        float: Option<(f64, f64, Vec2)>,
+    ) -> Pose {
+        let v = 3.0;
+        let (mut x, mut y, th) = (start.pos.x, start.pos.y, start.heading);
+        let steps = (seconds / 0.02).round() as usize;
+        for k in 1..=steps {
+            let t = t0 + k as f64 * 0.02;
+            x += (v * th.cos() + drift.x) * 0.02;
+            y += (v * th.sin() + drift.y) * 0.02;
+            // Straight: true wheel angle 0, the sensor reads the bias.
+            e.on_wheel_angle(t, bias);
+            if k % 5 == 0 {
+                let truth = Pose::new(x, y, th);
+                let mut antenna = antenna_of(e, &truth);
+                let mut in_float = false;
+                if let Some((a, b, err)) = float {
+                    if t >= a && t <= b {
+                        antenna += err;
+                        in_float = true;
+                    }
+                }
+                e.set_learning(!in_float);
+                e.set_coasting(in_float);
+                e.on_fix(&GnssFix {
+                    t_received: t + e.params().gnss_latency,
+                    antenna,
+                    heading: Some(th),
+                    speed: v,
+                    roll: None,
+                });
+            }
+        }
+        Pose::new(x, y, th)
+    }
+
+    fn observer_params() -> EstimatorParams {
+        EstimatorParams {
+            observer: ObserverParams {
+                bias_tau: 5.0,
+                drift_tau: 5.0,
+                coast_max: 30.0,
+                ..ObserverParams::default()
+            },
+            ..params(true)
+        }
+    }
+
+    #[test]
+    fn the_observer_learns_a_sensor_bias_and_a_world_drift_that_keeps_its_sign() {
+        let mut e = Estimator::new(observer_params());
+        let bias = 0.5f64.to_radians();
+        // East drift of 3 cm/s while driving north, then south.
+        let drift = v2(0.03, 0.0);
+        let north = Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+        let end = drive(&mut e, 0.0, 60.0, north, bias, drift, None);
+        assert!(
+            (e.wheel_offset() - bias).abs() < 0.05 * bias,
+            "offset {} vs {bias}",
+            e.wheel_offset()
+        );
+        assert!((e.drift() - drift).norm() < 0.003, "drift {:?}", e.drift());
+        // Turned about (the drift is on the other side of the vehicle now): the estimate is
+        // still right from the first fix, and the prediction carries it.
+        let south = Pose::new(end.pos.x + 3.0, end.pos.y, -std::f64::consts::FRAC_PI_2);
+        let t = 61.0;
+        drive(&mut e, t, 1.0, south, bias, drift, None);
+        assert!((e.drift() - drift).norm() < 0.003, "drift {:?}", e.drift());
+        // Without the observer the same drive leaves both at zero.
+        let mut off = Estimator::new(params(true));
+        drive(&mut off, 0.0, 20.0, north, bias, drift, None);
+        assert_eq!((off.wheel_offset(), off.drift()), (0.0, Vec2::zeros()));
+    }
+
+    #[test]
+    fn the_estimator_coasts_through_rtk_float_and_a_position_jump() {
+        let mut e = Estimator::new(observer_params());
+        let north = Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+        // A 20 cm float error from 30 s to 40 s: the estimate dead-reckons and stays on the
+        // true track instead.
+        let err = v2(0.2, 0.0);
+        let truth = drive(
+            &mut e,
+            0.0,
+            35.0,
+            north,
+            0.0,
+            Vec2::zeros(),
+            Some((30.0, 40.0, err)),
+        );
+        assert!(e.is_coasting());
+        let est = e.estimate(35.0).expect("an estimate").pose;
+        assert!(
+            (est.pos.x - truth.pos.x).abs() < 0.01,
+            "{est:?} vs {truth:?}"
+        );
+        // Fixed again: the fixes are taken at once.
+        let truth = drive(
+            &mut e,
+            35.0,
+            10.0,
+            truth,
+            0.0,
+            Vec2::zeros(),
+            Some((30.0, 40.0, err)),
+        );
+        assert!(!e.is_coasting());
+        let est = e.estimate(45.0).expect("an estimate").pose;
+        assert!((est.pos.x - truth.pos.x).abs() < 0.01);
+        // A 10 cm jump of a fixed solution (multipath) is not followed either, nor learnt.
+        let truth = drive(&mut e, 45.0, 5.0, truth, 0.0, Vec2::zeros(), None);
+        let before = e.drift();
+        let jump = v2(0.1, 0.0);
+        let ant = antenna_of(&e, &truth) + jump;
+        e.on_fix(&GnssFix {
+            t_received: 50.1,
+            antenna: ant,
+            heading: Some(truth.heading),
+            speed: 3.0,
+            roll: None,
+        });
+        assert!(e.is_coasting());
+        assert_eq!(e.drift(), before);
     }
 }

@@ -2,6 +2,7 @@
 //! clocks, no globals.
 
 pub mod abline;
+pub mod arcs;
 pub mod coverage;
 pub mod maneuver;
 pub mod turns;

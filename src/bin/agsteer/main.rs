@@ -1,5 +1,6 @@
 //! `agsteer`: the technician's and developer's tool.
 
+mod accuracy_cmd;
 mod dbc_cmd;
 mod maneuver_cmd;
 mod plan_cmd;
@@ -55,6 +56,29 @@ enum Command {
         /// Stop after this many lines, as a power loss would (for trying --resume).
         #[arg(long, value_name = "LINES")]
         stop_after: Option<u64>,
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    },
+    /// The accuracy report: every scenario in tools/scenarios/ (or the given files) with the
+    /// default tracker, pure pursuit and Stanley; XTE, 95 % class, pass-to-pass after
+    /// ISO 12188-2, acquisition after turns, RTK-float behaviour; OUT/<scenario>.svg of XTE
+    /// over distance and OUT/accuracy.json.
+    Accuracy {
+        /// Tracker: predictive, pure_pursuit, stanley or all.
+        #[arg(long, default_value = "all")]
+        tracker: String,
+        /// Print the results as JSON instead of the Markdown table.
+        #[arg(long)]
+        json: bool,
+        /// Output directory for the SVGs and accuracy.json.
+        #[arg(long, default_value = "out/accuracy")]
+        out: PathBuf,
+        /// Scenario directory (every *.toml in it).
+        #[arg(long, default_value = "tools/scenarios")]
+        scenarios: PathBuf,
+        /// Run these scenario files instead of the directory.
+        #[arg(long)]
+        config: Vec<PathBuf>,
         #[command(flatten)]
         cfg: ConfigArgs,
     },
@@ -169,6 +193,14 @@ fn main() -> ExitCode {
     init_logging();
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Accuracy {
+            tracker,
+            json,
+            out,
+            scenarios,
+            config,
+            cfg,
+        } => accuracy_cmd::run(&scenarios, &config, &tracker, json, &out, &cfg.set),
         Command::Demo {
             config,
             out,
@@ -316,7 +348,7 @@ fn run_demo(
             prepare_field_job(&cfg)
                 .with_context(|| format!("job.kind = \"field\" in {}", config.display()))?,
         ),
-        JobKind::Ab | JobKind::Maneuver => None,
+        JobKind::Ab | JobKind::Arcs | JobKind::Maneuver => None,
     };
     let maneuver = match cfg.job.kind {
         JobKind::Maneuver => {

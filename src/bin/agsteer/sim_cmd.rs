@@ -48,6 +48,7 @@ pub fn run(
                 agsteer::daemon::maneuver_file::load(cfg).context("job.kind = \"maneuver\"")?;
             (None, Some(mj.job))
         }
+        JobKind::Arcs => (None, None),
     };
     let first = segment_job.as_ref().and_then(|j| j.segments().first());
     let (a, b) = match first.map(|s| s.points.as_slice()) {

@@ -1,0 +1,143 @@
+//! `agsteer accuracy`: the scenario suite, every tracker side by side (see
+//! [`agsteer::demo::accuracy`]).
+
+use agsteer::config::{Config, TrackerChoice};
+use agsteer::demo::accuracy::{
+    evaluate, markdown_table, xte_svg, ScenarioResult, XteSeries, TRACKERS,
+};
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+
+/// The scenarios: the given files, or every `*.toml` in `dir`, sorted by name.
+fn scenarios(dir: &Path, files: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    if !files.is_empty() {
+        return Ok(files.to_vec());
+    }
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("scenario directory {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    if v.is_empty() {
+        bail!("no *.toml scenarios in {}", dir.display());
+    }
+    Ok(v)
+}
+
+fn trackers(name: &str) -> Result<Vec<TrackerChoice>> {
+    if name == "all" {
+        return Ok(TRACKERS.to_vec());
+    }
+    TRACKERS
+        .iter()
+        .copied()
+        .find(|k| agsteer::demo::accuracy::tracker_name(*k) == name)
+        .map(|k| vec![k])
+        .with_context(|| {
+            format!("unknown tracker {name:?} (predictive, pure_pursuit, stanley or all)")
+        })
+}
+
+type Outcome = (usize, usize, Result<(ScenarioResult, XteSeries)>);
+
+/// Run the suite; prints the table (or JSON) and writes OUT/<scenario>.svg and
+/// OUT/accuracy.json.
+pub fn run(
+    dir: &Path,
+    files: &[PathBuf],
+    tracker: &str,
+    json: bool,
+    out: &Path,
+    set: &[String],
+) -> Result<u8> {
+    let kinds = trackers(tracker)?;
+    let paths = scenarios(dir, files)?;
+    let mut cfgs: Vec<(String, Config)> = Vec::new();
+    for p in &paths {
+        let name = p
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| p.display().to_string());
+        let cfg = Config::load(p, set).with_context(|| format!("scenario {}", p.display()))?;
+        cfgs.push((name, cfg));
+    }
+    // Every (scenario, tracker) run is independent: spread them over the cores.
+    let jobs: Vec<(usize, usize)> = (0..cfgs.len())
+        .flat_map(|i| (0..kinds.len()).map(move |k| (i, k)))
+        .collect();
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .min(jobs.len())
+        .max(1);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut outcomes: Vec<Outcome> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                s.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let j = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(&(i, k)) = jobs.get(j) else {
+                            break;
+                        };
+                        let (name, cfg) = &cfgs[i];
+                        let r = evaluate(name, cfg, kinds[k])
+                            .with_context(|| format!("scenario {name}"));
+                        done.push((i, k, r));
+                    }
+                    done
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_default())
+            .collect()
+    });
+    outcomes.sort_by_key(|o| (o.0, o.1));
+    if outcomes.len() != jobs.len() {
+        bail!("a scenario run panicked");
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut results = Vec::new();
+    for (i, (name, _)) in cfgs.iter().enumerate() {
+        let mut series: Vec<(&str, XteSeries)> = Vec::new();
+        for o in outcomes.iter_mut().filter(|o| o.0 == i) {
+            let r = std::mem::replace(&mut o.2, Err(anyhow::anyhow!("taken")))?;
+            series.push((agsteer::demo::accuracy::tracker_name(kinds[o.1]), r.1));
+            results.push(r.0);
+        }
+        let refs: Vec<(&str, &XteSeries)> = series.iter().map(|(n, s)| (*n, s)).collect();
+        let svg_path = out.join(format!("{name}.svg"));
+        std::fs::write(&svg_path, xte_svg(name, &refs))
+            .with_context(|| format!("writing {}", svg_path.display()))?;
+    }
+    let text = serde_json::to_string_pretty(&results)?;
+    let json_path = out.join("accuracy.json");
+    std::fs::write(&json_path, &text)
+        .with_context(|| format!("writing {}", json_path.display()))?;
+    if json {
+        println!("{text}");
+    } else {
+        print!("{}", markdown_table(&results));
+        for r in &results {
+            if let Some(f) = &r.rtk_float {
+                println!(
+                    "\n{} / {}: RTK float {:?} s; safety.rtk_float_tolerance_s = {} ({}): {} fix-quality disengagement(s), max |XTE| during the float {}",
+                    r.scenario,
+                    r.tracker,
+                    f.windows_s,
+                    f.tolerance_s,
+                    f.behaviour,
+                    f.fix_disengagements,
+                    f.xte_max_during_float_m
+                        .map_or("- (no work samples)".into(), |m| format!("{:.2} cm", 100.0 * m)),
+                );
+            }
+        }
+        eprintln!("SVGs and accuracy.json in {}", out.display());
+    }
+    Ok(0)
+}

@@ -1,0 +1,116 @@
+//! The accuracy suite (`agsteer accuracy`, tools/scenarios) closed-loop: the default tracker
+//! against bounds about twice the figures measured when they were set (in brackets, cm), and
+//! against plain pure pursuit where the disturbance estimation must pay off.
+
+use agsteer::config::{Config, TrackerChoice};
+use agsteer::demo::accuracy::{evaluate, ScenarioResult};
+
+fn scenario(name: &str, kind: TrackerChoice, set: &[String]) -> ScenarioResult {
+    let path = format!("{}/tools/scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    let cfg = Config::load(std::path::Path::new(&path), set).expect("scenario config is valid");
+    evaluate(name, &cfg, kind).expect("the scenario runs").0
+}
+
+fn cm(m: f64) -> f64 {
+    100.0 * m
+}
+
+#[test]
+fn the_default_tracker_holds_its_figures_in_every_scenario() {
+    // (scenario, RMS cm bound, p95 cm bound, pass-to-pass 95 % cm bound) [measured rms/p95/p2p]
+    for (name, rms, p95, p2p) in [
+        ("straight_4kmh", 0.5, 0.8, 1.2),      // [0.20/0.35/0.52]
+        ("straight_10kmh", 0.6, 1.2, 1.5),     // [0.30/0.57/0.75]
+        ("straight_15kmh", 5.5, 9.0, 20.0),    // [2.76/4.40/9.91] acquisition at 15 km/h
+        ("was_bias", 0.6, 1.2, 1.5),           // [0.30/0.58/0.75]
+        ("slip_side_slope", 0.6, 1.2, 1.6),    // [0.29/0.56/0.77]
+        ("roll_antenna_3m", 0.7, 1.3, 1.8),    // [0.30/0.59/0.78]
+        ("gnss_markov", 2.3, 4.6, 6.6),        // [1.14/2.29/3.30]
+        ("rtk_float_20s", 0.6, 1.2, 1.5),      // [0.30/0.58/0.75]
+        ("speed_profile_4_15", 0.7, 1.3, 1.8), // [0.33/0.62/0.88]
+        ("all_disturbances", 4.7, 9.0, 12.0),  // [2.27/4.46/5.39]
+        ("curve_r30", 1.0, 1.7, 1.8),          // [0.49/0.82/0.88]
+        ("curve_r15", 1.6, 2.3, 2.7),          // [0.77/1.13/1.33]
+    ] {
+        let r = scenario(name, TrackerChoice::Predictive, &[]);
+        assert!(r.finished, "{name}: {r:?}");
+        assert!(
+            cm(r.xte_rms_m) < rms,
+            "{name}: rms {:.2} cm",
+            cm(r.xte_rms_m)
+        );
+        assert!(
+            cm(r.xte_p95_m) < p95,
+            "{name}: p95 {:.2} cm",
+            cm(r.xte_p95_m)
+        );
+        let pp = r.pass_to_pass_p95_m.expect("adjacent passes were compared");
+        assert!(r.pass_to_pass_stations > 100, "{name}: {r:?}");
+        assert!(cm(pp) < p2p, "{name}: pass-to-pass {:.2} cm", cm(pp));
+        assert_eq!(r.error_class_cm, (cm(r.xte_p95_m) - 1e-9).ceil() as u32);
+    }
+}
+
+#[test]
+fn disturbance_estimation_beats_plain_pure_pursuit_at_least_twice() {
+    for name in [
+        "was_bias",
+        "slip_side_slope",
+        "roll_antenna_3m",
+        "all_disturbances",
+    ] {
+        let ours = scenario(name, TrackerChoice::Predictive, &[]);
+        let reference = scenario(name, TrackerChoice::PurePursuit, &[]);
+        assert!(
+            2.0 * ours.xte_rms_m <= reference.xte_rms_m,
+            "{name}: default {:.2} cm vs pure pursuit {:.2} cm",
+            cm(ours.xte_rms_m),
+            cm(reference.xte_rms_m)
+        );
+    }
+}
+
+#[test]
+fn disturbance_estimation_beats_the_same_tracker_without_it() {
+    // Observer and coasting off: the predictive tracker as it was before (slip 4.04 cm).
+    let off: Vec<String> = [
+        "track.observer_bias_tau_s=0",
+        "track.observer_drift_tau_s=0",
+        "track.observer_slip_tau_s=0",
+        "track.observer_coast_max_s=0",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for (name, factor) in [("slip_side_slope", 4.0), ("rtk_float_20s", 2.0)] {
+        let on = scenario(name, TrackerChoice::Predictive, &[]);
+        let without = scenario(name, TrackerChoice::Predictive, &off);
+        assert!(
+            factor * on.xte_rms_m <= without.xte_rms_m,
+            "{name}: with {:.2} cm, without {:.2} cm",
+            cm(on.xte_rms_m),
+            cm(without.xte_rms_m)
+        );
+    }
+}
+
+#[test]
+fn rtk_float_behaviour_is_reported_as_configured() {
+    // Tolerance 30 s: steering degrades through the 20 s float and never disengages for it.
+    let r = scenario("rtk_float_20s", TrackerChoice::Predictive, &[]);
+    let f = r.rtk_float.expect("a float window");
+    assert_eq!((f.behaviour, f.fix_disengagements), ("degrade", 0));
+    let during = f.xte_max_during_float_m.expect("work samples in the float");
+    assert!(
+        cm(during) < 5.0,
+        "max {:.2} cm during the float [0.77]",
+        cm(during)
+    );
+    // Tolerance 0: the supervisor refuses the float fix at once.
+    let set = ["safety.rtk_float_tolerance_s=0".to_string()];
+    let r = scenario("rtk_float_20s", TrackerChoice::Predictive, &set);
+    let f = r.rtk_float.clone().expect("a float window");
+    assert_eq!(f.behaviour, "refuse");
+    assert!(f.fix_disengagements >= 1, "{r:?}");
+    assert!(r.engaged_fraction < 0.99, "{r:?}");
+}
