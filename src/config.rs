@@ -216,7 +216,8 @@ impl Default for GuidanceConfig {
 pub struct VehicleConfig {
     /// Wheelbase (rear axle to front axle), m.
     pub wheelbase_m: f64,
-    /// Minimum turning radius used for turns, m.
+    /// Minimum turning radius used for turns, m. Turns are planned with a larger radius when
+    /// the job speed needs it: v² / `safety.a_lat_max_m_s2` (15 km/h at 2 m/s²: 8.7 m).
     pub r_min_m: f64,
     /// Largest front-wheel angle either way, degrees.
     pub max_wheel_angle_deg: f64,
@@ -839,7 +840,7 @@ impl Config {
         let f = &self.field;
         CoverageParams {
             line_width: self.job.line_width_m,
-            r_min: self.vehicle.r_min_m,
+            r_min: self.turn_radius(),
             headland_passes: f.headland_passes,
             point_spacing: self.guidance.point_spacing_m,
             swath_angle: match f.swath_angle {
@@ -1593,6 +1594,18 @@ impl Config {
     pub fn speed(&self) -> f64 {
         self.control.speed_kmh / 3.6
     }
+    /// Radius of the planned turns, m: `vehicle.r_min_m`, or more when the job speed would
+    /// need a lateral acceleration above `safety.a_lat_max_m_s2` on it (v² / a_lat_max). The
+    /// supervisor would not allow the tighter turn at that speed, so it is not planned.
+    pub fn turn_radius(&self) -> f64 {
+        let v = self.speed();
+        let a = self.safety.a_lat_max_m_s2;
+        if a > 0.0 && a.is_finite() {
+            self.vehicle.r_min_m.max(v * v / a)
+        } else {
+            self.vehicle.r_min_m
+        }
+    }
     /// Largest wheel angle, rad.
     pub fn max_wheel_angle(&self) -> f64 {
         self.vehicle.max_wheel_angle_deg.to_radians()
@@ -1668,6 +1681,18 @@ fn fmt_num(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn turns_are_planned_no_tighter_than_the_speed_allows() {
+        let mut cfg = Config::default();
+        // 10 km/h, 2 m/s²: v²/a = 3.9 m < r_min 5 m.
+        assert_eq!(cfg.turn_radius(), cfg.vehicle.r_min_m);
+        cfg.control.speed_kmh = 15.0;
+        let v: f64 = 15.0 / 3.6;
+        assert!((cfg.turn_radius() - v * v / 2.0).abs() < 1e-12);
+        assert!(cfg.coverage_params().r_min > 8.0);
+        assert!(crate::control::ab_params(&cfg).turn.r_min > 8.0);
+    }
 
     #[test]
     fn defaults_are_valid() {

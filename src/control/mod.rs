@@ -29,7 +29,7 @@ pub fn ab_params(cfg: &Config) -> AbParams {
         point_b: v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]),
         line_width: cfg.job.line_width_m,
         line_num: cfg.job.line_num,
-        r_min: cfg.vehicle.r_min_m,
+        r_min: cfg.turn_radius(),
         side: match cfg.job.side {
             LineSide::Left => Side::Left,
             LineSide::Right => Side::Right,
@@ -37,7 +37,7 @@ pub fn ab_params(cfg: &Config) -> AbParams {
         block_extra: cfg.guidance.a.max(1) as u32,
         point_spacing: cfg.guidance.point_spacing_m,
         turn: TurnParams {
-            r_min: cfg.vehicle.r_min_m,
+            r_min: cfg.turn_radius(),
             arc_step: cfg.guidance.turn_arc_step_deg.to_radians(),
             merge_distance: cfg.guidance.turn_merge_distance_m,
             point_spacing: cfg.guidance.point_spacing_m,
