@@ -448,9 +448,15 @@ impl Controller {
         self.last_tick = Some(t);
         let learning =
             direction == Direction::Forward && self.guidance.tag() == crate::geo::Tag::Work;
-        let offset = self
+        let mut offset = self
             .integral
             .update(out.xte.unwrap_or(f64::NAN), est.speed, dt, learning);
+        if self.law.kind == TrackerChoice::Predictive {
+            // The steering controller servos the sensed angle to the command, so a sensor
+            // reading `wheel_offset` more than the wheels leaves them short by as much:
+            // command the estimated offset on top.
+            offset += self.estimator.wheel_offset();
+        }
         if offset != 0.0 && tr.valid {
             let max = self.tracker.max_wheel_angle;
             tr.wheel_angle = (tr.wheel_angle + offset).clamp(-max, max);

@@ -164,6 +164,9 @@ pub fn pi_turn(
             distance: d,
         });
     }
+    if params.max_curvature_rate > 0.0 && cc_pi_turn(p1, dir1, p2, n, d, params, out) {
+        return Ok(());
+    }
     let c1 = p1 + n * r;
     let rv1 = p1 - c1;
     // Seed: positive cross(direction, radius vector 1) turns clockwise, else counter-clockwise.
@@ -187,6 +190,66 @@ pub fn pi_turn(
         arc_points(c2, s2, p2, ccw, params.arc_step, false, out);
     }
     Ok(())
+}
+
+/// The pi turn with continuous curvature: a CC quarter turn (clothoid + arc + clothoid at
+/// κ_max = 1/r_min and σ_max = `max_curvature_rate`), a straight across, a second CC quarter
+/// turn. A CC quarter turn reaches a distance q > r_min both along and across, so it needs the
+/// lines at least 2·q apart and level; `false` (nothing written) otherwise, and the arcs are
+/// used.
+fn cc_pi_turn(
+    p1: Vec2,
+    dir1: Vec2,
+    p2: Vec2,
+    n: Vec2,
+    d: f64,
+    params: &TurnParams,
+    out: &mut Vec<PathPoint>,
+) -> bool {
+    use crate::geo::{Direction, Pose, Tag};
+    use crate::plan::maneuver::cc_turn::cc_turn;
+    use crate::plan::maneuver::path::{CurveParams, CurvePath, CurveSegment};
+    let curve = CurveParams {
+        kappa_max: 1.0 / params.r_min,
+        sigma_max: params.max_curvature_rate,
+    };
+    let delta = if cross(&dir1, &n) > 0.0 {
+        std::f64::consts::FRAC_PI_2
+    } else {
+        -std::f64::consts::FRAC_PI_2
+    };
+    let quarter = cc_turn(delta, Direction::Forward, &curve);
+    let start = Pose::new(p1.x, p1.y, dir1.y.atan2(dir1.x));
+    let reach = CurvePath {
+        start,
+        segments: quarter.clone(),
+    }
+    .end_pose()
+    .pos - p1;
+    let q = reach.dot(&dir1);
+    let level = (p2 - p1).dot(&dir1).abs() < 1e-3;
+    if !level || d + 1e-9 < 2.0 * q || !q.is_finite() {
+        return false;
+    }
+    let mut segments = quarter.clone();
+    segments.push(CurveSegment::line(Direction::Forward, d - 2.0 * q));
+    segments.extend(quarter);
+    let mut samples = Vec::new();
+    CurvePath { start, segments }.sample(params.point_spacing.min(0.5), &mut samples);
+    let first = out.len();
+    out.extend(samples.iter().map(|s| PathPoint {
+        pos: s.pose.pos,
+        tag: Tag::Turn,
+        direction: Direction::Forward,
+    }));
+    // Exact ends, as the arc turns.
+    if let Some(q) = out.get_mut(first) {
+        q.pos = p1;
+    }
+    if let Some(q) = out.last_mut() {
+        q.pos = p2;
+    }
+    true
 }
 
 /// A forward-only bulb (omega) turn between lines closer than `2·r_min`: an arc away from the

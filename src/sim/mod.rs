@@ -91,7 +91,9 @@ pub struct Disturbances {
     /// constant lateral slip to the right, m/s. Applied while moving (full above 0.5 m/s).
     pub slip_per_roll: f64,
     pub slip: f64,
-    /// Wheel-angle sensor bias, rad (added to the reported angle).
+    /// Wheel-angle sensor bias, rad: added to the reported angle, and the steering
+    /// controller, which closes its position loop on that sensor, holds the wheels at the
+    /// command minus the bias (so a tracker that trusts the sensor steers off by the bias).
     pub was_bias: f64,
     /// Actuator deadband: no motion while the delayed command is within this of the actuator
     /// position, rad (half-width).
@@ -565,7 +567,9 @@ impl Simulator {
             self.delay.push_back(self.command);
             d
         };
-        let target = delayed.clamp(-self.p.max_wheel_angle, self.p.max_wheel_angle);
+        // The steering controller servos the sensed angle (true + bias) to the command.
+        let target =
+            (delayed - self.p.dist.was_bias).clamp(-self.p.max_wheel_angle, self.p.max_wheel_angle);
         let mut err = target - self.act;
         let db = self.p.dist.deadband;
         if db > 0.0 {
@@ -1091,7 +1095,7 @@ mod tests {
     }
 
     #[test]
-    fn was_bias_appears_in_the_reported_angle() {
+    fn was_bias_appears_in_the_reported_angle_and_offsets_the_wheels() {
         let bias = 0.5f64.to_radians();
         let p = SimParams {
             dist: Disturbances {
@@ -1103,9 +1107,11 @@ mod tests {
         let mut s = Simulator::new(p, Pose::new(0.0, 0.0, 0.0), 2.0);
         s.set_command(0.1);
         let out = run(&mut s, 20.0);
-        assert!((s.true_state().wheel_angle - 0.1).abs() < 1e-9);
+        // The steering controller servos the biased reading to the command: the wheels sit
+        // at command − bias, the sensor reads the command.
+        assert!((s.true_state().wheel_angle - (0.1 - bias)).abs() < 1e-9);
         let m = was_mean(&out, 5.0);
-        assert!((m - 0.1 - bias).abs() < 2e-4, "mean {m}");
+        assert!((m - 0.1).abs() < 2e-4, "mean {m}");
     }
 
     #[test]
