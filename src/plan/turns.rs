@@ -386,6 +386,39 @@ mod tests {
     }
 
     #[test]
+    fn cc_pi_turns_end_on_the_next_line_and_fall_back_to_arcs_when_too_close() {
+        let mut p = params(5.0);
+        p.max_curvature_rate = 0.1;
+        let (p1, dir) = (v2(0.0, 100.0), v2(0.0, 1.0));
+        // 15 m apart (≥ two CC quarter-turn reaches of a little over 6 m): CC, either side.
+        for side in [1.0, -1.0] {
+            let p2 = v2(15.0 * side, 100.0);
+            let mut out = Vec::new();
+            pi_turn(p1, dir, p2, &p, &mut out).unwrap();
+            assert_eq!(out[0].pos, p1);
+            assert_eq!(out.last().unwrap().pos, p2);
+            // The last step heads back along −dir, and the path bulges beyond the line ends
+            // by more than r_min (clothoids reach further than arcs).
+            let n = out.len();
+            let d = (out[n - 1].pos - out[n - 2].pos).normalize();
+            assert!((d + dir).norm() < 0.02, "{d:?}");
+            let top = out.iter().map(|q| q.pos.y).fold(f64::MIN, f64::max);
+            assert!(top > 105.5 && top < 107.5, "{top}");
+            // Curvature from three points never above 1/r_min (plus sampling slack).
+            for w in out.windows(3) {
+                if let Some(c) = circumcentre(w[0].pos, w[1].pos, w[2].pos) {
+                    assert!((w[1].pos - c).norm() > 5.0 * 0.97);
+                }
+            }
+        }
+        // 12 m apart (≥ 2·r_min, below two CC reaches): the arc turn, top exactly r_min.
+        let mut out = Vec::new();
+        pi_turn(p1, dir, v2(12.0, 100.0), &p, &mut out).unwrap();
+        let top = out.iter().map(|q| q.pos.y).fold(f64::MIN, f64::max);
+        assert!((top - 105.0).abs() < 1e-9, "{top}");
+    }
+
+    #[test]
     fn pi_turn_geometry_both_sides_with_and_without_straight() {
         for &(r, d) in &[(5.0, 10.0), (5.0, 12.0), (5.0, 31.0), (3.0, 6.0)] {
             for &left in &[true, false] {
