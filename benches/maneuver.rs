@@ -26,6 +26,7 @@ fn bench(c: &mut Criterion) {
     for name in [
         "three_point_turn",
         "bay",
+        "bay_forward",
         "headland_fishtail",
         "field_gate",
         "obstacle_slalom",

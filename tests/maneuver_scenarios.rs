@@ -15,9 +15,10 @@ use agsteer::plan::maneuver::steering::{CcSteering, RsSteering};
 use geo::{Contains, Coord, Intersects, LineString, Polygon};
 use std::path::PathBuf;
 
-const SCENARIOS: [&str; 5] = [
+const SCENARIOS: [&str; 6] = [
     "three_point_turn",
     "bay",
+    "bay_forward",
     "headland_fishtail",
     "field_gate",
     "obstacle_slalom",
