@@ -135,39 +135,9 @@ pub enum FieldError {
 /// no fitting of short edges.
 pub fn load_local_map(text: &str) -> Result<Field, FieldError> {
     let parsed = geojson::parse_local(text)?;
-    let mut boundaries = parsed.boundaries;
-    let boundary = match boundaries.len() {
-        0 => return Err(FieldError::NoBoundary),
-        1 => boundaries.remove(0),
-        count => {
-            return Err(FieldError::SeveralBoundaries {
-                count,
-                features: boundaries
-                    .iter()
-                    .map(|b| b.label.clone())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
-        }
-    };
+    let boundary = single_boundary(parsed.boundaries)?;
     let clean = |ring: &[Vec2], feature: &str| -> Result<Vec<Vec2>, FieldError> {
-        let c = clean_ring(ring, 0.0);
-        if c.ring.len() < 3 || c.area_before_m2 < 1e-9 {
-            return Err(FieldError::TooFewPoints {
-                feature: feature.to_string(),
-                ring: "exterior ring".into(),
-                points: c.distinct_points,
-            });
-        }
-        if let Some((a, b)) = c.self_intersection {
-            return Err(FieldError::SelfIntersection {
-                feature: feature.to_string(),
-                ring: "exterior ring".into(),
-                edge_a: a,
-                edge_b: b,
-            });
-        }
-        Ok(c.ring)
+        checked_ring(clean_ring(ring, 0.0), feature, "exterior ring").map(|c| c.ring)
     };
     let outer = clean(&boundary.exterior, &boundary.label)?;
     let mut obstacles = Vec::new();
@@ -264,27 +234,53 @@ impl Accum {
         let r = &mut self.report;
         r.vertices_before += local.len();
         r.duplicates_removed += cleaned.duplicates_removed;
-        if cleaned.ring.len() < 3 || cleaned.area_before_m2 < 1e-9 {
-            return Err(FieldError::TooFewPoints {
-                feature: feature.to_string(),
-                ring: ring_name.to_string(),
-                points: cleaned.distinct_points,
-            });
-        }
-        if let Some((a, b)) = cleaned.self_intersection {
-            return Err(FieldError::SelfIntersection {
-                feature: feature.to_string(),
-                ring: ring_name.to_string(),
-                edge_a: a,
-                edge_b: b,
-            });
-        }
+        let cleaned = checked_ring(cleaned, feature, ring_name)?;
         r.vertices_after += cleaned.ring.len();
         r.collinear_removed += cleaned.collinear_removed;
         r.fitted_removed += cleaned.fitted_removed;
         r.rings_reoriented += usize::from(cleaned.reoriented);
         Ok((cleaned.ring, cleaned.area_before_m2, cleaned.area_after_m2))
     }
+}
+
+/// The one boundary polygon of a file; none or several are errors naming the features.
+fn single_boundary<C>(boundaries: Vec<RawPolygon<C>>) -> Result<RawPolygon<C>, FieldError> {
+    if boundaries.len() > 1 {
+        return Err(FieldError::SeveralBoundaries {
+            count: boundaries.len(),
+            features: boundaries
+                .iter()
+                .map(|b| b.label.clone())
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    }
+    boundaries.into_iter().next().ok_or(FieldError::NoBoundary)
+}
+
+/// A cleaned ring of `feature` that is still a polygon: at least three points enclosing an
+/// area, and no self-intersection; else the error naming the feature and the ring.
+fn checked_ring(
+    cleaned: RingCleanup,
+    feature: &str,
+    ring_name: &str,
+) -> Result<RingCleanup, FieldError> {
+    if cleaned.ring.len() < 3 || cleaned.area_before_m2 < 1e-9 {
+        return Err(FieldError::TooFewPoints {
+            feature: feature.to_string(),
+            ring: ring_name.to_string(),
+            points: cleaned.distinct_points,
+        });
+    }
+    if let Some((a, b)) = cleaned.self_intersection {
+        return Err(FieldError::SelfIntersection {
+            feature: feature.to_string(),
+            ring: ring_name.to_string(),
+            edge_a: a,
+            edge_b: b,
+        });
+    }
+    Ok(cleaned)
 }
 
 /// Whether ring `inner` lies inside ring `outer` (all vertices inside, no edges crossing).
@@ -315,23 +311,7 @@ fn assemble(
     mut obstacles: Vec<RawPolygon>,
     options: &LoadOptions,
 ) -> Result<LoadedField, FieldError> {
-    let boundary = match boundaries.len() {
-        0 => return Err(FieldError::NoBoundary),
-        1 => boundaries
-            .into_iter()
-            .next()
-            .ok_or(FieldError::NoBoundary)?,
-        count => {
-            return Err(FieldError::SeveralBoundaries {
-                count,
-                features: boundaries
-                    .iter()
-                    .map(|b| b.label.clone())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
-        }
-    };
+    let boundary = single_boundary(boundaries)?;
     let origin = options
         .origin
         .unwrap_or_else(|| bbox_centre(&boundary.exterior));
