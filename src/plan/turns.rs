@@ -192,6 +192,36 @@ pub fn pi_turn(
     Ok(())
 }
 
+/// A forward continuous-curvature quarter turn (clothoid + arc + clothoid at κ_max = 1/r_min
+/// and σ_max = `max_curvature_rate`), to the left or right, and its reach: being symmetric, it
+/// ends as far along its start heading as across it, m (a little more than r_min).
+pub(crate) fn cc_quarter_turn(
+    params: &TurnParams,
+    left: bool,
+) -> (Vec<crate::plan::maneuver::path::CurveSegment>, f64) {
+    use crate::geo::{Direction, Pose};
+    use crate::plan::maneuver::cc_turn::cc_turn;
+    use crate::plan::maneuver::path::{CurveParams, CurvePath};
+    let curve = CurveParams {
+        kappa_max: 1.0 / params.r_min,
+        sigma_max: params.max_curvature_rate,
+    };
+    let delta = if left {
+        std::f64::consts::FRAC_PI_2
+    } else {
+        -std::f64::consts::FRAC_PI_2
+    };
+    let segments = cc_turn(delta, Direction::Forward, &curve);
+    let reach = CurvePath {
+        start: Pose::new(0.0, 0.0, 0.0),
+        segments: segments.clone(),
+    }
+    .end_pose()
+    .pos
+    .x;
+    (segments, reach)
+}
+
 /// The pi turn with continuous curvature: a CC quarter turn (clothoid + arc + clothoid at
 /// κ_max = 1/r_min and σ_max = `max_curvature_rate`), a straight across, a second CC quarter
 /// turn. A CC quarter turn reaches a distance q > r_min both along and across, so it needs the
@@ -207,26 +237,9 @@ fn cc_pi_turn(
     out: &mut Vec<PathPoint>,
 ) -> bool {
     use crate::geo::{Direction, Pose, Tag};
-    use crate::plan::maneuver::cc_turn::cc_turn;
-    use crate::plan::maneuver::path::{CurveParams, CurvePath, CurveSegment};
-    let curve = CurveParams {
-        kappa_max: 1.0 / params.r_min,
-        sigma_max: params.max_curvature_rate,
-    };
-    let delta = if cross(&dir1, &n) > 0.0 {
-        std::f64::consts::FRAC_PI_2
-    } else {
-        -std::f64::consts::FRAC_PI_2
-    };
-    let quarter = cc_turn(delta, Direction::Forward, &curve);
+    use crate::plan::maneuver::path::{CurvePath, CurveSegment};
+    let (quarter, q) = cc_quarter_turn(params, cross(&dir1, &n) > 0.0);
     let start = Pose::new(p1.x, p1.y, dir1.y.atan2(dir1.x));
-    let reach = CurvePath {
-        start,
-        segments: quarter.clone(),
-    }
-    .end_pose()
-    .pos - p1;
-    let q = reach.dot(&dir1);
     let level = (p2 - p1).dot(&dir1).abs() < 1e-3;
     if !level || d + 1e-9 < 2.0 * q || !q.is_finite() {
         return false;

@@ -89,22 +89,9 @@ pub fn canonical_turn(g: f64, left: bool, p: &TurnParams) -> Result<Vec<TurnPart
 /// Curvature is zero at both cusps and both ends, so the steering never has to jump.
 fn cc_fishtail(g: f64, p: &TurnParams) -> Vec<TurnPart> {
     use crate::geo::Pose;
-    use crate::plan::maneuver::cc_turn::cc_turn;
     use crate::plan::maneuver::drive::split_at_cusps;
-    use crate::plan::maneuver::path::{CurveParams, CurvePath, CurveSegment};
-    use std::f64::consts::FRAC_PI_2;
-    let params = CurveParams {
-        kappa_max: 1.0 / p.r_min,
-        sigma_max: p.max_curvature_rate,
-    };
-    let quarter = cc_turn(FRAC_PI_2, Direction::Forward, &params);
-    let d = CurvePath {
-        start: Pose::new(0.0, 0.0, 0.0),
-        segments: quarter.clone(),
-    }
-    .end_pose()
-    .pos
-    .x;
+    use crate::plan::maneuver::path::{CurvePath, CurveSegment};
+    let (quarter, d) = crate::plan::turns::cc_quarter_turn(p, true);
     let mut segments = quarter.clone();
     segments.push(CurveSegment::line(
         Direction::Reverse,
