@@ -40,7 +40,7 @@
 
 use super::collision::{Blocked, CollisionMap, Footprint};
 use super::expansion::{leg_clear, rough_route, ExpansionParams, RoughRoute};
-use super::path::{CurveKind, CurvePath, CurveSegment};
+use super::path::{CurvePath, CurveSegment};
 use super::steering::Steering;
 use crate::geo::{cross, heading_vec, v2, vec_heading, wrap_angle, Direction, Pose, Vec2};
 use std::cmp::Ordering;
@@ -760,14 +760,7 @@ fn straight(a: &Pose, b: &Pose) -> CurvePath {
     CurvePath {
         start: *a,
         segments: if length > 1e-9 {
-            vec![CurveSegment {
-                kind: CurveKind::Line,
-                direction,
-                length,
-                kappa_start: 0.0,
-                kappa_end: 0.0,
-                sharpness: 0.0,
-            }]
+            vec![CurveSegment::line(direction, length)]
         } else {
             Vec::new()
         },
