@@ -80,7 +80,11 @@ impl Steering for RsSteering {
             Direction::Reverse => -1.0,
         };
         let kappa = delta.signum() * sign / self.r_min_m;
-        vec![CurveSegment::arc(direction, delta.abs() * self.r_min_m, kappa)]
+        vec![CurveSegment::arc(
+            direction,
+            delta.abs() * self.r_min_m,
+            kappa,
+        )]
     }
     fn distance(&self, from: &Pose, to: &Pose) -> f64 {
         rs_distance(from, to, self.r_min_m)
