@@ -281,26 +281,9 @@ impl<'a, S: Steering> Planner<'a, S> {
     }
 
     /// Whether the footprint stays clear along `path`, sampled every `spacing` (at most);
-    /// stops at the first blocked sample instead of sampling the whole path first.
-    fn path_clear(&mut self, path: &CurvePath) -> bool {
-        let fp = &self.p.footprint;
-        let mut pose = path.start;
-        if self.map.pose_clear(fp, &pose).is_err() {
-            return false;
-        }
-        for seg in &path.segments {
-            if seg.length > 0.0 {
-                let n = (seg.length / self.spacing).ceil().max(1.0) as usize;
-                for k in 1..=n {
-                    let s = seg.length * k as f64 / n as f64;
-                    if self.map.pose_clear(fp, &seg.pose_at(&pose, s)).is_err() {
-                        return false;
-                    }
-                }
-            }
-            pose = seg.end_pose(&pose);
-        }
-        true
+    /// stops at the first blocked sample ([`CollisionMap::path_clear`]).
+    fn path_clear(&self, path: &CurvePath) -> bool {
+        self.map.path_clear(&self.p.footprint, path, self.spacing)
     }
 
     /// Cost of segments driven after a segment in `prev` direction.
