@@ -46,6 +46,11 @@ use crate::geo::{cross, heading_vec, v2, vec_heading, wrap_angle, Direction, Pos
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap, HashSet};
 
+/// Finest collision sample spacing along the rough route's legs, m. The legs are straight and
+/// only a guide (everything the planner returns is checked at the full spacing), so a tiny
+/// `sample_tolerance_m` does not make the rough route finer (and slower) than this.
+const ROUGH_ROUTE_MIN_SPACING_M: f64 = 0.05;
+
 /// Every tunable of the planner, SI units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ManeuverParams {
@@ -600,7 +605,7 @@ pub fn plan_maneuver<S: Steering>(
         start,
         goal,
         &p.expansion,
-        pl.spacing.max(0.05),
+        pl.spacing.max(ROUGH_ROUTE_MIN_SPACING_M),
     );
     let route_pts = route.as_ref().map(|r| r.points.clone()).unwrap_or_default();
     stages.push(match &route {
