@@ -23,14 +23,19 @@ struct Scenario {
 fn bench(c: &mut Criterion) {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/maneuvers");
     let mut g = c.benchmark_group("maneuver");
-    for name in [
-        "three_point_turn",
-        "bay",
-        "bay_forward",
-        "headland_fishtail",
-        "field_gate",
-        "obstacle_slalom",
-    ] {
+    // Every NAME.toml of tools/maneuvers/, sorted.
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("tools/maneuvers")
+        .filter_map(|e| {
+            let path = e.expect("directory entry").path();
+            if path.extension()? != "toml" {
+                return None;
+            }
+            Some(path.file_stem()?.to_str()?.to_owned())
+        })
+        .collect();
+    names.sort();
+    for name in names {
         let text = std::fs::read_to_string(dir.join(format!("{name}.toml"))).expect("scenario");
         let s: Scenario = toml::from_str(&text).expect("scenario TOML");
         let cfg = Config::parse_with("", &s.set).expect("overlay");
@@ -48,7 +53,7 @@ fn bench(c: &mut Criterion) {
         let params = cfg.maneuver_params();
         let pose = |p: [f64; 3]| Pose::new(p[0], p[1], p[2].to_radians());
         let (from, to) = (pose(s.from), pose(s.to));
-        g.bench_function(name, |b| {
+        g.bench_function(&name, |b| {
             b.iter(|| {
                 let r = plan_maneuver(&map, &steer, &params, &from, &to).expect("valid");
                 assert!(r.path.is_some());

@@ -15,15 +15,6 @@ use agsteer::plan::maneuver::steering::{CcSteering, RsSteering};
 use geo::{Contains, Coord, Intersects, LineString, Polygon};
 use std::path::PathBuf;
 
-const SCENARIOS: [&str; 6] = [
-    "three_point_turn",
-    "bay",
-    "bay_forward",
-    "headland_fishtail",
-    "field_gate",
-    "obstacle_slalom",
-];
-
 #[derive(serde::Deserialize)]
 struct Scenario {
     map: String,
@@ -35,6 +26,24 @@ struct Scenario {
 
 fn dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/maneuvers")
+}
+
+/// Every scenario: the `NAME.toml` files of tools/maneuvers/, sorted (a new scenario file is
+/// checked without being listed here).
+fn scenarios() -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir())
+        .unwrap()
+        .filter_map(|e| {
+            let path = e.unwrap().path();
+            if path.extension()? != "toml" {
+                return None;
+            }
+            Some(path.file_stem()?.to_str()?.to_owned())
+        })
+        .collect();
+    names.sort();
+    assert!(!names.is_empty(), "no scenarios in {}", dir().display());
+    names
 }
 
 fn load(name: &str) -> (Scenario, String) {
@@ -228,15 +237,15 @@ fn independent_check_catches_collisions() {
 
 #[test]
 fn scenarios_plain_reeds_shepp() {
-    for name in SCENARIOS {
-        check(name, CurveChoice::Rs);
+    for name in scenarios() {
+        check(&name, CurveChoice::Rs);
     }
 }
 
 #[test]
 fn scenarios_continuous_curvature() {
-    for name in SCENARIOS {
-        check(name, CurveChoice::Cc);
+    for name in scenarios() {
+        check(&name, CurveChoice::Cc);
     }
 }
 
