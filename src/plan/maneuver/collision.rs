@@ -506,15 +506,17 @@ fn point_in_rectangle(c: &[Vec2; 4], p: &Vec2) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::f64::consts::FRAC_PI_2;
 
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
+    /// The axis-aligned rectangle `[x0, x1] × [y0, y1]` as a counter-clockwise ring.
+    pub(crate) fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
         vec![v2(x0, y0), v2(x1, y0), v2(x1, y1), v2(x0, y1)]
     }
 
-    fn tractor() -> Footprint {
+    /// A 4 × 2 m vehicle, rear axle 1 m from the rear, no implement, `margin_m` clearance.
+    pub(crate) fn tractor_with_margin(margin_m: f64) -> Footprint {
         Footprint {
             vehicle: VehicleBox {
                 length_m: 4.0,
@@ -522,8 +524,12 @@ mod tests {
                 rear_axle_from_rear_m: 1.0,
             },
             implement: None,
-            margin_m: 0.0,
+            margin_m,
         }
+    }
+
+    fn tractor() -> Footprint {
+        tractor_with_margin(0.0)
     }
 
     #[test]

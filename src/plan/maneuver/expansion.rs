@@ -266,18 +266,10 @@ pub fn rough_route(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::maneuver::collision::VehicleBox;
+    use crate::plan::maneuver::collision::tests::tractor_with_margin;
 
     fn fp() -> Footprint {
-        Footprint {
-            vehicle: VehicleBox {
-                length_m: 4.0,
-                width_m: 2.0,
-                rear_axle_from_rear_m: 1.0,
-            },
-            implement: None,
-            margin_m: 0.1,
-        }
+        tractor_with_margin(0.1)
     }
 
     fn params() -> ExpansionParams {

@@ -760,15 +760,12 @@ mod tests {
     use super::*;
     use crate::config::Config;
     use crate::geo::v2;
+    use crate::plan::maneuver::collision::tests::rect;
     use crate::plan::maneuver::steering::RsSteering;
     use std::f64::consts::{FRAC_PI_2, PI};
 
     fn params() -> ManeuverParams {
         Config::default().maneuver_params()
-    }
-
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
-        vec![v2(x0, y0), v2(x1, y0), v2(x1, y1), v2(x0, y1)]
     }
 
     const RS: RsSteering = RsSteering { r_min_m: 5.0 };
