@@ -9,9 +9,10 @@ use agsteer::config::{Config, CurveChoice};
 use agsteer::field::load_local_map;
 use agsteer::geo::Pose;
 use agsteer::plan::maneuver::collision::CollisionMap;
+use agsteer::plan::maneuver::job::{collision_map, plan_configured, pose_of};
 use agsteer::plan::maneuver::path::{CurvePath, PathSample};
 use agsteer::plan::maneuver::search::{plan_maneuver, ManeuverResult};
-use agsteer::plan::maneuver::steering::{CcSteering, RsSteering};
+use agsteer::plan::maneuver::steering::RsSteering;
 use geo::{Contains, Coord, Intersects, LineString, Polygon};
 use std::path::PathBuf;
 
@@ -118,35 +119,8 @@ fn plan(name: &str, curve: CurveChoice) -> (Scenario, String, Config, ManeuverRe
     assert!(cfg.validate().is_empty(), "{:?}", cfg.validate());
     cfg.maneuver.curve = curve;
     let field = load_local_map(&map_text).unwrap();
-    let map = CollisionMap::new(
-        Some(field.boundary),
-        field.obstacles,
-        cfg.maneuver.grid_cell_m,
-    )
-    .unwrap();
-    let pose = |p: [f64; 3]| Pose::new(p[0], p[1], p[2].to_radians());
-    let params = cfg.maneuver_params();
-    let r = match curve {
-        CurveChoice::Cc => plan_maneuver(
-            &map,
-            &CcSteering {
-                params: cfg.maneuver_curve_params(),
-            },
-            &params,
-            &pose(s.from),
-            &pose(s.to),
-        ),
-        CurveChoice::Rs => plan_maneuver(
-            &map,
-            &RsSteering {
-                r_min_m: cfg.vehicle.r_min_m,
-            },
-            &params,
-            &pose(s.from),
-            &pose(s.to),
-        ),
-    }
-    .unwrap();
+    let map = collision_map(&cfg, Some(&field)).unwrap();
+    let r = plan_configured(&cfg, &map, curve, &pose_of(s.from), &pose_of(s.to)).unwrap();
     (s, map_text, cfg, r)
 }
 
@@ -158,7 +132,7 @@ fn check(name: &str, curve: CurveChoice) {
         .unwrap_or_else(|| panic!("{name} ({curve:?}): not found: {:?}", r.failure));
     // Ends where asked.
     let end = path.end_pose();
-    let goal = Pose::new(s.to[0], s.to[1], s.to[2].to_radians());
+    let goal = pose_of(s.to);
     assert!(
         (end.pos - goal.pos).norm() < 0.02,
         "{name}: ends at {end:?}, goal {goal:?}"
