@@ -224,39 +224,36 @@ impl Best {
     }
 }
 
-type Formula = fn(f64, f64, f64, f64, f64) -> Option<(f64, f64, f64)>;
-
 /// Offers `formula`'s solution under the four symmetries of the Reeds-Shepp formulas, in this
 /// order: as is; time-flipped (x → −x, φ → −φ: every length negated); reflected (y → −y,
 /// φ → −φ: L and R swapped); both. `lengths` lays a solution `(t, u, v)` out along `word`.
+/// (Generic in `formula` so that each call site is compiled with its formula inlined.)
 #[inline(always)]
 fn offer_symmetric<const N: usize>(
     (x, y, phi, sp, cp): (f64, f64, f64, f64, f64),
-    formula: Formula,
+    formula: impl Fn(f64, f64, f64, f64, f64) -> Option<(f64, f64, f64)>,
     word: [RsLetter; N],
     lengths: impl Fn(f64, f64, f64) -> [f64; N],
     b: &mut Best,
 ) {
+    let mut offer = |x: f64, y: f64, phi: f64, sp: f64, w: &[RsLetter; N], negate: bool| {
+        if let Some((t, u, v)) = formula(x, y, phi, sp, cp) {
+            let mut l = lengths(t, u, v);
+            if negate {
+                l = l.map(|x| -x);
+            }
+            b.offer(w, &l);
+        }
+    };
     let reflected = word.map(|l| match l {
         L => R,
         R => L,
         S => S,
     });
-    let variants = [
-        (x, y, phi, sp, &word, 1.0),
-        (-x, y, -phi, -sp, &word, -1.0),
-        (x, -y, -phi, -sp, &reflected, 1.0),
-        (-x, -y, phi, sp, &reflected, -1.0),
-    ];
-    for (x, y, phi, sp, w, sign) in variants {
-        if let Some((t, u, v)) = formula(x, y, phi, sp, cp) {
-            let mut l = lengths(t, u, v);
-            if sign < 0.0 {
-                l = l.map(|x| -x);
-            }
-            b.offer(w, &l);
-        }
-    }
+    offer(x, y, phi, sp, &word, false);
+    offer(-x, y, -phi, -sp, &word, true);
+    offer(x, -y, -phi, -sp, &reflected, false);
+    offer(-x, -y, phi, sp, &reflected, true);
 }
 
 /// The goal seen from the start driven backwards (x, y of the "backwards" formulas, §8).
