@@ -4,8 +4,7 @@
 
 use agsteer::config::Config;
 use agsteer::field::load_local_map;
-use agsteer::geo::Pose;
-use agsteer::plan::maneuver::collision::CollisionMap;
+use agsteer::plan::maneuver::job::{collision_map, pose_of};
 use agsteer::plan::maneuver::search::plan_maneuver;
 use agsteer::plan::maneuver::steering::CcSteering;
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -23,32 +22,31 @@ struct Scenario {
 fn bench(c: &mut Criterion) {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/maneuvers");
     let mut g = c.benchmark_group("maneuver");
-    for name in [
-        "three_point_turn",
-        "bay",
-        "bay_forward",
-        "headland_fishtail",
-        "field_gate",
-        "obstacle_slalom",
-    ] {
+    // Every NAME.toml of tools/maneuvers/, sorted.
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("tools/maneuvers")
+        .filter_map(|e| {
+            let path = e.expect("directory entry").path();
+            if path.extension()? != "toml" {
+                return None;
+            }
+            Some(path.file_stem()?.to_str()?.to_owned())
+        })
+        .collect();
+    names.sort();
+    for name in names {
         let text = std::fs::read_to_string(dir.join(format!("{name}.toml"))).expect("scenario");
         let s: Scenario = toml::from_str(&text).expect("scenario TOML");
         let cfg = Config::parse_with("", &s.set).expect("overlay");
         let field = load_local_map(&std::fs::read_to_string(dir.join(&s.map)).expect("map"))
             .expect("map GeoJSON");
-        let map = CollisionMap::new(
-            Some(field.boundary),
-            field.obstacles,
-            cfg.maneuver.grid_cell_m,
-        )
-        .expect("map");
+        let map = collision_map(&cfg, Some(&field)).expect("map");
         let steer = CcSteering {
             params: cfg.maneuver_curve_params(),
         };
         let params = cfg.maneuver_params();
-        let pose = |p: [f64; 3]| Pose::new(p[0], p[1], p[2].to_radians());
-        let (from, to) = (pose(s.from), pose(s.to));
-        g.bench_function(name, |b| {
+        let (from, to) = (pose_of(s.from), pose_of(s.to));
+        g.bench_function(&name, |b| {
             b.iter(|| {
                 let r = plan_maneuver(&map, &steer, &params, &from, &to).expect("valid");
                 assert!(r.path.is_some());

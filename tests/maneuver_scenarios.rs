@@ -9,20 +9,12 @@ use agsteer::config::{Config, CurveChoice};
 use agsteer::field::load_local_map;
 use agsteer::geo::Pose;
 use agsteer::plan::maneuver::collision::CollisionMap;
+use agsteer::plan::maneuver::job::{collision_map, plan_configured, pose_of};
 use agsteer::plan::maneuver::path::{CurvePath, PathSample};
 use agsteer::plan::maneuver::search::{plan_maneuver, ManeuverResult};
-use agsteer::plan::maneuver::steering::{CcSteering, RsSteering};
+use agsteer::plan::maneuver::steering::RsSteering;
 use geo::{Contains, Coord, Intersects, LineString, Polygon};
 use std::path::PathBuf;
-
-const SCENARIOS: [&str; 6] = [
-    "three_point_turn",
-    "bay",
-    "bay_forward",
-    "headland_fishtail",
-    "field_gate",
-    "obstacle_slalom",
-];
 
 #[derive(serde::Deserialize)]
 struct Scenario {
@@ -35,6 +27,24 @@ struct Scenario {
 
 fn dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/maneuvers")
+}
+
+/// Every scenario: the `NAME.toml` files of tools/maneuvers/, sorted (a new scenario file is
+/// checked without being listed here).
+fn scenarios() -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir())
+        .unwrap()
+        .filter_map(|e| {
+            let path = e.unwrap().path();
+            if path.extension()? != "toml" {
+                return None;
+            }
+            Some(path.file_stem()?.to_str()?.to_owned())
+        })
+        .collect();
+    names.sort();
+    assert!(!names.is_empty(), "no scenarios in {}", dir().display());
+    names
 }
 
 fn load(name: &str) -> (Scenario, String) {
@@ -109,35 +119,8 @@ fn plan(name: &str, curve: CurveChoice) -> (Scenario, String, Config, ManeuverRe
     assert!(cfg.validate().is_empty(), "{:?}", cfg.validate());
     cfg.maneuver.curve = curve;
     let field = load_local_map(&map_text).unwrap();
-    let map = CollisionMap::new(
-        Some(field.boundary),
-        field.obstacles,
-        cfg.maneuver.grid_cell_m,
-    )
-    .unwrap();
-    let pose = |p: [f64; 3]| Pose::new(p[0], p[1], p[2].to_radians());
-    let params = cfg.maneuver_params();
-    let r = match curve {
-        CurveChoice::Cc => plan_maneuver(
-            &map,
-            &CcSteering {
-                params: cfg.maneuver_curve_params(),
-            },
-            &params,
-            &pose(s.from),
-            &pose(s.to),
-        ),
-        CurveChoice::Rs => plan_maneuver(
-            &map,
-            &RsSteering {
-                r_min_m: cfg.vehicle.r_min_m,
-            },
-            &params,
-            &pose(s.from),
-            &pose(s.to),
-        ),
-    }
-    .unwrap();
+    let map = collision_map(&cfg, Some(&field)).unwrap();
+    let r = plan_configured(&cfg, &map, curve, &pose_of(s.from), &pose_of(s.to)).unwrap();
     (s, map_text, cfg, r)
 }
 
@@ -149,7 +132,7 @@ fn check(name: &str, curve: CurveChoice) {
         .unwrap_or_else(|| panic!("{name} ({curve:?}): not found: {:?}", r.failure));
     // Ends where asked.
     let end = path.end_pose();
-    let goal = Pose::new(s.to[0], s.to[1], s.to[2].to_radians());
+    let goal = pose_of(s.to);
     assert!(
         (end.pos - goal.pos).norm() < 0.02,
         "{name}: ends at {end:?}, goal {goal:?}"
@@ -228,15 +211,15 @@ fn independent_check_catches_collisions() {
 
 #[test]
 fn scenarios_plain_reeds_shepp() {
-    for name in SCENARIOS {
-        check(name, CurveChoice::Rs);
+    for name in scenarios() {
+        check(&name, CurveChoice::Rs);
     }
 }
 
 #[test]
 fn scenarios_continuous_curvature() {
-    for name in SCENARIOS {
-        check(name, CurveChoice::Cc);
+    for name in scenarios() {
+        check(&name, CurveChoice::Cc);
     }
 }
 

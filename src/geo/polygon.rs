@@ -85,8 +85,8 @@ pub fn segments_intersect(a0: &Vec2, a1: &Vec2, b0: &Vec2, b1: &Vec2) -> bool {
     on(a0, a1, b0, d1) || on(a0, a1, b1, d2) || on(b0, b1, a0, d3) || on(b0, b1, a1, d4)
 }
 
-/// Distance from `p` to the segment `a–b`, m.
-pub fn point_segment_distance(p: &Vec2, a: &Vec2, b: &Vec2) -> f64 {
+/// The point of the segment `a–b` closest to `p` (`a` when the segment has no length).
+pub fn closest_point_on_segment(p: &Vec2, a: &Vec2, b: &Vec2) -> Vec2 {
     let ab = b - a;
     let len2 = ab.norm_squared();
     let t = if len2 > 0.0 {
@@ -94,7 +94,12 @@ pub fn point_segment_distance(p: &Vec2, a: &Vec2, b: &Vec2) -> f64 {
     } else {
         0.0
     };
-    (p - (a + ab * t)).norm()
+    a + ab * t
+}
+
+/// Distance from `p` to the segment `a–b`, m.
+pub fn point_segment_distance(p: &Vec2, a: &Vec2, b: &Vec2) -> f64 {
+    (p - closest_point_on_segment(p, a, b)).norm()
 }
 
 /// Whether `ring` is simple: no two non-adjacent edges meet. O(n²); fine for boundaries of a

@@ -6,8 +6,8 @@ use agsteer::config::{Config, CurveChoice};
 use agsteer::field::load_local_map;
 use agsteer::geo::{Direction, Pose, Vec2};
 use agsteer::plan::maneuver::collision::CollisionMap;
-use agsteer::plan::maneuver::search::{plan_maneuver, ManeuverError, ManeuverResult, Method};
-use agsteer::plan::maneuver::steering::{CcSteering, RsSteering};
+use agsteer::plan::maneuver::job::{plan_configured, pose_of};
+use agsteer::plan::maneuver::search::{ManeuverError, ManeuverResult, Method};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -39,7 +39,7 @@ pub fn parse_pose(s: &str) -> Result<Pose> {
     if v.iter().any(|x| !x.is_finite()) {
         bail!("pose `{s}`: every number must be finite");
     }
-    Ok(Pose::new(v[0], v[1], v[2].to_radians()))
+    Ok(pose_of([v[0], v[1], v[2]]))
 }
 
 #[derive(Serialize)]
@@ -135,22 +135,8 @@ fn plan_one(
     from: &Pose,
     to: &Pose,
 ) -> (Result<ManeuverResult, ManeuverError>, f64) {
-    let params = cfg.maneuver_params();
     let t0 = Instant::now();
-    let r = match curve {
-        CurveChoice::Cc => {
-            let s = CcSteering {
-                params: cfg.maneuver_curve_params(),
-            };
-            plan_maneuver(map, &s, &params, from, to)
-        }
-        CurveChoice::Rs => {
-            let s = RsSteering {
-                r_min_m: cfg.vehicle.r_min_m,
-            };
-            plan_maneuver(map, &s, &params, from, to)
-        }
-    };
+    let r = plan_configured(cfg, map, curve, from, to);
     (r, t0.elapsed().as_secs_f64() * 1e3)
 }
 
@@ -188,8 +174,7 @@ pub fn run(cfg: &Config, a: &ManeuverArgs) -> Result<u8> {
             }
             let req: BatchLine = serde_json::from_str(line)
                 .with_context(|| format!("{} line {}", batch.display(), n + 1))?;
-            let pose = |p: [f64; 3]| Pose::new(p[0], p[1], p[2].to_radians());
-            let (r, ms) = plan_one(&map, cfg, curve, &pose(req.from), &pose(req.to));
+            let (r, ms) = plan_one(&map, cfg, curve, &pose_of(req.from), &pose_of(req.to));
             if !say(&serde_json::to_string(&result_out(&r, ms))?)? {
                 return Ok(0);
             }

@@ -51,6 +51,12 @@ enum Piece {
     Line { len: f64, s: f64 },
 }
 
+impl Piece {
+    fn turn(delta: f64, l: f64, s: f64) -> Piece {
+        Piece::Turn { delta, l, s }
+    }
+}
+
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
     len: f64,
@@ -265,17 +271,9 @@ impl<'a> Solver<'a> {
                         out.offer(Candidate::new(
                             self.g.circle_turn_length(d1) + len + self.g.circle_turn_length(d2),
                             &[
-                                Piece::Turn {
-                                    delta: d1,
-                                    l: c1.l,
-                                    s: c1.s,
-                                },
+                                Piece::turn(d1, c1.l, c1.s),
                                 Piece::Line { len, s: sl },
-                                Piece::Turn {
-                                    delta: d2,
-                                    l: c2.l,
-                                    s: c2.s,
-                                },
+                                Piece::turn(d2, c2.l, c2.s),
                             ],
                         ));
                     }
@@ -339,21 +337,9 @@ impl<'a> Solver<'a> {
                         out.offer(Candidate::new(
                             t12 + self.g.circle_turn_length(d3),
                             &[
-                                Piece::Turn {
-                                    delta: d1,
-                                    l: c1.l,
-                                    s: c1.s,
-                                },
-                                Piece::Turn {
-                                    delta: d2,
-                                    l: l2,
-                                    s: s2,
-                                },
-                                Piece::Turn {
-                                    delta: d3,
-                                    l: c3.l,
-                                    s: c3.s,
-                                },
+                                Piece::turn(d1, c1.l, c1.s),
+                                Piece::turn(d2, l2, s2),
+                                Piece::turn(d3, c3.l, c3.s),
                             ],
                         ));
                         if h == 0.0 {
@@ -427,20 +413,12 @@ impl<'a> Solver<'a> {
             let dn = deflection(cn.l, cn.s, th0 + phi, self.goal.heading);
             let mut pieces = [NO_PIECE; 6];
             let mut n = 0;
-            pieces[n] = Piece::Turn {
-                delta: d1,
-                l: c1.l,
-                s: c1.s,
-            };
+            pieces[n] = Piece::turn(d1, c1.l, c1.s);
             n += 1;
             for j in 0..=k {
                 if j > 0 {
                     let m = &mids[j - 1];
-                    pieces[n] = Piece::Turn {
-                        delta: m.delta,
-                        l: m.l,
-                        s: m.s,
-                    };
+                    pieces[n] = Piece::turn(m.delta, m.l, m.s);
                     n += 1;
                 }
                 if j == line_at {
@@ -448,11 +426,7 @@ impl<'a> Solver<'a> {
                     n += 1;
                 }
             }
-            pieces[n] = Piece::Turn {
-                delta: dn,
-                l: cn.l,
-                s: cn.s,
-            };
+            pieces[n] = Piece::turn(dn, cn.l, cn.s);
             n += 1;
             out.offer(Candidate {
                 len: self.g.circle_turn_length(d1) + mid_len + len + self.g.circle_turn_length(dn),
@@ -586,26 +560,10 @@ impl<'a> Solver<'a> {
                         + g.circle_turn_length(d3)
                         + g.circle_turn_length(d4),
                     &[
-                        Piece::Turn {
-                            delta: d1,
-                            l: c1.l,
-                            s: c1.s,
-                        },
-                        Piece::Turn {
-                            delta: d2,
-                            l: m1.0,
-                            s: m1.1,
-                        },
-                        Piece::Turn {
-                            delta: d3,
-                            l: m2.0,
-                            s: m2.1,
-                        },
-                        Piece::Turn {
-                            delta: d4,
-                            l: cn.l,
-                            s: cn.s,
-                        },
+                        Piece::turn(d1, c1.l, c1.s),
+                        Piece::turn(d2, m1.0, m1.1),
+                        Piece::turn(d3, m2.0, m2.1),
+                        Piece::turn(d4, cn.l, cn.s),
                     ],
                 ));
                 if dy0 == 0.0 {

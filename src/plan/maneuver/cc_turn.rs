@@ -296,10 +296,17 @@ mod tests {
     fn reverse_sign_convention() {
         let p = params(0.1);
         let segs = cc_turn(1.0, Direction::Reverse, &p);
+        // Not vacuous: a 1 rad turn has curved segments.
+        assert!(segs
+            .iter()
+            .any(|s| s.kappa_start != 0.0 || s.kappa_end != 0.0));
         assert!(segs
             .iter()
             .all(|s| s.kappa_start <= 0.0 && s.kappa_end <= 0.0));
         let segs = cc_turn(1.0, Direction::Forward, &p);
+        assert!(segs
+            .iter()
+            .any(|s| s.kappa_start != 0.0 || s.kappa_end != 0.0));
         assert!(segs
             .iter()
             .all(|s| s.kappa_start >= 0.0 && s.kappa_end >= 0.0));

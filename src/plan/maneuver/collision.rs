@@ -25,6 +25,7 @@
 //! footprint's `margin_m`, so the continuous sweep of the bare vehicle is proved clear when
 //! `margin_m ≥ tol/2` (the `[maneuver]` validation enforces this).
 
+use super::path::CurvePath;
 use crate::geo::polygon::{bbox, contains_point, point_segment_distance, segments_intersect};
 use crate::geo::{v2, Pose, Vec2};
 
@@ -471,17 +472,27 @@ impl CollisionMap {
         Ok(())
     }
 
-    /// Whether `footprint` is clear at every pose of `poses` (samples of a path at a spacing
-    /// from [`Footprint::sample_spacing_m`]). Returns the index of the first blocked sample.
-    pub fn poses_clear<'a>(
-        &self,
-        footprint: &Footprint,
-        poses: impl IntoIterator<Item = &'a Pose>,
-    ) -> Result<(), (usize, Blocked)> {
-        for (k, p) in poses.into_iter().enumerate() {
-            self.pose_clear(footprint, p).map_err(|b| (k, b))?;
+    /// Whether `footprint` stays clear along `path`: the start pose and, on each segment of
+    /// length `L`, the poses at `L k / n`, `k = 1..=n`, `n = ceil(L / spacing_m)` (so samples
+    /// are at most `spacing_m` apart; see [`Footprint::sample_spacing_m`]).
+    pub fn path_clear(&self, footprint: &Footprint, path: &CurvePath, spacing_m: f64) -> bool {
+        let mut pose = path.start;
+        if self.pose_clear(footprint, &pose).is_err() {
+            return false;
         }
-        Ok(())
+        for seg in &path.segments {
+            if seg.length > 0.0 {
+                let n = (seg.length / spacing_m).ceil().max(1.0) as usize;
+                for k in 1..=n {
+                    let s = seg.length * k as f64 / n as f64;
+                    if self.pose_clear(footprint, &seg.pose_at(&pose, s)).is_err() {
+                        return false;
+                    }
+                }
+            }
+            pose = seg.end_pose(&pose);
+        }
+        true
     }
 }
 
@@ -495,15 +506,17 @@ fn point_in_rectangle(c: &[Vec2; 4], p: &Vec2) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::f64::consts::FRAC_PI_2;
 
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
+    /// The axis-aligned rectangle `[x0, x1] × [y0, y1]` as a counter-clockwise ring.
+    pub(crate) fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
         vec![v2(x0, y0), v2(x1, y0), v2(x1, y1), v2(x0, y1)]
     }
 
-    fn tractor() -> Footprint {
+    /// A 4 × 2 m vehicle, rear axle 1 m from the rear, no implement, `margin_m` clearance.
+    pub(crate) fn tractor_with_margin(margin_m: f64) -> Footprint {
         Footprint {
             vehicle: VehicleBox {
                 length_m: 4.0,
@@ -511,8 +524,12 @@ mod tests {
                 rear_axle_from_rear_m: 1.0,
             },
             implement: None,
-            margin_m: 0.0,
+            margin_m,
         }
+    }
+
+    fn tractor() -> Footprint {
+        tractor_with_margin(0.0)
     }
 
     #[test]

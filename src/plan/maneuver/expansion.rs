@@ -11,7 +11,7 @@
 //! distance 0). Walking back from the two closest points to the roots gives the route.
 
 use super::collision::{CollisionMap, Footprint};
-use crate::geo::polygon::point_segment_distance;
+use crate::geo::polygon::closest_point_on_segment;
 use crate::geo::{cross, left_normal, v2, vec_heading, Pose, Vec2};
 use std::collections::HashSet;
 
@@ -90,38 +90,22 @@ fn segment_distance(a0: Vec2, a1: Vec2, b0: Vec2, b1: Vec2) -> (f64, Vec2, Vec2)
     if let Some(p) = segments_intersect_point(&a0, &a1, &b0, &b1) {
         return (0.0, p, p);
     }
-    let closest = |p: Vec2, s0: Vec2, s1: Vec2| {
-        let ab = s1 - s0;
-        let l2 = ab.norm_squared();
-        let t = if l2 > 0.0 {
-            ((p - s0).dot(&ab) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        s0 + ab * t
-    };
+    // Each endpoint against the other segment; the nearest pair wins.
     let cands = [
-        (
-            point_segment_distance(&a0, &b0, &b1),
-            a0,
-            closest(a0, b0, b1),
-        ),
-        (
-            point_segment_distance(&a1, &b0, &b1),
-            a1,
-            closest(a1, b0, b1),
-        ),
-        (
-            point_segment_distance(&b0, &a0, &a1),
-            closest(b0, a0, a1),
-            b0,
-        ),
-        (
-            point_segment_distance(&b1, &a0, &a1),
-            closest(b1, a0, a1),
-            b1,
-        ),
-    ];
+        (a0, b0, b1, true),
+        (a1, b0, b1, true),
+        (b0, a0, a1, false),
+        (b1, a0, a1, false),
+    ]
+    .map(|(p, s0, s1, p_on_a)| {
+        let q = closest_point_on_segment(&p, &s0, &s1);
+        let d = (p - q).norm();
+        if p_on_a {
+            (d, p, q)
+        } else {
+            (d, q, p)
+        }
+    });
     cands
         .into_iter()
         .min_by(|x, y| x.0.total_cmp(&y.0))
@@ -282,18 +266,10 @@ pub fn rough_route(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::maneuver::collision::VehicleBox;
+    use crate::plan::maneuver::collision::tests::tractor_with_margin;
 
     fn fp() -> Footprint {
-        Footprint {
-            vehicle: VehicleBox {
-                length_m: 4.0,
-                width_m: 2.0,
-                rear_axle_from_rear_m: 1.0,
-            },
-            implement: None,
-            margin_m: 0.1,
-        }
+        tractor_with_margin(0.1)
     }
 
     fn params() -> ExpansionParams {

@@ -90,10 +90,7 @@ pub fn field_clearance(
     let footprint = params.footprint;
     let spacing = footprint.sample_spacing_m(params.sample_tolerance_m, 1.0 / cfg.vehicle.r_min_m);
     Ok(std::sync::Arc::new(move |path: &CurvePath| {
-        let mut samples = Vec::new();
-        path.sample(spacing, &mut samples);
-        map.poses_clear(&footprint, samples.iter().map(|s| &s.pose))
-            .is_ok()
+        map.path_clear(&footprint, path, spacing)
     }))
 }
 

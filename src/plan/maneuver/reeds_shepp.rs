@@ -224,159 +224,87 @@ impl Best {
     }
 }
 
+/// Offers `formula`'s solution under the four symmetries of the Reeds-Shepp formulas, in this
+/// order: as is; time-flipped (x → −x, φ → −φ: every length negated); reflected (y → −y,
+/// φ → −φ: L and R swapped); both. `lengths` lays a solution `(t, u, v)` out along `word`.
+/// (Generic in `formula` so that each call site is compiled with its formula inlined.)
+#[inline(always)]
+fn offer_symmetric<const N: usize>(
+    (x, y, phi, sp, cp): (f64, f64, f64, f64, f64),
+    formula: impl Fn(f64, f64, f64, f64, f64) -> Option<(f64, f64, f64)>,
+    word: [RsLetter; N],
+    lengths: impl Fn(f64, f64, f64) -> [f64; N],
+    b: &mut Best,
+) {
+    let mut offer = |x: f64, y: f64, phi: f64, sp: f64, w: &[RsLetter; N], negate: bool| {
+        if let Some((t, u, v)) = formula(x, y, phi, sp, cp) {
+            let mut l = lengths(t, u, v);
+            if negate {
+                l = l.map(|x| -x);
+            }
+            b.offer(w, &l);
+        }
+    };
+    let reflected = word.map(|l| match l {
+        L => R,
+        R => L,
+        S => S,
+    });
+    offer(x, y, phi, sp, &word, false);
+    offer(-x, y, -phi, -sp, &word, true);
+    offer(x, -y, -phi, -sp, &reflected, false);
+    offer(-x, -y, phi, sp, &reflected, true);
+}
+
+/// The goal seen from the start driven backwards (x, y of the "backwards" formulas, §8).
+fn backwards(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> (f64, f64, f64, f64, f64) {
+    (x * cp + y * sp, x * sp - y * cp, phi, sp, cp)
+}
+
 fn csc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
-    if let Some((t, u, v)) = lp_sp_lp(x, y, phi, sp, cp) {
-        b.offer(&[L, S, L], &[t, u, v]);
-    }
-    if let Some((t, u, v)) = lp_sp_lp(-x, y, -phi, -sp, cp) {
-        b.offer(&[L, S, L], &[-t, -u, -v]);
-    }
-    if let Some((t, u, v)) = lp_sp_lp(x, -y, -phi, -sp, cp) {
-        b.offer(&[R, S, R], &[t, u, v]);
-    }
-    if let Some((t, u, v)) = lp_sp_lp(-x, -y, phi, sp, cp) {
-        b.offer(&[R, S, R], &[-t, -u, -v]);
-    }
-    if let Some((t, u, v)) = lp_sp_rp(x, y, phi, sp, cp) {
-        b.offer(&[L, S, R], &[t, u, v]);
-    }
-    if let Some((t, u, v)) = lp_sp_rp(-x, y, -phi, -sp, cp) {
-        b.offer(&[L, S, R], &[-t, -u, -v]);
-    }
-    if let Some((t, u, v)) = lp_sp_rp(x, -y, -phi, -sp, cp) {
-        b.offer(&[R, S, L], &[t, u, v]);
-    }
-    if let Some((t, u, v)) = lp_sp_rp(-x, -y, phi, sp, cp) {
-        b.offer(&[R, S, L], &[-t, -u, -v]);
-    }
+    let a = (x, y, phi, sp, cp);
+    offer_symmetric(a, lp_sp_lp, [L, S, L], |t, u, v| [t, u, v], b);
+    offer_symmetric(a, lp_sp_rp, [L, S, R], |t, u, v| [t, u, v], b);
 }
 
 fn ccc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
-    if let Some((t, u, v)) = lp_rm_l(x, y, phi, sp, cp) {
-        b.offer(&[L, R, L], &[t, u, v]);
-    }
-    if let Some((t, u, v)) = lp_rm_l(-x, y, -phi, -sp, cp) {
-        b.offer(&[L, R, L], &[-t, -u, -v]);
-    }
-    if let Some((t, u, v)) = lp_rm_l(x, -y, -phi, -sp, cp) {
-        b.offer(&[R, L, R], &[t, u, v]);
-    }
-    if let Some((t, u, v)) = lp_rm_l(-x, -y, phi, sp, cp) {
-        b.offer(&[R, L, R], &[-t, -u, -v]);
-    }
-    // Backwards.
-    let xb = x * cp + y * sp;
-    let yb = x * sp - y * cp;
-    if let Some((t, u, v)) = lp_rm_l(xb, yb, phi, sp, cp) {
-        b.offer(&[L, R, L], &[v, u, t]);
-    }
-    if let Some((t, u, v)) = lp_rm_l(-xb, yb, -phi, -sp, cp) {
-        b.offer(&[L, R, L], &[-v, -u, -t]);
-    }
-    if let Some((t, u, v)) = lp_rm_l(xb, -yb, -phi, -sp, cp) {
-        b.offer(&[R, L, R], &[v, u, t]);
-    }
-    if let Some((t, u, v)) = lp_rm_l(-xb, -yb, phi, sp, cp) {
-        b.offer(&[R, L, R], &[-v, -u, -t]);
-    }
+    offer_symmetric(
+        (x, y, phi, sp, cp),
+        lp_rm_l,
+        [L, R, L],
+        |t, u, v| [t, u, v],
+        b,
+    );
+    let back = backwards(x, y, phi, sp, cp);
+    offer_symmetric(back, lp_rm_l, [L, R, L], |t, u, v| [v, u, t], b);
 }
 
 fn cccc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
-    if let Some((t, u, v)) = lp_rup_lum_rm(x, y, phi, sp, cp) {
-        b.offer(&[L, R, L, R], &[t, u, -u, v]);
-    }
-    if let Some((t, u, v)) = lp_rup_lum_rm(-x, y, -phi, -sp, cp) {
-        b.offer(&[L, R, L, R], &[-t, -u, u, -v]);
-    }
-    if let Some((t, u, v)) = lp_rup_lum_rm(x, -y, -phi, -sp, cp) {
-        b.offer(&[R, L, R, L], &[t, u, -u, v]);
-    }
-    if let Some((t, u, v)) = lp_rup_lum_rm(-x, -y, phi, sp, cp) {
-        b.offer(&[R, L, R, L], &[-t, -u, u, -v]);
-    }
-    if let Some((t, u, v)) = lp_rum_lum_rp(x, y, phi, sp, cp) {
-        b.offer(&[L, R, L, R], &[t, u, u, v]);
-    }
-    if let Some((t, u, v)) = lp_rum_lum_rp(-x, y, -phi, -sp, cp) {
-        b.offer(&[L, R, L, R], &[-t, -u, -u, -v]);
-    }
-    if let Some((t, u, v)) = lp_rum_lum_rp(x, -y, -phi, -sp, cp) {
-        b.offer(&[R, L, R, L], &[t, u, u, v]);
-    }
-    if let Some((t, u, v)) = lp_rum_lum_rp(-x, -y, phi, sp, cp) {
-        b.offer(&[R, L, R, L], &[-t, -u, -u, -v]);
-    }
+    let a = (x, y, phi, sp, cp);
+    offer_symmetric(a, lp_rup_lum_rm, [L, R, L, R], |t, u, v| [t, u, -u, v], b);
+    offer_symmetric(a, lp_rum_lum_rp, [L, R, L, R], |t, u, v| [t, u, u, v], b);
 }
 
 fn ccsc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
     let h = FRAC_PI_2;
-    if let Some((t, u, v)) = lp_rm_sm_lm(x, y, phi, sp, cp) {
-        b.offer(&[L, R, S, L], &[t, -h, u, v]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_lm(-x, y, -phi, -sp, cp) {
-        b.offer(&[L, R, S, L], &[-t, h, -u, -v]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_lm(x, -y, -phi, -sp, cp) {
-        b.offer(&[R, L, S, R], &[t, -h, u, v]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_lm(-x, -y, phi, sp, cp) {
-        b.offer(&[R, L, S, R], &[-t, h, -u, -v]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_rm(x, y, phi, sp, cp) {
-        b.offer(&[L, R, S, R], &[t, -h, u, v]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_rm(-x, y, -phi, -sp, cp) {
-        b.offer(&[L, R, S, R], &[-t, h, -u, -v]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_rm(x, -y, -phi, -sp, cp) {
-        b.offer(&[R, L, S, L], &[t, -h, u, v]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_rm(-x, -y, phi, sp, cp) {
-        b.offer(&[R, L, S, L], &[-t, h, -u, -v]);
-    }
-    // Backwards.
-    let xb = x * cp + y * sp;
-    let yb = x * sp - y * cp;
-    if let Some((t, u, v)) = lp_rm_sm_lm(xb, yb, phi, sp, cp) {
-        b.offer(&[L, S, R, L], &[v, u, -h, t]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_lm(-xb, yb, -phi, -sp, cp) {
-        b.offer(&[L, S, R, L], &[-v, -u, h, -t]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_lm(xb, -yb, -phi, -sp, cp) {
-        b.offer(&[R, S, L, R], &[v, u, -h, t]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_lm(-xb, -yb, phi, sp, cp) {
-        b.offer(&[R, S, L, R], &[-v, -u, h, -t]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_rm(xb, yb, phi, sp, cp) {
-        b.offer(&[R, S, R, L], &[v, u, -h, t]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_rm(-xb, yb, -phi, -sp, cp) {
-        b.offer(&[R, S, R, L], &[-v, -u, h, -t]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_rm(xb, -yb, -phi, -sp, cp) {
-        b.offer(&[L, S, L, R], &[v, u, -h, t]);
-    }
-    if let Some((t, u, v)) = lp_rm_sm_rm(-xb, -yb, phi, sp, cp) {
-        b.offer(&[L, S, L, R], &[-v, -u, h, -t]);
-    }
+    let a = (x, y, phi, sp, cp);
+    offer_symmetric(a, lp_rm_sm_lm, [L, R, S, L], |t, u, v| [t, -h, u, v], b);
+    offer_symmetric(a, lp_rm_sm_rm, [L, R, S, R], |t, u, v| [t, -h, u, v], b);
+    let back = backwards(x, y, phi, sp, cp);
+    offer_symmetric(back, lp_rm_sm_lm, [L, S, R, L], |t, u, v| [v, u, -h, t], b);
+    offer_symmetric(back, lp_rm_sm_rm, [R, S, R, L], |t, u, v| [v, u, -h, t], b);
 }
 
 fn ccscc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
     let h = FRAC_PI_2;
-    if let Some((t, u, v)) = lp_rm_s_lm_rp(x, y, phi, sp, cp) {
-        b.offer(&[L, R, S, L, R], &[t, -h, u, -h, v]);
-    }
-    if let Some((t, u, v)) = lp_rm_s_lm_rp(-x, y, -phi, -sp, cp) {
-        b.offer(&[L, R, S, L, R], &[-t, h, -u, h, -v]);
-    }
-    if let Some((t, u, v)) = lp_rm_s_lm_rp(x, -y, -phi, -sp, cp) {
-        b.offer(&[R, L, S, R, L], &[t, -h, u, -h, v]);
-    }
-    if let Some((t, u, v)) = lp_rm_s_lm_rp(-x, -y, phi, sp, cp) {
-        b.offer(&[R, L, S, R, L], &[-t, h, -u, h, -v]);
-    }
+    let a = (x, y, phi, sp, cp);
+    offer_symmetric(
+        a,
+        lp_rm_s_lm_rp,
+        [L, R, S, L, R],
+        |t, u, v| [t, -h, u, -h, v],
+        b,
+    );
 }
 
 /// Shortest word from `start` to `goal` for turning radius `r_min_m` (None if r ≤ 0 or the

@@ -40,11 +40,16 @@
 
 use super::collision::{Blocked, CollisionMap, Footprint};
 use super::expansion::{leg_clear, rough_route, ExpansionParams, RoughRoute};
-use super::path::{CurveKind, CurvePath, CurveSegment};
+use super::path::{CurvePath, CurveSegment};
 use super::steering::Steering;
 use crate::geo::{cross, heading_vec, v2, vec_heading, wrap_angle, Direction, Pose, Vec2};
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap, HashSet};
+
+/// Finest collision sample spacing along the rough route's legs, m. The legs are straight and
+/// only a guide (everything the planner returns is checked at the full spacing), so a tiny
+/// `sample_tolerance_m` does not make the rough route finer (and slower) than this.
+const ROUGH_ROUTE_MIN_SPACING_M: f64 = 0.05;
 
 /// Every tunable of the planner, SI units.
 #[derive(Debug, Clone, PartialEq)]
@@ -281,26 +286,9 @@ impl<'a, S: Steering> Planner<'a, S> {
     }
 
     /// Whether the footprint stays clear along `path`, sampled every `spacing` (at most);
-    /// stops at the first blocked sample instead of sampling the whole path first.
-    fn path_clear(&mut self, path: &CurvePath) -> bool {
-        let fp = &self.p.footprint;
-        let mut pose = path.start;
-        if self.map.pose_clear(fp, &pose).is_err() {
-            return false;
-        }
-        for seg in &path.segments {
-            if seg.length > 0.0 {
-                let n = (seg.length / self.spacing).ceil().max(1.0) as usize;
-                for k in 1..=n {
-                    let s = seg.length * k as f64 / n as f64;
-                    if self.map.pose_clear(fp, &seg.pose_at(&pose, s)).is_err() {
-                        return false;
-                    }
-                }
-            }
-            pose = seg.end_pose(&pose);
-        }
-        true
+    /// stops at the first blocked sample ([`CollisionMap::path_clear`]).
+    fn path_clear(&self, path: &CurvePath) -> bool {
+        self.map.path_clear(&self.p.footprint, path, self.spacing)
     }
 
     /// Cost of segments driven after a segment in `prev` direction.
@@ -617,7 +605,7 @@ pub fn plan_maneuver<S: Steering>(
         start,
         goal,
         &p.expansion,
-        pl.spacing.max(0.05),
+        pl.spacing.max(ROUGH_ROUTE_MIN_SPACING_M),
     );
     let route_pts = route.as_ref().map(|r| r.points.clone()).unwrap_or_default();
     stages.push(match &route {
@@ -760,14 +748,7 @@ fn straight(a: &Pose, b: &Pose) -> CurvePath {
     CurvePath {
         start: *a,
         segments: if length > 1e-9 {
-            vec![CurveSegment {
-                kind: CurveKind::Line,
-                direction,
-                length,
-                kappa_start: 0.0,
-                kappa_end: 0.0,
-                sharpness: 0.0,
-            }]
+            vec![CurveSegment::line(direction, length)]
         } else {
             Vec::new()
         },
@@ -779,15 +760,12 @@ mod tests {
     use super::*;
     use crate::config::Config;
     use crate::geo::v2;
+    use crate::plan::maneuver::collision::tests::rect;
     use crate::plan::maneuver::steering::RsSteering;
     use std::f64::consts::{FRAC_PI_2, PI};
 
     fn params() -> ManeuverParams {
         Config::default().maneuver_params()
-    }
-
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
-        vec![v2(x0, y0), v2(x1, y0), v2(x1, y1), v2(x0, y1)]
     }
 
     const RS: RsSteering = RsSteering { r_min_m: 5.0 };

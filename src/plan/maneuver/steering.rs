@@ -5,7 +5,7 @@ use super::cc_reeds_shepp::cc_reeds_shepp_shortest;
 use super::cc_turn::cc_turn;
 pub use super::path::CurveParams;
 use super::path::CurvePath;
-use super::path::{CurveKind, CurveSegment};
+use super::path::CurveSegment;
 use super::reeds_shepp::{reeds_shepp_length, reeds_shepp_shortest};
 use crate::geo::{Direction, Pose};
 
@@ -29,17 +29,6 @@ pub trait Steering {
     fn kappa_max(&self) -> f64;
 }
 
-fn line(direction: Direction, length: f64) -> CurveSegment {
-    CurveSegment {
-        kind: CurveKind::Line,
-        direction,
-        length,
-        kappa_start: 0.0,
-        kappa_end: 0.0,
-        sharpness: 0.0,
-    }
-}
-
 fn rs_distance(from: &Pose, to: &Pose, r_min: f64) -> f64 {
     let euclid = (to.pos - from.pos).norm();
     reeds_shepp_length(from, to, r_min).map_or(euclid, |l| l.max(euclid))
@@ -58,7 +47,7 @@ impl Steering for CcSteering {
     }
     fn turn(&self, delta: f64, direction: Direction, straight_m: f64) -> Vec<CurveSegment> {
         if delta.abs() < 1e-9 {
-            vec![line(direction, straight_m)]
+            vec![CurveSegment::line(direction, straight_m)]
         } else {
             cc_turn(delta, direction, &self.params)
         }
@@ -84,21 +73,18 @@ impl Steering for RsSteering {
     }
     fn turn(&self, delta: f64, direction: Direction, straight_m: f64) -> Vec<CurveSegment> {
         if delta.abs() < 1e-9 {
-            return vec![line(direction, straight_m)];
+            return vec![CurveSegment::line(direction, straight_m)];
         }
         let sign = match direction {
             Direction::Forward => 1.0,
             Direction::Reverse => -1.0,
         };
         let kappa = delta.signum() * sign / self.r_min_m;
-        vec![CurveSegment {
-            kind: CurveKind::Arc,
+        vec![CurveSegment::arc(
             direction,
-            length: delta.abs() * self.r_min_m,
-            kappa_start: kappa,
-            kappa_end: kappa,
-            sharpness: 0.0,
-        }]
+            delta.abs() * self.r_min_m,
+            kappa,
+        )]
     }
     fn distance(&self, from: &Pose, to: &Pose) -> f64 {
         rs_distance(from, to, self.r_min_m)
