@@ -8,7 +8,7 @@
 //! between 10 Hz fixes. With `predict` off it returns the latest fix as it is: the seed's plain
 //! reference. Allocation-free: the wheel-angle history is a fixed ring.
 
-use crate::geo::{heading_vec, left_normal, vec_heading, wrap_angle, Pose, Vec2};
+use crate::geo::{heading_vec, left_normal, v2, vec_heading, wrap_angle, Pose, Vec2};
 
 /// GNSS antenna position relative to the rear-axle centre, m.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -276,6 +276,9 @@ impl Estimator {
         let steps = (span / PREDICT_STEP).ceil() as usize;
         let (mut x, mut y, mut th) = (pose.pos.x, pose.pos.y, pose.heading);
         let l = self.params.wheelbase;
+        // The slope slip's speed to the left is fixed over the span (the latest roll), so it
+        // is worked out once, not per step (see [`Estimator::drift_velocity`]).
+        let slip_left = self.slip * self.roll.sin();
         if steps > 0 {
             let h = span / steps as f64;
             for i in 0..steps {
@@ -283,9 +286,11 @@ impl Estimator {
                 let t_mid = t0 + (i as f64 + 0.5) * h;
                 let rate = v * (self.wheel_angle_at(t_mid) - self.bias).tan() / l;
                 let th_mid = th + 0.5 * h * rate;
-                let drift = self.drift_velocity(th_mid);
-                x += (v * th_mid.cos() + drift.x) * h;
-                y += (v * th_mid.sin() + drift.y) * h;
+                // One sin/cos per step for both the motion and the slip's direction.
+                let (sin, cos) = th_mid.sin_cos();
+                let drift = self.drift - left_normal(&v2(cos, sin)) * slip_left;
+                x += (v * cos + drift.x) * h;
+                y += (v * sin + drift.y) * h;
                 th += rate * h;
             }
         }
@@ -518,7 +523,6 @@ impl Estimator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geo::v2;
 
     fn params(predict: bool) -> EstimatorParams {
         EstimatorParams {
