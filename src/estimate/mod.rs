@@ -259,11 +259,6 @@ impl Estimator {
         self.drift
     }
 
-    /// The estimated slope-slip coefficient, m/s per rad of roll.
-    pub fn slip_coefficient(&self) -> f64 {
-        self.slip
-    }
-
     /// The whole estimated drift velocity (world frame, m/s) of a vehicle heading `heading`
     /// (rad) at the latest roll: the world drift plus the slope slip.
     pub fn drift_velocity(&self, heading: f64) -> Vec2 {
