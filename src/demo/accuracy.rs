@@ -44,10 +44,7 @@ pub const TRACKERS: [TrackerChoice; 3] = [
     TrackerChoice::Stanley,
 ];
 
-/// The configuration name of a tracker.
-pub fn tracker_name(kind: TrackerChoice) -> &'static str {
-    super::tracker_name(kind)
-}
+pub use super::tracker_name;
 
 /// What the RTK-float part of a scenario did.
 #[derive(Debug, Clone, Serialize)]
@@ -252,7 +249,7 @@ pub fn evaluate(
     let mut stats = XteStats::default();
     let mut series = XteSeries::default();
     let mut offset = 0.0;
-    let windows: Vec<[f64; 2]> = cfg.sim.gnss_float_windows_s.clone();
+    let windows = &cfg.sim.gnss_float_windows_s;
     let in_float = |t: f64| windows.iter().any(|w| t >= w[0] && t <= w[0] + w[1]);
     let mut float_max: Option<f64> = None;
     for p in &run.work {

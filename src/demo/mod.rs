@@ -401,7 +401,8 @@ pub struct DemoRun {
     pub work: Vec<WorkPass>,
 }
 
-pub(crate) fn tracker_name(kind: TrackerChoice) -> &'static str {
+/// The configuration name of a tracker (`track.kind`).
+pub fn tracker_name(kind: TrackerChoice) -> &'static str {
     match kind {
         TrackerChoice::Predictive => "predictive",
         TrackerChoice::PurePursuit => "pure_pursuit",
