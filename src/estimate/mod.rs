@@ -276,10 +276,11 @@ impl Estimator {
         let slip_left = self.slip * self.roll.sin();
         if steps > 0 {
             let h = span / steps as f64;
+            let mut cursor = 1;
             for i in 0..steps {
                 // Midpoint rule for the heading keeps the arc accurate at this step.
                 let t_mid = t0 + (i as f64 + 0.5) * h;
-                let rate = v * (self.wheel_angle_at(t_mid) - self.bias).tan() / l;
+                let rate = v * (self.wheel_angle_from(t_mid, &mut cursor) - self.bias).tan() / l;
                 let th_mid = th + 0.5 * h * rate;
                 // One sin/cos per step for both the motion and the slip's direction.
                 let (sin, cos) = th_mid.sin_cos();
@@ -469,6 +470,15 @@ impl Estimator {
     /// The measured wheel angle at `t`, interpolated (held before the first and after the
     /// last sample).
     pub fn wheel_angle_at(&self, t: f64) -> f64 {
+        self.wheel_angle_from(t, &mut 1)
+    }
+
+    /// [`Estimator::wheel_angle_at`] for times that do not decrease from call to call (the
+    /// prediction's steps): the search starts at sample `*cursor` (start with 1) and leaves it
+    /// at the sample found, so the steps of one prediction scan the ring once between them
+    /// instead of once each. Every sample before the cursor is older than the previous time,
+    /// hence than `t`: the result is the same as a search from the start.
+    fn wheel_angle_from(&self, t: f64, cursor: &mut usize) -> f64 {
         if self.wheel_len == 0 {
             return 0.0;
         }
@@ -476,9 +486,10 @@ impl Estimator {
         if t <= first.0 {
             return first.1;
         }
-        for i in 1..self.wheel_len {
+        for i in (*cursor).max(1)..self.wheel_len {
             let (t1, a1) = self.wheel_sample(i);
             if t <= t1 {
+                *cursor = i;
                 let (t0, a0) = self.wheel_sample(i - 1);
                 let span = t1 - t0;
                 return if span > 0.0 {
@@ -488,6 +499,7 @@ impl Estimator {
                 };
             }
         }
+        *cursor = self.wheel_len;
         self.wheel_sample(self.wheel_len - 1).1
     }
 
@@ -604,6 +616,16 @@ mod tests {
             e.on_wheel_angle(3.0 + i as f64, i as f64);
         }
         assert_eq!(e.wheel_angle_at(1e9), 999.0, "ring keeps the newest");
+        // The prediction's cursor search gives what a search from the start gives, for
+        // non-decreasing times before, within (on and between samples) and after the ring.
+        let mut cursor = 1;
+        for k in 0..=1600 {
+            // The ring holds t = 875..=1002 s.
+            let t = 800.0 + 0.25 * k as f64;
+            let a = e.wheel_angle_from(t, &mut cursor);
+            assert_eq!(a, e.wheel_angle_at(t), "t = {t}");
+        }
+        assert_eq!(cursor, RING, "ran past the newest sample");
     }
 
     #[test]
