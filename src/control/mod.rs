@@ -385,11 +385,6 @@ impl Controller {
         self.estimator.set_coasting(float);
     }
 
-    /// The observer's estimates: wheel-angle offset (rad) and world drift (m/s).
-    pub fn disturbance_estimate(&self) -> (f64, Vec2) {
-        (self.estimator.wheel_offset(), self.estimator.drift())
-    }
-
     pub fn on_wheel_angle(&mut self, t: f64, angle: f64) {
         self.estimator.on_wheel_angle(t, angle);
     }

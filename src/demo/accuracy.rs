@@ -26,7 +26,7 @@
 use super::{run, DemoOptions, WorkPass, XteStats, ACQUISITION_END_M, ACQUISITION_SKIP_M};
 use crate::config::{Config, TrackerChoice};
 use crate::control::ControlError;
-use crate::geo::{signed_offset, Vec2};
+use crate::geo::Vec2;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -44,10 +44,7 @@ pub const TRACKERS: [TrackerChoice; 3] = [
     TrackerChoice::Stanley,
 ];
 
-/// The configuration name of a tracker.
-pub fn tracker_name(kind: TrackerChoice) -> &'static str {
-    super::tracker_name(kind)
-}
+pub use super::tracker_name;
 
 /// What the RTK-float part of a scenario did.
 #[derive(Debug, Clone, Serialize)]
@@ -112,32 +109,13 @@ pub fn error_class_cm(p95_m: f64) -> u32 {
 
 /// The nearest point of `line` to `p`: (distance along, signed offset, positive left).
 fn project(line: &[Vec2], cumulative: &[f64], p: &Vec2) -> Option<(f64, f64)> {
-    let mut best: Option<(f64, f64, f64)> = None;
-    for i in 0..line.len().saturating_sub(1) {
-        let a = line[i];
-        let d = line[i + 1] - a;
-        let len = d.norm();
-        if len <= 0.0 {
-            continue;
-        }
-        let dir = d / len;
-        let t = (p - a).dot(&dir).clamp(0.0, len);
-        let dist = (p - (a + dir * t)).norm();
-        if best.is_none_or(|b| dist < b.0) {
-            best = Some((dist, cumulative[i] + t, signed_offset(p, &a, &dir)));
-        }
-    }
-    best.map(|b| (b.1, b.2))
+    let last = line.len().checked_sub(2)?;
+    super::nearest_on_polyline(line, cumulative, p, 0..=last, false)
 }
 
 fn cumulative(line: &[Vec2]) -> Vec<f64> {
     let mut c = Vec::with_capacity(line.len());
-    let mut s = 0.0;
-    c.push(0.0);
-    for w in line.windows(2) {
-        s += (w[1] - w[0]).norm();
-        c.push(s);
-    }
+    super::cumulative_lengths(line, &mut c);
     c
 }
 
@@ -271,7 +249,7 @@ pub fn evaluate(
     let mut stats = XteStats::default();
     let mut series = XteSeries::default();
     let mut offset = 0.0;
-    let windows: Vec<[f64; 2]> = cfg.sim.gnss_float_windows_s.clone();
+    let windows = &cfg.sim.gnss_float_windows_s;
     let in_float = |t: f64| windows.iter().any(|w| t >= w[0] && t <= w[0] + w[1]);
     let mut float_max: Option<f64> = None;
     for p in &run.work {

@@ -291,6 +291,58 @@ pub struct Trace {
     pub outlines: Vec<Vec<Vec2>>,
 }
 
+/// The cumulative lengths of the polyline `points` into `out` (cleared first), m: 0 at the
+/// first point.
+pub(crate) fn cumulative_lengths(points: &[Vec2], out: &mut Vec<f64>) {
+    out.clear();
+    let mut s = 0.0;
+    out.push(0.0);
+    for w in points.windows(2) {
+        s += (w[1] - w[0]).norm();
+        out.push(s);
+    }
+}
+
+/// The nearest point to `p` on the segments `segments` (indices of their first points) of the
+/// polyline `points` with cumulative lengths `cumulative`: (distance along m, signed offset m,
+/// positive left). With `extend_ends`, beyond the polyline's ends the distance along keeps
+/// counting along its end segments (negative before the start). `None` for fewer than two
+/// points.
+pub(crate) fn nearest_on_polyline(
+    points: &[Vec2],
+    cumulative: &[f64],
+    p: &Vec2,
+    segments: std::ops::RangeInclusive<usize>,
+    extend_ends: bool,
+) -> Option<(f64, f64)> {
+    let n = points.len();
+    if n < 2 {
+        return None;
+    }
+    let mut best: Option<(f64, f64, f64)> = None;
+    for i in segments {
+        let a = points[i];
+        let d = points[i + 1] - a;
+        let len = d.norm();
+        if len <= 0.0 {
+            continue;
+        }
+        let dir = d / len;
+        let t = (p - a).dot(&dir);
+        let tc = t.clamp(0.0, len);
+        let dist = (p - (a + dir * tc)).norm();
+        if best.is_none_or(|b| dist < b.0) {
+            let along_seg = if extend_ends && ((i == 0 && t < 0.0) || (i == n - 2 && t > len)) {
+                t
+            } else {
+                tc
+            };
+            best = Some((dist, cumulative[i] + along_seg, signed_offset(p, &a, &dir)));
+        }
+    }
+    best.map(|(_, along, offset)| (along, offset))
+}
+
 /// The work path being scored against the true pose, with its cumulative lengths.
 #[derive(Debug, Default)]
 struct ScoredPath {
@@ -314,13 +366,7 @@ impl ScoredPath {
         let path = g.global_path();
         self.points.clear();
         self.points.extend(path.iter().map(|p| p.pos));
-        self.cumulative.clear();
-        let mut s = 0.0;
-        self.cumulative.push(0.0);
-        for w in self.points.windows(2) {
-            s += (w[1] - w[0]).norm();
-            self.cumulative.push(s);
-        }
+        cumulative_lengths(&self.points, &mut self.cumulative);
     }
 
     fn length(&self) -> f64 {
@@ -336,33 +382,7 @@ impl ScoredPath {
         }
         let lo = hint.saturating_sub(4).min(n - 2);
         let hi = (hint + 4).min(n - 2);
-        let mut best: Option<(f64, f64, f64)> = None;
-        for i in lo..=hi {
-            let a = self.points[i];
-            let d = self.points[i + 1] - a;
-            let len = d.norm();
-            if len <= 0.0 {
-                continue;
-            }
-            let dir = d / len;
-            let t = (p - a).dot(&dir);
-            let tc = t.clamp(0.0, len);
-            let dist = (p - (a + dir * tc)).norm();
-            if best.is_none_or(|b| dist < b.0) {
-                // Beyond the ends of the whole path, keep measuring along the end segments.
-                let along_seg = if (i == 0 && t < 0.0) || (i == n - 2 && t > len) {
-                    t
-                } else {
-                    tc
-                };
-                best = Some((
-                    dist,
-                    self.cumulative[i] + along_seg,
-                    signed_offset(p, &a, &dir),
-                ));
-            }
-        }
-        best.map(|(_, along, xte)| (along, xte))
+        nearest_on_polyline(&self.points, &self.cumulative, p, lo..=hi, true)
     }
 }
 
@@ -381,7 +401,8 @@ pub struct DemoRun {
     pub work: Vec<WorkPass>,
 }
 
-pub(crate) fn tracker_name(kind: TrackerChoice) -> &'static str {
+/// The configuration name of a tracker (`track.kind`).
+pub fn tracker_name(kind: TrackerChoice) -> &'static str {
     match kind {
         TrackerChoice::Predictive => "predictive",
         TrackerChoice::PurePursuit => "pure_pursuit",

@@ -8,7 +8,7 @@
 //! between 10 Hz fixes. With `predict` off it returns the latest fix as it is: the seed's plain
 //! reference. Allocation-free: the wheel-angle history is a fixed ring.
 
-use crate::geo::{heading_vec, left_normal, vec_heading, wrap_angle, Pose, Vec2};
+use crate::geo::{heading_vec, left_normal, v2, vec_heading, wrap_angle, Pose, Vec2};
 
 /// GNSS antenna position relative to the rear-axle centre, m.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -259,11 +259,6 @@ impl Estimator {
         self.drift
     }
 
-    /// The estimated slope-slip coefficient, m/s per rad of roll.
-    pub fn slip_coefficient(&self) -> f64 {
-        self.slip
-    }
-
     /// The whole estimated drift velocity (world frame, m/s) of a vehicle heading `heading`
     /// (rad) at the latest roll: the world drift plus the slope slip.
     pub fn drift_velocity(&self, heading: f64) -> Vec2 {
@@ -276,16 +271,22 @@ impl Estimator {
         let steps = (span / PREDICT_STEP).ceil() as usize;
         let (mut x, mut y, mut th) = (pose.pos.x, pose.pos.y, pose.heading);
         let l = self.params.wheelbase;
+        // The slope slip's speed to the left is fixed over the span (the latest roll), so it
+        // is worked out once, not per step (see [`Estimator::drift_velocity`]).
+        let slip_left = self.slip * self.roll.sin();
         if steps > 0 {
             let h = span / steps as f64;
+            let mut cursor = 1;
             for i in 0..steps {
                 // Midpoint rule for the heading keeps the arc accurate at this step.
                 let t_mid = t0 + (i as f64 + 0.5) * h;
-                let rate = v * (self.wheel_angle_at(t_mid) - self.bias).tan() / l;
+                let rate = v * (self.wheel_angle_from(t_mid, &mut cursor) - self.bias).tan() / l;
                 let th_mid = th + 0.5 * h * rate;
-                let drift = self.drift_velocity(th_mid);
-                x += (v * th_mid.cos() + drift.x) * h;
-                y += (v * th_mid.sin() + drift.y) * h;
+                // One sin/cos per step for both the motion and the slip's direction.
+                let (sin, cos) = th_mid.sin_cos();
+                let drift = self.drift - left_normal(&v2(cos, sin)) * slip_left;
+                x += (v * cos + drift.x) * h;
+                y += (v * sin + drift.y) * h;
                 th += rate * h;
             }
         }
@@ -469,6 +470,15 @@ impl Estimator {
     /// The measured wheel angle at `t`, interpolated (held before the first and after the
     /// last sample).
     pub fn wheel_angle_at(&self, t: f64) -> f64 {
+        self.wheel_angle_from(t, &mut 1)
+    }
+
+    /// [`Estimator::wheel_angle_at`] for times that do not decrease from call to call (the
+    /// prediction's steps): the search starts at sample `*cursor` (start with 1) and leaves it
+    /// at the sample found, so the steps of one prediction scan the ring once between them
+    /// instead of once each. Every sample before the cursor is older than the previous time,
+    /// hence than `t`: the result is the same as a search from the start.
+    fn wheel_angle_from(&self, t: f64, cursor: &mut usize) -> f64 {
         if self.wheel_len == 0 {
             return 0.0;
         }
@@ -476,9 +486,10 @@ impl Estimator {
         if t <= first.0 {
             return first.1;
         }
-        for i in 1..self.wheel_len {
+        for i in (*cursor).max(1)..self.wheel_len {
             let (t1, a1) = self.wheel_sample(i);
             if t <= t1 {
+                *cursor = i;
                 let (t0, a0) = self.wheel_sample(i - 1);
                 let span = t1 - t0;
                 return if span > 0.0 {
@@ -488,6 +499,7 @@ impl Estimator {
                 };
             }
         }
+        *cursor = self.wheel_len;
         self.wheel_sample(self.wheel_len - 1).1
     }
 
@@ -518,7 +530,6 @@ impl Estimator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geo::v2;
 
     fn params(predict: bool) -> EstimatorParams {
         EstimatorParams {
@@ -605,6 +616,16 @@ mod tests {
             e.on_wheel_angle(3.0 + i as f64, i as f64);
         }
         assert_eq!(e.wheel_angle_at(1e9), 999.0, "ring keeps the newest");
+        // The prediction's cursor search gives what a search from the start gives, for
+        // non-decreasing times before, within (on and between samples) and after the ring.
+        let mut cursor = 1;
+        for k in 0..=1600 {
+            // The ring holds t = 875..=1002 s.
+            let t = 800.0 + 0.25 * k as f64;
+            let a = e.wheel_angle_from(t, &mut cursor);
+            assert_eq!(a, e.wheel_angle_at(t), "t = {t}");
+        }
+        assert_eq!(cursor, RING, "ran past the newest sample");
     }
 
     #[test]

@@ -79,12 +79,12 @@ pub fn arcs_job(p: &ArcsParams) -> Result<SegmentJob, PlanError> {
     for i in 0..p.lines {
         let points = line_points(p, i);
         if i > 0 {
-            let Some(prev) = segments.last().map(|s: &JobSegment| s.points.clone()) else {
+            // The previous line's end and direction there (a line has at least 3 points).
+            let Some(&[.., before, p1]) = segments.last().map(|s: &JobSegment| &s.points[..])
+            else {
                 break;
             };
-            let n = prev.len();
-            let p1 = prev[n - 1];
-            let dir1 = (prev[n - 1] - prev[n - 2]).normalize();
+            let dir1 = (p1 - before).normalize();
             let p2 = points[0];
             turn.clear();
             if (p2 - p1).norm() + 1e-3 >= 2.0 * p.turn.r_min {
