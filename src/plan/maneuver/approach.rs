@@ -49,7 +49,7 @@ pub fn approach_path(
 }
 
 fn connect(from: &Pose, to: &Pose, curve: &CurveParams) -> Option<CurvePath> {
-    super::reeds_shepp::reeds_shepp_shortest(from, to, 1.0 / curve.kappa_max)
+    super::cc_reeds_shepp::cc_reeds_shepp_shortest(from, to, curve)
 }
 
 #[cfg(test)]
