@@ -70,17 +70,8 @@ pub fn ab_job_plan(cfg: &Config) -> Result<JobPlan, ControlError> {
     Ok(match cfg.job.line_order {
         LineOrder::Blocks => AbPlan::new(params)?.into(),
         LineOrder::Sequential => {
-            let segments = crate::plan::abline::sequential_segments(&params)?;
-            JobPlan::Segments(crate::guidance::segments::SegmentJob::new(
-                segments
-                    .into_iter()
-                    .map(|s| crate::guidance::segments::JobSegment {
-                        kind: s.kind,
-                        direction: s.direction,
-                        cell: s.cell,
-                        points: s.points,
-                    })
-                    .collect(),
+            JobPlan::Segments(crate::guidance::segments::SegmentJob::from_plan_segments(
+                crate::plan::abline::sequential_segments(&params)?,
             )?)
         }
     })
@@ -335,11 +326,7 @@ impl Controller {
     ) -> Option<Result<usize, crate::plan::maneuver::approach::ApproachError>> {
         let a = self.approach.as_ref()?;
         let g = &self.guidance;
-        if g.is_finished()
-            || g.is_approaching()
-            || g.phase() != crate::guidance::progress::Phase::Work
-            || g.lines_done() > 0
-        {
+        if !g.approach_allowed() {
             return None;
         }
         let est = self.estimator.estimate(t)?;
@@ -358,16 +345,11 @@ impl Controller {
         )
         .map(|(_, parts)| {
             let n = parts.len();
-            // Accepted: the conditions above are the guidance's own.
-            let segments = parts
-                .into_iter()
-                .map(|p| crate::guidance::segments::JobSegment {
-                    kind: crate::plan::coverage::SegmentKind::Transit,
-                    direction: p.direction,
-                    cell: 0,
-                    points: p.points,
-                })
-                .collect();
+            let segments = crate::guidance::segments::JobSegment::from_driven_parts(
+                parts,
+                crate::plan::coverage::SegmentKind::Transit,
+            );
+            // Accepted: approach_allowed() held above.
             self.guidance.set_approach(segments);
             n
         });

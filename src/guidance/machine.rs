@@ -515,7 +515,7 @@ impl Guidance {
     /// work line before any line is done, and not while approaching; `false` when refused. An
     /// empty list is accepted and changes nothing.
     pub fn set_approach(&mut self, segments: Vec<JobSegment>) -> bool {
-        if self.approach_index.is_some() || self.phase != Phase::Work || self.lines_done > 0 {
+        if !self.approach_allowed() {
             return false;
         }
         if segments.is_empty() {
@@ -524,6 +524,12 @@ impl Guidance {
         self.approach = segments;
         self.load_approach_segment(0);
         true
+    }
+
+    /// Whether [`Guidance::set_approach`] would accept an approach now: on a work line before
+    /// any line is done, not finished and not already approaching.
+    pub fn approach_allowed(&self) -> bool {
+        self.approach_index.is_none() && self.phase == Phase::Work && self.lines_done == 0
     }
 
     /// Whether an approach path is being driven.

@@ -2,7 +2,8 @@
 //! by the same state machine, local path and tracker as an AB job.
 
 use crate::geo::{Direction, PathPoint, Tag, Vec2};
-use crate::plan::coverage::{FieldPlan, SegmentKind};
+use crate::plan::coverage::{FieldPlan, PlanSegment, SegmentKind};
+use crate::plan::maneuver::drive::DrivenPart;
 use crate::plan::PlanError;
 
 /// One driveable piece of a segment job.
@@ -34,6 +35,22 @@ impl JobSegment {
         } else {
             Tag::Turn
         }
+    }
+
+    /// The parts of a manoeuvre path between its cusps as `kind` segments of cell 0.
+    pub fn from_driven_parts(
+        parts: impl IntoIterator<Item = DrivenPart>,
+        kind: SegmentKind,
+    ) -> Vec<JobSegment> {
+        parts
+            .into_iter()
+            .map(|p| JobSegment {
+                kind,
+                direction: p.direction,
+                cell: 0,
+                points: p.points,
+            })
+            .collect()
     }
 
     /// Length along the points, m.
@@ -97,17 +114,32 @@ impl SegmentJob {
 
     /// The segments of a field plan, in its driving order.
     pub fn from_field_plan(plan: &FieldPlan) -> Result<Self, PlanError> {
+        SegmentJob::from_plan_segments(plan.segments.iter().cloned())
+    }
+
+    /// Planned segments (a field plan's, sequential AB lines) in driving order.
+    pub fn from_plan_segments(
+        segments: impl IntoIterator<Item = PlanSegment>,
+    ) -> Result<Self, PlanError> {
         SegmentJob::new(
-            plan.segments
-                .iter()
+            segments
+                .into_iter()
                 .map(|s| JobSegment {
                     kind: s.kind,
                     direction: s.direction,
                     cell: s.cell,
-                    points: s.points.clone(),
+                    points: s.points,
                 })
                 .collect(),
         )
+    }
+
+    /// The parts of a manoeuvre path between its cusps, as `kind` segments.
+    pub fn from_driven_parts(
+        parts: impl IntoIterator<Item = DrivenPart>,
+        kind: SegmentKind,
+    ) -> Result<Self, PlanError> {
+        SegmentJob::new(JobSegment::from_driven_parts(parts, kind))
     }
 
     pub fn segments(&self) -> &[JobSegment] {

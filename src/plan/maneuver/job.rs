@@ -11,7 +11,7 @@ use super::search::{plan_maneuver, ManeuverError, ManeuverResult};
 use super::steering::{CcSteering, RsSteering};
 use crate::config::{Config, CurveChoice};
 use crate::geo::Pose;
-use crate::guidance::segments::{JobSegment, SegmentJob};
+use crate::guidance::segments::SegmentJob;
 use crate::plan::coverage::{Field, SegmentKind};
 
 /// Why a manoeuvre job could not be prepared.
@@ -102,17 +102,7 @@ pub fn pose_of(p: [f64; 3]) -> Pose {
 /// `path` as the guidance drives it: one transit segment per part between cusps, points every
 /// `spacing_m`.
 pub fn segment_job(path: &CurvePath, spacing_m: f64) -> Result<SegmentJob, crate::plan::PlanError> {
-    SegmentJob::new(
-        split_at_cusps(path, spacing_m)
-            .into_iter()
-            .map(|p| JobSegment {
-                kind: SegmentKind::Transit,
-                direction: p.direction,
-                cell: 0,
-                points: p.points,
-            })
-            .collect(),
-    )
+    SegmentJob::from_driven_parts(split_at_cusps(path, spacing_m), SegmentKind::Transit)
 }
 
 /// A planned manoeuvre job.
