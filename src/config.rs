@@ -323,8 +323,8 @@ pub struct TrackConfig {
     pub observer_bias_limit_deg: f64,
     /// Largest drift speed the observer may estimate, m/s.
     pub observer_drift_limit_mps: f64,
-    /// Time constant of the slope-slip coefficient (lateral slip per degree of IMU roll), s
-    /// (0 = off).
+    /// Time constant of the slope-slip coefficient (lateral slip per degree of IMU roll) at 2°
+    /// of roll, s (0 = off).
     pub observer_slip_tau_s: f64,
     /// Largest slope-slip coefficient, m/s per degree of roll.
     pub observer_slip_limit_mps_per_deg: f64,
@@ -356,7 +356,7 @@ impl Default for TrackConfig {
             observer_min_speed_mps: 1.0,
             observer_bias_limit_deg: 3.0,
             observer_drift_limit_mps: 0.3,
-            observer_slip_tau_s: 15.0,
+            observer_slip_tau_s: 30.0,
             observer_slip_limit_mps_per_deg: 0.05,
             observer_coast_max_s: 30.0,
         }

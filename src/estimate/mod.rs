@@ -9,6 +9,7 @@
 //! reference. Allocation-free: the wheel-angle history is a fixed ring.
 
 use crate::geo::{heading_vec, left_normal, v2, vec_heading, wrap_angle, Pose, Vec2};
+use nalgebra::{Matrix3, Vector3};
 
 /// GNSS antenna position relative to the rear-axle centre, m.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -52,31 +53,30 @@ pub struct EstimatorParams {
     pub observer: ObserverParams,
 }
 
-/// The disturbance observer: a constant-gain (steady-state Kalman) filter on the innovation
-/// of each fix against the pose predicted from the previous fix. Two slowly varying
-/// disturbances are estimated:
+/// The disturbance observer: Kalman-type filters on the innovation of each fix against the
+/// pose predicted from the previous fix. Three slowly varying disturbances are estimated:
 ///
 /// * a wheel-angle offset `b` (vehicle frame, rad: measured − true angle), from the heading
 ///   innovation: the predicted yaw rate uses v·tan(δ_measured − b)/L, so
 ///   Δθ ≈ −v·Δt/(L·cos²δ)·(b − b̂);
-/// * a drift velocity `d` (world frame, m/s, e.g. side-slope slip), from the lateral
-///   innovation Δl ≈ (d − d̂)·n·Δt, n the vehicle's left normal. Only the component along n is
-///   observable on a straight pass; kept as a world vector, a drift that is fixed on the
-///   ground (downhill) keeps its sign when the direction of travel flips, and turns observe it
-///   from every side.
-///
+/// * a drift velocity `d` (world frame, m/s, e.g. slip on a slope without a roll signal), from
+///   the lateral innovation Δl ≈ (d − d̂)·n·Δt, n the vehicle's left normal. Only the component
+///   along n is observable on a straight pass; kept as a world vector, a drift that is fixed on
+///   the ground (downhill) keeps its sign when the direction of travel flips;
 /// * a side-slope slip coefficient `c` (vehicle frame, m/s per rad of roll), see
-///   [`ObserverParams::slip_tau`].
+///   [`ObserverParams::slip_tau`], from the same lateral innovation.
 ///
-/// Each update moves the estimate by Δt/τ of the innovation's measurement of its error, a
+/// The offset's estimate moves by Δt/τ of the innovation's measurement of its error, a
 /// first-order filter with time constant τ; τ starts at 1 s and grows with the time learnt up
 /// to the configured value, as a Kalman filter's gain falls from its initial covariance to the
-/// steady state. Innovations beyond a gate (5 cm lateral, 0.02 rad heading) are jumps, not
-/// drift: they are not learnt from, and the estimator dead-reckons through them and through
-/// RTK-float periods ([`ObserverParams::coast_max`]). Both estimates enter the prediction, and the
-/// controller steers the velocity (course) rather than the heading onto the path, which cancels
-/// the drift. The innovation of two consecutive fixes telescopes: white position noise σ leaves
-/// about σ/τ_drift of noise on the drift, heading noise σθ about σθ·L/(v·τ_bias) on the offset.
+/// steady state. The drift and the slip share one measurement and are estimated together by a
+/// three-state Kalman filter ([`LateralFilter`]) tuned to the same time constants. Innovations
+/// beyond a gate (5 cm lateral, 0.02 rad heading) are jumps, not drift: they are not learnt
+/// from, and the estimator dead-reckons through them and through RTK-float periods
+/// ([`ObserverParams::coast_max`]). The estimates enter the prediction, and the controller
+/// steers the velocity (course) rather than the heading onto the path, which cancels the drift.
+/// The innovation of two consecutive fixes telescopes: white position noise σ leaves about
+/// σ/τ_drift of noise on the drift, heading noise σθ about σθ·L/(v·τ_bias) on the offset.
 /// Reference: the disturbance-observer form of a Kalman filter on the path-relative error model,
 /// e.g. Åström & Murray, *Feedback Systems*, ch. 7 (state estimation with integral
 /// disturbance states).
@@ -92,11 +92,13 @@ pub struct ObserverParams {
     pub bias_limit: f64,
     /// Largest drift speed, m/s.
     pub drift_limit: f64,
-    /// Time constant of the slope-slip coefficient estimate, s; 0 = off. Side-slope slip is
-    /// about proportional to the slope: a vehicle-frame lateral velocity −c·sin(roll) (to the
-    /// right, downhill, for positive roll), with c learnt by normalised LMS from the same
-    /// lateral innovation as the drift. It follows a slope that varies along the pass, which a
-    /// drift estimate can only chase, and it keeps doing so while coasting.
+    /// Time constant of the slope-slip coefficient estimate at a roll of 2°, s; 0 = off.
+    /// Side-slope slip is about proportional to the slope: a vehicle-frame lateral velocity
+    /// −c·sin(roll) (to the right, downhill, for positive roll). The regressor of a fix
+    /// interval is the mean of the rolls at its two ends: the antenna's lean makes roll noise
+    /// a position error, which the latest roll alone would correlate with the innovation. The
+    /// slip follows a slope that varies along the pass, which a drift estimate can only chase,
+    /// and it keeps doing so while coasting.
     pub slip_tau: f64,
     /// Largest slip coefficient, m/s per rad of roll.
     pub slip_limit: f64,
@@ -157,9 +159,81 @@ struct Innovation {
 const BIAS_MAX_WHEEL: f64 = 0.2;
 /// Shortest effective time constant at the start of learning, s.
 const MIN_TAU: f64 = 1.0;
-/// Regularisation of the slip coefficient's normalised LMS step: sin² of about 1°, so that on
-/// flat ground the coefficient is left alone.
-const SLIP_EPS: f64 = 3e-4;
+/// The roll at which the slip coefficient's estimate has the time constant
+/// [`ObserverParams::slip_tau`], rad (2°): at a steeper slope it learns faster, on flat ground
+/// it is left alone.
+const SLIP_REFERENCE_ROLL: f64 = 0.035;
+
+/// The Kalman filter of the lateral disturbances θ = (world drift x, y in m/s; slip
+/// coefficient in m/s per rad of roll), each a random walk. The measurement is the lateral
+/// rate error of one fix interval, e = Δl/Δt = h·(θ − θ̂) + noise, h = (n, −sin roll).
+///
+/// Estimating them jointly matters on a side slope: the downhill drift and the slope slip push
+/// the same way on every pass, so only the slope's variation along a pass tells them apart, and
+/// two filters fed the same error would share it arbitrarily (then dead reckoning through RTK
+/// float drifts wherever the slope differs from its mean). The noise densities are set so
+/// that, alone, each state is a first-order filter with its configured time constant (the
+/// slip at [`SLIP_REFERENCE_ROLL`]): process noise q = r/τ² against a measurement noise
+/// density r (the scale cancels, r = 1). The covariance starts at the value of a 1 s time
+/// constant ([`MIN_TAU`]) and is never let above it, so that a state that is not observed
+/// (the drift along the pass, the slip on flat ground) does not gather an unbounded gain.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct LateralFilter {
+    p: Matrix3<f64>,
+}
+
+impl LateralFilter {
+    /// Covariance of a time constant τ (s) for a state seen through a regressor of size `h`.
+    fn variance(tau: f64, h: f64) -> f64 {
+        1.0 / (tau * h * h)
+    }
+
+    fn initial() -> Matrix3<f64> {
+        Matrix3::from_diagonal(&Vector3::new(
+            Self::variance(MIN_TAU, 1.0),
+            Self::variance(MIN_TAU, 1.0),
+            Self::variance(MIN_TAU, SLIP_REFERENCE_ROLL),
+        ))
+    }
+
+    fn new() -> Self {
+        LateralFilter { p: Self::initial() }
+    }
+
+    /// One fix interval `dt` (s) with regressor `h` and lateral rate error `e` (m/s): the
+    /// correction of θ̂.
+    fn update(&mut self, h: &Vector3<f64>, e: f64, dt: f64, o: &ObserverParams) -> Vector3<f64> {
+        // Process noise q = r/τ² (r = 1) for the slip in units of the reference roll.
+        let q = |tau: f64, scale: f64| {
+            if tau > 0.0 {
+                1.0 / (tau * tau * scale * scale)
+            } else {
+                0.0
+            }
+        };
+        let q_drift = q(o.drift_tau, 1.0);
+        let q_slip = q(o.slip_tau, SLIP_REFERENCE_ROLL);
+        self.p += Matrix3::from_diagonal(&Vector3::new(q_drift, q_drift, q_slip)) * dt;
+        let ph = self.p * h;
+        let s = h.dot(&ph) + 1.0 / dt;
+        let k = ph / s;
+        self.p -= k * ph.transpose();
+        // Keep the covariance symmetric and each variance within its initial value (scaling
+        // the row and column keeps it positive semi-definite).
+        self.p = 0.5 * (self.p + self.p.transpose());
+        let cap = Self::initial();
+        for i in 0..3 {
+            if self.p[(i, i)] > cap[(i, i)] {
+                let f = (cap[(i, i)] / self.p[(i, i)]).sqrt();
+                for j in 0..3 {
+                    self.p[(i, j)] *= f;
+                    self.p[(j, i)] *= f;
+                }
+            }
+        }
+        k * e
+    }
+}
 
 /// The estimate handed to guidance and tracking.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -196,8 +270,12 @@ pub struct Estimator {
     drift: Vec2,
     /// Estimated slope-slip coefficient, m/s per rad of roll (lateral, to the right).
     slip: f64,
+    /// The joint filter of the drift and the slip.
+    lateral: LateralFilter,
     /// Roll of the latest fix, rad (0 without a roll signal).
     roll: f64,
+    /// Roll of the fix before, rad.
+    roll_prev: f64,
     /// Time the observer has learnt for, s: the effective time constants grow with it up to
     /// the configured ones (as a Kalman filter's gain falls from a large initial covariance).
     learnt: f64,
@@ -224,7 +302,9 @@ impl Estimator {
             bias: 0.0,
             drift: Vec2::zeros(),
             slip: 0.0,
+            lateral: LateralFilter::new(),
             roll: 0.0,
+            roll_prev: 0.0,
             learnt: 0.0,
             learn: true,
             coast: false,
@@ -330,26 +410,34 @@ impl Estimator {
             (i.dt, i.t_prev, i.heading, i.lateral, i.normal);
         self.learnt += dt;
         let tau = |configured: f64| configured.min(self.learnt.max(MIN_TAU));
-        if o.bias_tau > 0.0 {
-            let delta = self.wheel_angle_at(t_prev + 0.5 * dt) - self.bias;
-            if delta.abs() < BIAS_MAX_WHEEL {
-                let c = delta.cos();
-                let step = -d_heading * self.params.wheelbase * c * c / (v * tau(o.bias_tau));
-                self.bias = (self.bias + step).clamp(-o.bias_limit, o.bias_limit);
-            }
+        // The wheel angle over the interval, less the offset.
+        let delta = self.wheel_angle_at(t_prev + 0.5 * dt) - self.bias;
+        if o.bias_tau > 0.0 && delta.abs() < BIAS_MAX_WHEEL {
+            let c = delta.cos();
+            let step = -d_heading * self.params.wheelbase * c * c / (v * tau(o.bias_tau));
+            self.bias = (self.bias + step).clamp(-o.bias_limit, o.bias_limit);
         }
-        if o.slip_tau > 0.0 {
-            // Normalised LMS on the lateral rate error e = Δl/Δt with regressor −sin(roll).
-            let phi = -self.roll.sin();
-            let step = d_lateral / tau(o.slip_tau) * phi / (phi * phi + SLIP_EPS);
-            self.slip = (self.slip + step).clamp(-o.slip_limit, o.slip_limit);
-        }
-        if o.drift_tau > 0.0 {
-            self.drift += n * (d_lateral / tau(o.drift_tau));
+        // The lateral rate error e = Δl/Δt measures h·(θ − θ̂) with θ = (drift, slip) and
+        // h = (n, −sin roll): one Kalman update of the three together.
+        let drift_on = o.drift_tau > 0.0;
+        let slip_on = o.slip_tau > 0.0;
+        if drift_on || slip_on {
+            let h = Vector3::new(
+                if drift_on { n.x } else { 0.0 },
+                if drift_on { n.y } else { 0.0 },
+                if slip_on {
+                    -(0.5 * (self.roll_prev + self.roll)).sin()
+                } else {
+                    0.0
+                },
+            );
+            let step = self.lateral.update(&h, d_lateral / dt, dt, &o);
+            self.drift += v2(step.x, step.y);
             let norm = self.drift.norm();
             if norm > o.drift_limit {
                 self.drift *= o.drift_limit / norm;
             }
+            self.slip = (self.slip + step.z).clamp(-o.slip_limit, o.slip_limit);
         }
     }
 
@@ -404,6 +492,7 @@ impl Estimator {
         let roll = fix
             .roll
             .filter(|r| r.is_finite() && self.params.roll_compensation);
+        self.roll_prev = self.roll;
         self.roll = roll.unwrap_or(0.0);
         let pos = self.antenna_to_rear_axle(&fix.antenna, heading, roll);
         let mut pose = Pose::new(pos.x, pos.y, heading);
@@ -530,6 +619,7 @@ impl Estimator {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::FRAC_PI_2;
 
     fn params(predict: bool) -> EstimatorParams {
         EstimatorParams {
@@ -717,6 +807,83 @@ mod tests {
             },
             ..params(true)
         }
+    }
+
+    /// Passes north and south across a slope falling to the East, rolling `roll(along)` (right
+    /// side down driving north), the vehicle slipping downhill at `slip`·sin(roll) m/s, with an
+    /// IMU roll noise of ±0.05° (deterministic) and the antenna 3 m up: the estimator's slip
+    /// coefficient and world drift afterwards.
+    fn slope_passes(roll: impl Fn(f64) -> f64, slip: f64, passes: usize) -> (f64, Vec2) {
+        let mut e = Estimator::new(EstimatorParams {
+            observer: ObserverParams {
+                drift_tau: 60.0,
+                slip_tau: 30.0,
+                ..ObserverParams::default()
+            },
+            ..params(true)
+        });
+        let v = 4.0;
+        let mut t = 0.0;
+        let mut noise = 0x2545_f491_u64;
+        for pass in 0..passes {
+            let north = pass % 2 == 0;
+            let th = if north { FRAC_PI_2 } else { -FRAC_PI_2 };
+            let x0 = pass as f64 * 3.0;
+            let (mut x, mut y) = (x0, if north { 0.0 } else { 150.0 });
+            // Re-anchor at the start of each pass (a turn, not simulated, comes between).
+            e.fix_pose = None;
+            for k in 1..=(150.0 / v / 0.02) as usize {
+                t += 0.02;
+                let along = if north { y } else { 150.0 - y };
+                // Positive roll when driving north (East side down); flips driving south.
+                let r = if north { roll(along) } else { -roll(along) };
+                let right = -left_normal(&heading_vec(th));
+                x += (v * th.cos() + right.x * slip * r.sin()) * 0.02;
+                y += (v * th.sin() + right.y * slip * r.sin()) * 0.02;
+                e.on_wheel_angle(t, 0.0);
+                if k % 5 == 0 {
+                    noise = noise
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    let u = (noise >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                    let measured = r + 0.1f64.to_radians() * u;
+                    let truth = Pose::new(x, y, th);
+                    let antenna = antenna_of(&e, &truth)
+                        - left_normal(&heading_vec(th)) * (e.params().antenna.up * r.sin());
+                    e.on_fix(&GnssFix {
+                        t_received: t + e.params().gnss_latency,
+                        antenna,
+                        heading: Some(th),
+                        speed: v,
+                        roll: Some(measured),
+                    });
+                }
+            }
+        }
+        (e.slip, e.drift())
+    }
+
+    #[test]
+    fn the_observer_tells_slope_slip_from_a_world_drift() {
+        // 0.015 m/s per degree of roll, the roll 2° ± 1° over 60 m: the downhill drift and the
+        // slip push the same way on every pass; only the variation tells them apart.
+        let c = 0.015f64.to_degrees();
+        let varying =
+            |along: f64| (2.0 + (along / 60.0 * std::f64::consts::TAU).sin()).to_radians();
+        let (slip, drift) = slope_passes(varying, c, 12);
+        assert!((slip - c).abs() < 0.1 * c, "slip {slip} vs {c}");
+        assert!(drift.norm() < 0.004, "drift {drift:?}");
+        // On an even slope they cannot be told apart; the sum must be right, and roll noise
+        // (3 m up, it moves the antenna) must not drive them apart to their limits.
+        let even = |_: f64| 2f64.to_radians();
+        let (slip, drift) = slope_passes(even, c, 12);
+        let total = drift.x + slip * 2f64.to_radians().sin();
+        let truth = c * 2f64.to_radians().sin();
+        assert!((total - truth).abs() < 0.003, "total {total} vs {truth}");
+        assert!(
+            slip.abs() < 2.0 * c && drift.norm() < 0.05,
+            "slip {slip}, drift {drift:?}"
+        );
     }
 
     #[test]
