@@ -4,34 +4,20 @@
 //!
 //! Run: cargo bench --bench maneuver_curves -- --warm-up-time 1 --measurement-time 3
 
-use agsteer::geo::{Direction, Pose};
+use agsteer::geo::Direction;
 use agsteer::plan::maneuver::cc_reeds_shepp::{cc_reeds_shepp_length, cc_reeds_shepp_shortest};
 use agsteer::plan::maneuver::cc_turn::cc_turn;
 use agsteer::plan::maneuver::path::CurveParams;
 use agsteer::plan::maneuver::reeds_shepp::{reeds_shepp_length, reeds_shepp_shortest};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 use std::hint::black_box;
 
-fn pairs() -> Vec<(Pose, Pose)> {
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-    (0..256)
-        .map(|_| {
-            let mut p = || {
-                Pose::new(
-                    rng.gen_range(-20.0..20.0),
-                    rng.gen_range(-20.0..20.0),
-                    rng.gen_range(-PI..PI),
-                )
-            };
-            (p(), p())
-        })
-        .collect()
-}
+#[path = "../tests/common/mod.rs"]
+mod common;
 
 fn bench(c: &mut Criterion) {
-    let pairs = pairs();
+    let pairs = common::random_pose_pairs(256, 7);
     let params = CurveParams {
         kappa_max: 0.2,
         sigma_max: 0.1,

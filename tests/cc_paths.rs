@@ -4,28 +4,13 @@
 //!
 //! Run: cargo test --release --test cc_paths -- --nocapture
 
-use agsteer::geo::{wrap_angle, Pose};
+use agsteer::geo::wrap_angle;
 use agsteer::plan::maneuver::cc_reeds_shepp::{cc_reeds_shepp_length, cc_reeds_shepp_shortest};
 use agsteer::plan::maneuver::path::{CurveParams, PathSample};
 use agsteer::plan::maneuver::reeds_shepp::reeds_shepp_length;
-use rand::{Rng, SeedableRng};
-use std::f64::consts::PI;
+mod common;
 
-fn pairs(n: usize, seed: u64) -> Vec<(Pose, Pose)> {
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    (0..n)
-        .map(|_| {
-            let mut p = || {
-                Pose::new(
-                    rng.gen_range(-20.0..20.0),
-                    rng.gen_range(-20.0..20.0),
-                    rng.gen_range(-PI..PI),
-                )
-            };
-            (p(), p())
-        })
-        .collect()
-}
+use common::random_pose_pairs as pairs;
 
 struct Stats {
     none: usize,

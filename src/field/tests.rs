@@ -1,6 +1,6 @@
 use super::*;
 use crate::geo::polygon::point_segment_distance;
-use crate::geo::v2;
+use crate::geo::{rect, v2};
 
 const ORIGIN: LatLon = LatLon {
     lat_deg: 52.0,
@@ -35,10 +35,6 @@ fn collection(features: &[String]) -> String {
         r#"{{"type":"FeatureCollection","features":[{}]}}"#,
         features.join(",")
     )
-}
-
-fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
-    vec![v2(x0, y0), v2(x1, y0), v2(x1, y1), v2(x0, y1)]
 }
 
 fn opts() -> LoadOptions {

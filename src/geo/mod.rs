@@ -18,6 +18,13 @@ pub fn v2(x: f64, y: f64) -> Vec2 {
     Vec2::new(x, y)
 }
 
+/// The axis-aligned rectangle `[x0, x1] × [y0, y1]` as a counter-clockwise ring (a test
+/// fixture shared by the planners' and the field reader's tests).
+#[cfg(test)]
+pub(crate) fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
+    vec![v2(x0, y0), v2(x1, y0), v2(x1, y1), v2(x0, y1)]
+}
+
 /// Wrap an angle to (-π, π].
 #[inline]
 pub fn wrap_angle(a: f64) -> f64 {

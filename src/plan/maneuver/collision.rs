@@ -508,12 +508,8 @@ fn point_in_rectangle(c: &[Vec2; 4], p: &Vec2) -> bool {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::geo::rect;
     use std::f64::consts::FRAC_PI_2;
-
-    /// The axis-aligned rectangle `[x0, x1] × [y0, y1]` as a counter-clockwise ring.
-    pub(crate) fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
-        vec![v2(x0, y0), v2(x1, y0), v2(x1, y1), v2(x0, y1)]
-    }
 
     /// A 4 × 2 m vehicle, rear axle 1 m from the rear, no implement, `margin_m` clearance.
     pub(crate) fn tractor_with_margin(margin_m: f64) -> Footprint {

@@ -759,8 +759,8 @@ fn straight(a: &Pose, b: &Pose) -> CurvePath {
 mod tests {
     use super::*;
     use crate::config::Config;
+    use crate::geo::rect;
     use crate::geo::v2;
-    use crate::plan::maneuver::collision::tests::rect;
     use crate::plan::maneuver::steering::RsSteering;
     use std::f64::consts::{FRAC_PI_2, PI};
 

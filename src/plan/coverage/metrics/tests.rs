@@ -1,9 +1,5 @@
 use super::*;
-use crate::geo::{v2, Direction};
-
-fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Vec2> {
-    vec![v2(x0, y0), v2(x1, y0), v2(x1, y1), v2(x0, y1)]
-}
+use crate::geo::{rect, v2, Direction};
 
 fn seg(kind: SegmentKind, index: usize, points: Vec<Vec2>) -> PlanSegment {
     PlanSegment {
