@@ -331,6 +331,18 @@ pub struct TrackConfig {
     /// Through an RTK-float period, dead-reckon from the last fixed position for at most this
     /// long instead of following the float positions, s (0 = off).
     pub observer_coast_max_s: f64,
+    /// Lost-motion compensation (predictive tracker only; see
+    /// [`LostMotion`](crate::track::lost_motion::LostMotion)): time constant of the steering's
+    /// lost-motion (backlash + actuator deadband) estimate, s (0 = off).
+    pub lost_motion_tau_s: f64,
+    /// The command is pushed the other way only when the measured wheel angle is past the
+    /// demand by this much, degrees (above the wheel-angle sensor's noise).
+    pub lost_motion_threshold_deg: f64,
+    /// Largest lost motion the compensation may learn, degrees.
+    pub lost_motion_limit_deg: f64,
+    /// The estimate learns only this long after the push direction changed, with a steady
+    /// demand, s (about the actuator's settling time).
+    pub lost_motion_settle_s: f64,
 }
 
 impl Default for TrackConfig {
@@ -359,6 +371,10 @@ impl Default for TrackConfig {
             observer_slip_tau_s: 30.0,
             observer_slip_limit_mps_per_deg: 0.05,
             observer_coast_max_s: 30.0,
+            lost_motion_tau_s: 5.0,
+            lost_motion_threshold_deg: 0.1,
+            lost_motion_limit_deg: 1.0,
+            lost_motion_settle_s: 0.5,
         }
     }
 }
@@ -1234,6 +1250,25 @@ impl Config {
             t.observer_coast_max_s,
             0.0,
             600.0,
+        );
+        c.range("track.lost_motion_tau_s", t.lost_motion_tau_s, 0.0, 600.0);
+        c.range(
+            "track.lost_motion_threshold_deg",
+            t.lost_motion_threshold_deg,
+            0.0,
+            2.0,
+        );
+        c.range(
+            "track.lost_motion_limit_deg",
+            t.lost_motion_limit_deg,
+            0.0,
+            5.0,
+        );
+        c.range(
+            "track.lost_motion_settle_s",
+            t.lost_motion_settle_s,
+            0.0,
+            10.0,
         );
 
         let s = &self.sim;

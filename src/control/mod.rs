@@ -15,6 +15,7 @@ use crate::guidance::{Guidance, GuidanceError, GuidanceParams, JobPlan};
 use crate::plan::abline::{AbParams, AbPlan, Side};
 use crate::plan::turns::TurnParams;
 use crate::track::local_path::LocalPathParams;
+use crate::track::lost_motion::{LostMotion, LostMotionParams};
 use crate::track::{
     pure_pursuit, stanley, steering_from_travel, travel_pose, IntegralAction, TrackOutput,
     TrackerParams,
@@ -227,6 +228,22 @@ fn integral_action(cfg: &Config, learnt: f64) -> IntegralAction {
     }
 }
 
+/// The lost-motion compensation from `[track]` (off for the pure-pursuit and Stanley
+/// references).
+pub fn lost_motion_params(cfg: &Config) -> LostMotionParams {
+    let t = &cfg.track;
+    LostMotionParams {
+        tau: if t.kind == TrackerChoice::Predictive {
+            t.lost_motion_tau_s
+        } else {
+            0.0
+        },
+        threshold: t.lost_motion_threshold_deg.to_radians(),
+        limit: t.lost_motion_limit_deg.to_radians(),
+        settle: t.lost_motion_settle_s,
+    }
+}
+
 /// Estimation, guidance and tracking for one job.
 pub struct Controller {
     estimator: Estimator,
@@ -238,6 +255,11 @@ pub struct Controller {
     last_tick: Option<f64>,
     /// Approach paths (`guidance.approach_paths`), `None` when off.
     approach: Option<ApproachSettings>,
+    /// The steering's lost-motion compensation.
+    lost_motion: LostMotion,
+    /// Whether the supervisor engaged the previous command (the compensation learns only
+    /// from commands the actuator followed).
+    engaged: bool,
 }
 
 /// Whether a sampled approach path keeps the vehicle inside the field and off its obstacles.
@@ -305,6 +327,8 @@ impl Controller {
             integral: integral_action(cfg, 0.0),
             last_tick: None,
             approach: approach_settings(cfg),
+            lost_motion: LostMotion::new(lost_motion_params(cfg), 0.0),
+            engaged: false,
         })
     }
 
@@ -369,6 +393,17 @@ impl Controller {
 
     pub fn on_wheel_angle(&mut self, t: f64, angle: f64) {
         self.estimator.on_wheel_angle(t, angle);
+    }
+
+    /// Whether the safety supervisor engaged the latest command (the actuator steers by the
+    /// next ones).
+    pub fn set_engaged(&mut self, engaged: bool) {
+        self.engaged = engaged;
+    }
+
+    /// The learnt lost motion of the steering (backlash + actuator deadband), rad.
+    pub fn lost_motion(&self) -> f64 {
+        self.lost_motion.estimate
     }
 
     /// One control period at time `t` (s, controller clock).
@@ -438,6 +473,19 @@ impl Controller {
             let max = self.tracker.max_wheel_angle;
             tr.wheel_angle = (tr.wheel_angle + offset).clamp(-max, max);
         }
+        if tr.valid {
+            // Put the wheels where the command says despite the steering's play; learn the
+            // play on work lines from commands the actuator followed.
+            let measured = self.estimator.latest_wheel_angle().unwrap_or(f64::NAN);
+            let learn = learning
+                && self.engaged
+                && est.speed.abs() >= self.estimator.params().observer.min_speed;
+            let max = self.tracker.max_wheel_angle;
+            tr.wheel_angle = self
+                .lost_motion
+                .command(tr.wheel_angle, measured, dt, learn)
+                .clamp(-max, max);
+        }
         if tr.wheel_angle.is_finite() {
             out.wheel_angle = Some(tr.wheel_angle);
         }
@@ -450,6 +498,7 @@ impl Controller {
         self.tracker = tracker_params(cfg);
         self.law = law_params(cfg);
         self.integral = integral_action(cfg, self.integral.offset);
+        self.lost_motion = LostMotion::new(lost_motion_params(cfg), self.lost_motion.estimate);
         self.estimator.set_params(estimator_params(cfg));
     }
 

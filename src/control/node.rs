@@ -410,6 +410,7 @@ impl ControllerNode {
         let cmd = self
             .supervisor
             .step(t, c.wheel_angle, c.xte, c.heading_error);
+        self.ctrl.set_engaged(cmd.engaged);
         let angle_deg = cmd.wheel_angle.to_degrees().clamp(-90.0, 90.0);
         let engaged = if cmd.engaged { 1.0 } else { 0.0 };
         if matches!(self.output, OutputKind::Angle | OutputKind::Both) {

@@ -176,6 +176,9 @@ pub struct Report {
     pub distance_m: f64,
     pub max_wheel_angle_deg: f64,
     pub max_wheel_rate_deg_s: f64,
+    /// The steering's lost motion (backlash + actuator deadband) the default tracker learnt by
+    /// the end, degrees (0 for the reference trackers).
+    pub steering_lost_motion_deg: f64,
     pub sim_time_s: f64,
     pub wall_time_s: f64,
     pub tracker: String,
@@ -770,6 +773,7 @@ pub fn run(
         distance_m: distance,
         max_wheel_angle_deg: max_wheel.to_degrees(),
         max_wheel_rate_deg_s: max_rate.to_degrees(),
+        steering_lost_motion_deg: node.controller().lost_motion().to_degrees(),
         sim_time_s: t,
         wall_time_s: wall.elapsed().as_secs_f64(),
         tracker: tracker_name(cfg.track.kind).to_string(),

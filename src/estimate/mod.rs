@@ -554,6 +554,11 @@ impl Estimator {
         self.wheel[(start + i) % RING]
     }
 
+    /// The newest measured wheel angle, rad (`None` before the first).
+    pub fn latest_wheel_angle(&self) -> Option<f64> {
+        (self.wheel_len > 0).then(|| self.wheel_sample(self.wheel_len - 1).1)
+    }
+
     /// The measured wheel angle at `t`, interpolated (held before the first and after the
     /// last sample).
     pub fn wheel_angle_at(&self, t: f64) -> f64 {

@@ -5,6 +5,7 @@
 //! dead-reckoned pose from [`crate::estimate`]).
 
 pub mod local_path;
+pub mod lost_motion;
 
 use crate::geo::{cross, heading_vec, Direction, Pose, Vec2};
 use local_path::LocalPath;
