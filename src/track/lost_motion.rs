@@ -16,7 +16,7 @@
 //! too large. The estimate learns from that settled residual, so it needs no calibration and
 //! falls to zero on a vehicle without play. Reference: the adaptive backlash inverse of
 //! Tao & Kokotović, *Adaptive Control of Systems with Actuator and Sensor Nonlinearities*
-//! (Wiley 1996), ch. 5, here with the wheel-angle sensor closing the loop.
+//! (Wiley 1996), here with the wheel-angle sensor closing the loop.
 
 /// Lost-motion compensation parameters, SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
