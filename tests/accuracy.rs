@@ -4,6 +4,8 @@
 
 use agsteer::config::{Config, TrackerChoice};
 use agsteer::demo::accuracy::{evaluate, ScenarioResult};
+use agsteer::demo::DemoOptions;
+use agsteer::sim::can_node::{Fault, FaultKind, Scenario};
 
 fn scenario(name: &str, kind: TrackerChoice, set: &[String]) -> ScenarioResult {
     let path = format!("{}/tools/scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
@@ -137,24 +139,36 @@ fn the_default_tracker_learns_the_steering_play_and_removes_its_weave() {
         cm(with.xte_rms_m),
         cm(without.xte_rms_m)
     );
-    let learnt = |set: &[String]| {
+    let learnt = |set: &[String], opts: &DemoOptions| {
         let path = format!(
             "{}/tools/scenarios/straight_15kmh.toml",
             env!("CARGO_MANIFEST_DIR")
         );
         let cfg = Config::load(std::path::Path::new(&path), set).expect("valid");
-        let run = agsteer::demo::run(
-            &cfg,
-            &agsteer::demo::DemoOptions::default(),
-            &mut |_| {},
-            &mut |_, _| {},
-        )
-        .expect("the scenario runs");
+        let run =
+            agsteer::demo::run(&cfg, opts, &mut |_| {}, &mut |_, _| {}).expect("the scenario runs");
         run.report.steering_lost_motion_deg
     };
-    let lost = learnt(&play);
+    let lost = learnt(&play, &DemoOptions::default());
     assert!((0.3..0.4).contains(&lost), "learnt {lost:.3}° of 0.35°");
     // Steering without play: nothing to learn, nothing added.
-    let lost = learnt(&[]);
+    let lost = learnt(&[], &DemoOptions::default());
     assert!(lost < 0.03, "learnt {lost:.3}° of none");
+    // Disengaged (a GNSS dropout 5 s in, never re-engaged) the actuator does not follow the
+    // commands, and nothing is learnt from them though the wheels never reach the demand.
+    let mut short = play.clone();
+    short.push("sim.max_time_s=60".to_string());
+    let dropout = DemoOptions {
+        scenario: Scenario {
+            fault: vec![Fault {
+                kind: FaultKind::GnssDropout,
+                at_s: 5.0,
+                duration_s: 1.0,
+            }],
+        },
+        no_reengage: true,
+        ..Default::default()
+    };
+    let lost = learnt(&short, &dropout);
+    assert!(lost < 0.1, "learnt {lost:.3}° while disengaged");
 }
