@@ -498,7 +498,7 @@ impl Controller {
         self.tracker = tracker_params(cfg);
         self.law = law_params(cfg);
         self.integral = integral_action(cfg, self.integral.offset);
-        self.lost_motion = LostMotion::new(lost_motion_params(cfg), self.lost_motion.estimate);
+        self.lost_motion.set_params(lost_motion_params(cfg));
         self.estimator.set_params(estimator_params(cfg));
     }
 

@@ -49,6 +49,8 @@ pub struct NodeStatus {
     pub lines_done: u64,
     pub finished: bool,
     pub wheel_angle_command_deg: f64,
+    /// The steering's lost motion (backlash + actuator deadband) learnt so far, degrees.
+    pub steering_lost_motion_deg: f64,
     pub bad_frames: u64,
 }
 
@@ -179,6 +181,7 @@ impl ControllerNode {
                 lines_done: 0,
                 finished: false,
                 wheel_angle_command_deg: 0.0,
+                steering_lost_motion_deg: 0.0,
                 bad_frames: 0,
             },
         })
@@ -443,6 +446,7 @@ impl ControllerNode {
             lines_done: g.lines_done(),
             finished: g.is_finished(),
             wheel_angle_command_deg: angle_deg,
+            steering_lost_motion_deg: self.ctrl.lost_motion().to_degrees(),
             ..self.status
         };
         if self.ticks % self.status_every == 0 {

@@ -64,6 +64,12 @@ impl LostMotion {
         }
     }
 
+    /// New parameters; the learnt estimate (within the new limit) and the state are kept.
+    pub fn set_params(&mut self, params: LostMotionParams) {
+        self.params = params;
+        self.estimate = self.estimate.clamp(0.0, params.limit.max(0.0));
+    }
+
     /// The command (rad) for the `demand`ed sensed wheel angle (rad) given the latest
     /// `measured` one (rad), one control period `dt` (s) on; the estimate learns when
     /// `learning`. Non-finite inputs pass the demand through.
@@ -213,6 +219,21 @@ mod tests {
             steering.step(command);
         }
         assert!(lm.estimate < 0.01f64.to_radians(), "{}", lm.estimate);
+    }
+
+    #[test]
+    fn new_parameters_keep_the_estimate_within_the_new_limit() {
+        let mut lm = LostMotion::new(params(), 0.5f64.to_radians());
+        lm.set_params(LostMotionParams {
+            tau: 10.0,
+            ..params()
+        });
+        assert_eq!(lm.estimate, 0.5f64.to_radians());
+        lm.set_params(LostMotionParams {
+            limit: 0.2f64.to_radians(),
+            ..params()
+        });
+        assert_eq!(lm.estimate, 0.2f64.to_radians());
     }
 
     #[test]
