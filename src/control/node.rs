@@ -77,6 +77,8 @@ pub struct ControllerNode {
     cusp: bool,
     /// The last approach request was refused (already logged).
     approach_refused: bool,
+    /// Guidance failed in the previous period (its error already logged).
+    guidance_failing: bool,
     last_request: Option<f64>,
 }
 
@@ -168,6 +170,7 @@ impl ControllerNode {
             },
             cusp: false,
             approach_refused: false,
+            guidance_failing: false,
             last_request: None,
             status: NodeStatus {
                 state: SafetyState::Disengaged,
@@ -386,9 +389,21 @@ impl ControllerNode {
     /// One control period at `t`: appends the frames to send.
     pub fn tick(&mut self, t: f64, out: &mut Vec<Frame>) -> Cmd {
         let c = match self.ctrl.tick(t) {
-            Ok(c) => c,
+            Ok(c) => {
+                if self.guidance_failing {
+                    self.guidance_failing = false;
+                    tracing::info!("guidance recovered");
+                }
+                c
+            }
             Err(e) => {
-                tracing::error!("guidance: {e}");
+                // Logged once when it starts, not every control period while it persists.
+                if self.guidance_failing {
+                    tracing::trace!("guidance: {e}");
+                } else {
+                    self.guidance_failing = true;
+                    tracing::error!("guidance: {e}; not steering until it clears");
+                }
                 super::ControlOutput {
                     wheel_angle: None,
                     estimate: None,
