@@ -7,10 +7,15 @@ use agsteer::demo::accuracy::{evaluate, ScenarioResult};
 use agsteer::demo::DemoOptions;
 use agsteer::sim::can_node::{Fault, FaultKind, Scenario};
 
-fn scenario(name: &str, kind: TrackerChoice, set: &[String]) -> ScenarioResult {
+fn scenario_config(name: &str, set: &[String]) -> Config {
     let path = format!("{}/tools/scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-    let cfg = Config::load(std::path::Path::new(&path), set).expect("scenario config is valid");
-    evaluate(name, &cfg, kind).expect("the scenario runs").0
+    Config::load(std::path::Path::new(&path), set).expect("scenario config is valid")
+}
+
+fn scenario(name: &str, kind: TrackerChoice, set: &[String]) -> ScenarioResult {
+    evaluate(name, &scenario_config(name, set), kind)
+        .expect("the scenario runs")
+        .0
 }
 
 fn cm(m: f64) -> f64 {
@@ -140,11 +145,7 @@ fn the_default_tracker_learns_the_steering_play_and_removes_its_weave() {
         cm(without.xte_rms_m)
     );
     let learnt = |set: &[String], opts: &DemoOptions| {
-        let path = format!(
-            "{}/tools/scenarios/straight_15kmh.toml",
-            env!("CARGO_MANIFEST_DIR")
-        );
-        let cfg = Config::load(std::path::Path::new(&path), set).expect("valid");
+        let cfg = scenario_config("straight_15kmh", set);
         let run =
             agsteer::demo::run(&cfg, opts, &mut |_| {}, &mut |_, _| {}).expect("the scenario runs");
         run.report.steering_lost_motion_deg
