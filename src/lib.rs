@@ -19,6 +19,7 @@ pub mod estimate;
 pub mod field;
 pub mod geo;
 pub mod guidance;
+pub mod input;
 pub mod plan;
 pub mod safety;
 pub mod sim;

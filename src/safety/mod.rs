@@ -58,15 +58,7 @@ impl SafetyState {
     }
 }
 
-/// GNSS solution quality as the supervisor sees it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FixQuality {
-    RtkFixed,
-    RtkFloat,
-    Other,
-    None,
-}
+pub use crate::input::FixQuality;
 
 /// Inputs whose frames carry a counter and a CRC.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

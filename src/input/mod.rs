@@ -1,0 +1,156 @@
+//! The input seam: everything the controller learns from the outside world arrives as an
+//! [`Input`], whatever carried it (NMEA 2000 / ISOBUS frames on CAN, NMEA 0183 or UBX over a
+//! serial port, USB, UDP or TCP).
+//!
+//! Contract:
+//! - Adapters (the CAN frame decoder, the serial GNSS parsers) turn bytes into `Input`s and
+//!   nothing else: no estimation, no unit conversion beyond the edge (degrees → radians,
+//!   clockwise-from-North → counter-clockwise-from-East happen here, once), no state about the
+//!   job.
+//! - Every `Input` carries its arrival time `t` on the controller's monotonic clock (s) and the
+//!   [`SourceId`] it came from, so one source per input kind can be selected downstream.
+//! - Values the sender marked not available are `None`, never a number.
+//! - The controller consumes `Input`s only; adding a GNSS transport never touches it.
+//!
+//! Edge conventions (see `docs/CONVENTIONS.md`): positions are WGS-84 degrees (converted to the
+//! local ENU frame by the consumer, which owns the job's origin); angles are radians; headings
+//! and courses are yaw, counter-clockwise from East, in (-π, π]; speeds m/s; positive wheel
+//! angle turns left.
+
+use serde::Serialize;
+
+/// Where an input came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SourceId {
+    /// A CAN node by its source address (J1939 / ISO 11783-5).
+    Can(u8),
+    /// A byte-stream GNSS input (serial, USB, UDP, TCP), numbered in configuration order.
+    Stream(u8),
+    /// The in-process simulator or a test.
+    Local,
+}
+
+/// GNSS solution quality, as NMEA 2000 129029's method and NMEA 0183 GGA's quality indicator
+/// both express it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FixQuality {
+    /// RTK with fixed integer ambiguities: centimetre class.
+    RtkFixed,
+    /// RTK float: decimetre class.
+    RtkFloat,
+    /// Any other solution (autonomous, SBAS, DGNSS, PPP, dead reckoning...).
+    Other,
+    /// No solution.
+    None,
+}
+
+/// Reference of a heading.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadingReference {
+    True,
+    /// Magnetic: usable only with the magnetic variation applied.
+    Magnetic,
+}
+
+/// A GNSS antenna position.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PositionInput {
+    pub t: f64,
+    pub source: SourceId,
+    pub lat_deg: f64,
+    pub lon_deg: f64,
+    /// Height above the ellipsoid, m, when sent.
+    pub altitude_m: Option<f64>,
+    /// Time between the fix's time of validity and its arrival, s, when the sender's time
+    /// stamp allows computing it.
+    pub latency_s: Option<f64>,
+    /// Quality carried with the position itself (NMEA 0183 GGA, UBX NAV-PVT); `None` when
+    /// it comes separately (NMEA 2000 129029).
+    pub quality: Option<FixQuality>,
+}
+
+/// GNSS solution quality and its details (NMEA 2000 129029, GGA, GST, NAV-PVT).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct QualityInput {
+    pub t: f64,
+    pub source: SourceId,
+    pub quality: FixQuality,
+    pub satellites: Option<u8>,
+    pub hdop: Option<f64>,
+    /// Age of the differential (RTK) corrections, s.
+    pub correction_age_s: Option<f64>,
+    /// 1-σ horizontal position error the receiver reports, m.
+    pub horizontal_sigma_m: Option<f64>,
+}
+
+/// Course and speed over ground.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CourseSpeedInput {
+    pub t: f64,
+    pub source: SourceId,
+    /// Course over ground as yaw (rad, counter-clockwise from East), when moving.
+    pub course: Option<f64>,
+    /// Speed over ground, m/s (no sign: GNSS cannot tell reversing).
+    pub speed_mps: Option<f64>,
+}
+
+/// Vehicle heading (a dual-antenna or moving-base receiver, a compass).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HeadingInput {
+    pub t: f64,
+    pub source: SourceId,
+    /// Yaw, rad, counter-clockwise from East, as sent (not corrected for variation).
+    pub heading: f64,
+    pub reference: HeadingReference,
+    /// Magnetic variation, rad, positive East, when sent.
+    pub variation: Option<f64>,
+}
+
+/// Attitude from an IMU.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AttitudeInput {
+    pub t: f64,
+    pub source: SourceId,
+    /// Roll, rad, positive when the right side is down.
+    pub roll: Option<f64>,
+    pub pitch: Option<f64>,
+}
+
+/// Anything the controller is told. Adapters produce these; the controller node consumes
+/// them (see the module contract).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Input {
+    Position(PositionInput),
+    Quality(QualityInput),
+    CourseSpeed(CourseSpeedInput),
+    Heading(HeadingInput),
+    Attitude(AttitudeInput),
+}
+
+impl Input {
+    /// Arrival time on the controller clock, s.
+    pub fn t(&self) -> f64 {
+        match self {
+            Input::Position(i) => i.t,
+            Input::Quality(i) => i.t,
+            Input::CourseSpeed(i) => i.t,
+            Input::Heading(i) => i.t,
+            Input::Attitude(i) => i.t,
+        }
+    }
+
+    /// Where it came from.
+    pub fn source(&self) -> SourceId {
+        match self {
+            Input::Position(i) => i.source,
+            Input::Quality(i) => i.source,
+            Input::CourseSpeed(i) => i.source,
+            Input::Heading(i) => i.source,
+            Input::Attitude(i) => i.source,
+        }
+    }
+}
