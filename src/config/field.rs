@@ -1,0 +1,92 @@
+//! `[field]`: field coverage planning (headland passes, swath direction, route, obstacles,
+//! boundary clean-up, ENU origin).
+//!
+//! Owns the section's keys, their defaults and their range checks.
+
+use super::check::Checker;
+use serde::{Deserialize, Serialize};
+
+/// How `[field]` chooses the swath direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SwathAngleChoice {
+    /// Minimum span of the convex hull.
+    MinSpan,
+    /// Fewest turns over the cells.
+    MinTurns,
+    /// `field.swath_angle_deg`.
+    Fixed,
+}
+
+/// Where `[field]` takes the local ENU origin from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FieldOrigin {
+    /// Centre of the boundary's lat/lon bounding box.
+    Auto,
+    /// `job.origin_lat_deg` / `job.origin_lon_deg`.
+    Config,
+}
+
+/// `[field]`: field coverage planning (`agsteer plan`). Width from `job.line_width_m`, r_min
+/// from `vehicle.r_min_m`, point spacing from `guidance.point_spacing_m`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FieldConfig {
+    /// Headland passes around the boundary, each `job.line_width_m` wide.
+    pub headland_passes: usize,
+    /// Swath direction objective: "min_span", "min_turns" or "fixed".
+    pub swath_angle: SwathAngleChoice,
+    /// Swath direction for `swath_angle = "fixed"`, degrees CCW from East.
+    pub swath_angle_deg: f64,
+    /// Swath order in a cell: "auto", "sequential" or "skip".
+    pub route: crate::plan::coverage::RouteOrder,
+    /// Obstacles whose largest dimension is at most this are passed on detours; larger ones get
+    /// headland passes and split the swaths, m.
+    pub small_obstacle_max_m: f64,
+    /// Boundary clean-up tolerance (largest distance of a dropped point), m; 0 = no fitting.
+    pub boundary_tolerance_m: f64,
+    /// ENU origin: "auto" (boundary bounding-box centre) or "config" (job.origin_*).
+    pub origin: FieldOrigin,
+}
+
+impl Default for FieldConfig {
+    fn default() -> Self {
+        FieldConfig {
+            headland_passes: 2,
+            swath_angle: SwathAngleChoice::MinSpan,
+            swath_angle_deg: 0.0,
+            route: crate::plan::coverage::RouteOrder::Auto,
+            small_obstacle_max_m: 15.0,
+            boundary_tolerance_m: 0.1,
+            origin: FieldOrigin::Auto,
+        }
+    }
+}
+
+impl FieldConfig {
+    /// Range checks of `[field]`.
+    pub(crate) fn validate(&self, c: &mut Checker) {
+        let fc = self;
+        if fc.headland_passes > 50 {
+            c.push(
+                "field.headland_passes",
+                fc.headland_passes.to_string(),
+                "must be in 0..=50",
+            );
+        }
+        c.range("field.swath_angle_deg", fc.swath_angle_deg, -360.0, 360.0);
+        c.range(
+            "field.small_obstacle_max_m",
+            fc.small_obstacle_max_m,
+            0.0,
+            1000.0,
+        );
+        c.range(
+            "field.boundary_tolerance_m",
+            fc.boundary_tolerance_m,
+            0.0,
+            10.0,
+        );
+    }
+}

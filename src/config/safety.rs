@@ -1,0 +1,121 @@
+//! `[safety]`: engage gating, input freshness and command limits.
+//!
+//! Owns the section's keys, their defaults and their range checks.
+
+use super::check::{fmt_num, Checker};
+use serde::{Deserialize, Serialize};
+
+/// `[safety]`: engage gating, input freshness and command limits.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SafetyConfig {
+    /// GNSS older than this disengages, s.
+    pub gnss_timeout_s: f64,
+    /// RTK float is tolerated this long, s (0 = never).
+    pub rtk_float_tolerance_s: f64,
+    /// Wheel angle older than this disengages, s.
+    pub wheel_angle_timeout_s: f64,
+    /// Allowed speed range, km/h.
+    pub min_speed_kmh: f64,
+    pub max_speed_kmh: f64,
+    /// While the daemon has asked for a stop to change direction (a cusp of a manoeuvre), the
+    /// speed may be below min_speed_kmh for at most this long, s.
+    pub max_stop_time_s: f64,
+    /// Measured wheel angle this far from the command…, degrees
+    pub override_angle_deg: f64,
+    /// …for longer than this is an operator override, s.
+    pub override_time_s: f64,
+    /// Engaging needs |XTE| below this, m.
+    pub max_engage_xte_m: f64,
+    /// Engaging needs |heading error| below this, degrees.
+    pub max_engage_heading_error_deg: f64,
+    /// Largest commanded wheel-angle rate, degrees/s.
+    pub max_wheel_rate_deg_s: f64,
+    /// Largest lateral acceleration v²·κ, m/s².
+    pub a_lat_max_m_s2: f64,
+    /// Actuator model for override detection: dead time, s; lag, s; rate, degrees/s.
+    pub actuator_dead_time_s: f64,
+    pub actuator_tau_s: f64,
+    pub actuator_rate_deg_s: f64,
+}
+
+impl Default for SafetyConfig {
+    fn default() -> Self {
+        SafetyConfig {
+            gnss_timeout_s: 0.3,
+            rtk_float_tolerance_s: 0.0,
+            wheel_angle_timeout_s: 0.1,
+            min_speed_kmh: 0.5,
+            max_speed_kmh: 25.0,
+            max_stop_time_s: 10.0,
+            override_angle_deg: 8.0,
+            override_time_s: 0.5,
+            max_engage_xte_m: 1.0,
+            max_engage_heading_error_deg: 60.0,
+            max_wheel_rate_deg_s: 45.0,
+            a_lat_max_m_s2: 2.0,
+            actuator_dead_time_s: 0.05,
+            actuator_tau_s: 0.15,
+            actuator_rate_deg_s: 30.0,
+        }
+    }
+}
+
+impl SafetyConfig {
+    /// Range checks of `[safety]`.
+    pub(crate) fn validate(&self, c: &mut Checker) {
+        let f = self;
+        c.range("safety.gnss_timeout_s", f.gnss_timeout_s, 0.05, 5.0);
+        c.range(
+            "safety.rtk_float_tolerance_s",
+            f.rtk_float_tolerance_s,
+            0.0,
+            3600.0,
+        );
+        c.range(
+            "safety.wheel_angle_timeout_s",
+            f.wheel_angle_timeout_s,
+            0.02,
+            2.0,
+        );
+        c.range("safety.min_speed_kmh", f.min_speed_kmh, 0.0, 50.0);
+        c.range("safety.max_stop_time_s", f.max_stop_time_s, 0.0, 120.0);
+        c.range("safety.max_speed_kmh", f.max_speed_kmh, 0.5, 60.0);
+        if f.min_speed_kmh >= f.max_speed_kmh {
+            c.push(
+                "safety.min_speed_kmh",
+                fmt_num(f.min_speed_kmh),
+                "must be below safety.max_speed_kmh",
+            );
+        }
+        c.range("safety.override_angle_deg", f.override_angle_deg, 0.5, 90.0);
+        c.range("safety.override_time_s", f.override_time_s, 0.0, 10.0);
+        c.range("safety.max_engage_xte_m", f.max_engage_xte_m, 0.01, 50.0);
+        c.range(
+            "safety.max_engage_heading_error_deg",
+            f.max_engage_heading_error_deg,
+            1.0,
+            180.0,
+        );
+        c.range(
+            "safety.max_wheel_rate_deg_s",
+            f.max_wheel_rate_deg_s,
+            1.0,
+            500.0,
+        );
+        c.range("safety.a_lat_max_m_s2", f.a_lat_max_m_s2, 0.1, 20.0);
+        c.range(
+            "safety.actuator_dead_time_s",
+            f.actuator_dead_time_s,
+            0.0,
+            0.5,
+        );
+        c.range("safety.actuator_tau_s", f.actuator_tau_s, 0.0, 5.0);
+        c.range(
+            "safety.actuator_rate_deg_s",
+            f.actuator_rate_deg_s,
+            1.0,
+            500.0,
+        );
+    }
+}

@@ -1,0 +1,223 @@
+//! `[sim]`: the vehicle simulator (sensors, actuator, disturbances, driver's speed profile).
+//!
+//! Owns the section's keys, their defaults and their range checks.
+
+use super::check::{fmt_num, Checker};
+use serde::{Deserialize, Serialize};
+
+/// `[sim]`: the vehicle simulator.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimConfig {
+    /// Random seed: the same seed gives the same run.
+    pub seed: u64,
+    /// Internal integration step, s.
+    pub step_s: f64,
+    /// GNSS update rate, Hz.
+    pub gnss_rate_hz: f64,
+    /// GNSS latency (measurement to delivery), s.
+    pub gnss_latency_s: f64,
+    /// GNSS position white noise σ per axis, m.
+    pub gnss_sigma_m: f64,
+    /// Dual-antenna heading noise σ, degrees.
+    pub heading_sigma_deg: f64,
+    /// Wheel-angle sensor rate, Hz.
+    pub was_rate_hz: f64,
+    /// Wheel-angle sensor noise σ, degrees.
+    pub was_noise_deg: f64,
+    /// Steering actuator dead time, s.
+    pub actuator_dead_time_s: f64,
+    /// Steering actuator first-order lag time constant, s.
+    pub actuator_tau_s: f64,
+    /// Steering actuator rate limit, degrees/s.
+    pub actuator_rate_deg_s: f64,
+    /// Initial lateral offset of the vehicle from line A→B (positive = left), m.
+    pub start_offset_m: f64,
+    /// Initial heading error relative to A→B, degrees.
+    pub start_heading_deg: f64,
+    /// Stop the simulation after this much simulated time even if unfinished, s (0 = auto).
+    pub max_time_s: f64,
+    /// The simulated tractor's acceleration and braking when a direction request changes its
+    /// speed, m/s².
+    pub accel_mps2: f64,
+    // Disturbances, all off by default.
+    /// Correlated GNSS position error per axis (first-order Gauss-Markov): stationary σ, m
+    /// (0 = off), and time constant, s.
+    pub gnss_markov_sigma_m: f64,
+    pub gnss_markov_tau_s: f64,
+    /// Multipath jumps: mean rate per hour (0 = off), magnitude (random direction), m, and
+    /// duration, s.
+    pub gnss_multipath_rate_per_h: f64,
+    pub gnss_multipath_m: f64,
+    pub gnss_multipath_duration_s: f64,
+    /// RTK-float windows `[[start_s, duration_s], ...]` of simulated time: 129029 reports RTK
+    /// float and a Gauss-Markov error (σ m, τ s) per axis is added.
+    pub gnss_float_windows_s: Vec<[f64; 2]>,
+    pub gnss_float_sigma_m: f64,
+    pub gnss_float_tau_s: f64,
+    /// Terrain: slope, degrees (0 = flat), falling towards `terrain_downhill_deg` (CCW from
+    /// East), varying by ±`terrain_slope_amp_deg` sinusoidally with `terrain_wavelength_m`
+    /// along the contour direction.
+    pub terrain_slope_deg: f64,
+    pub terrain_downhill_deg: f64,
+    pub terrain_slope_amp_deg: f64,
+    pub terrain_wavelength_m: f64,
+    /// IMU roll/pitch frame rate, Hz (0 = no IMU), and noise σ, degrees.
+    pub imu_rate_hz: f64,
+    pub imu_noise_deg: f64,
+    /// Side-slope slip to the right (downhill for positive roll), m/s per degree of roll, and a
+    /// constant slip to the right, m/s.
+    pub slip_per_roll_mps_per_deg: f64,
+    pub slip_mps: f64,
+    /// Wheel-angle sensor bias, degrees.
+    pub was_bias_deg: f64,
+    /// Actuator deadband (half-width), degrees, and backlash (total play), degrees.
+    pub actuator_deadband_deg: f64,
+    pub actuator_backlash_deg: f64,
+    /// Speed profile of the simulated driver going forward, km/h: `speed_max_kmh` on the
+    /// straight, slowing to `speed_min_kmh` in turns (|wheel angle| above
+    /// `speed_turn_angle_deg`), at `accel_mps2`. `speed_max_kmh` = 0: constant
+    /// `control.speed_kmh`.
+    pub speed_min_kmh: f64,
+    pub speed_max_kmh: f64,
+    pub speed_turn_angle_deg: f64,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        SimConfig {
+            seed: 1,
+            step_s: 0.001,
+            gnss_rate_hz: 10.0,
+            gnss_latency_s: 0.05,
+            gnss_sigma_m: 0.01,
+            heading_sigma_deg: 0.1,
+            was_rate_hz: 100.0,
+            was_noise_deg: 0.05,
+            actuator_dead_time_s: 0.05,
+            actuator_tau_s: 0.15,
+            actuator_rate_deg_s: 30.0,
+            start_offset_m: 0.0,
+            start_heading_deg: 0.0,
+            max_time_s: 0.0,
+            accel_mps2: 0.5,
+            gnss_markov_sigma_m: 0.0,
+            gnss_markov_tau_s: 60.0,
+            gnss_multipath_rate_per_h: 0.0,
+            gnss_multipath_m: 0.1,
+            gnss_multipath_duration_s: 10.0,
+            gnss_float_windows_s: Vec::new(),
+            gnss_float_sigma_m: 0.2,
+            gnss_float_tau_s: 10.0,
+            terrain_slope_deg: 0.0,
+            terrain_downhill_deg: 0.0,
+            terrain_slope_amp_deg: 0.0,
+            terrain_wavelength_m: 100.0,
+            imu_rate_hz: 0.0,
+            imu_noise_deg: 0.0,
+            slip_per_roll_mps_per_deg: 0.0,
+            slip_mps: 0.0,
+            was_bias_deg: 0.0,
+            actuator_deadband_deg: 0.0,
+            actuator_backlash_deg: 0.0,
+            speed_min_kmh: 4.0,
+            speed_max_kmh: 0.0,
+            speed_turn_angle_deg: 5.0,
+        }
+    }
+}
+
+impl SimConfig {
+    /// Range checks of `[sim]`.
+    pub(crate) fn validate(&self, c: &mut Checker) {
+        let s = self;
+        c.range("sim.step_s", s.step_s, 0.0001, 0.01);
+        c.range("sim.gnss_rate_hz", s.gnss_rate_hz, 0.5, 100.0);
+        c.range("sim.gnss_latency_s", s.gnss_latency_s, 0.0, 1.0);
+        c.range("sim.gnss_sigma_m", s.gnss_sigma_m, 0.0, 10.0);
+        c.range("sim.heading_sigma_deg", s.heading_sigma_deg, 0.0, 10.0);
+        c.range("sim.was_rate_hz", s.was_rate_hz, 1.0, 1000.0);
+        c.range("sim.was_noise_deg", s.was_noise_deg, 0.0, 5.0);
+        c.range("sim.actuator_dead_time_s", s.actuator_dead_time_s, 0.0, 1.0);
+        c.range("sim.actuator_tau_s", s.actuator_tau_s, 0.0, 5.0);
+        c.range("sim.actuator_rate_deg_s", s.actuator_rate_deg_s, 1.0, 500.0);
+        c.range("sim.start_offset_m", s.start_offset_m, -50.0, 50.0);
+        c.range("sim.start_heading_deg", s.start_heading_deg, -90.0, 90.0);
+        c.range("sim.max_time_s", s.max_time_s, 0.0, 1e7);
+        c.range("sim.accel_mps2", s.accel_mps2, 0.05, 10.0);
+        c.range("sim.gnss_markov_sigma_m", s.gnss_markov_sigma_m, 0.0, 1.0);
+        c.range("sim.gnss_markov_tau_s", s.gnss_markov_tau_s, 0.1, 3600.0);
+        c.range(
+            "sim.gnss_multipath_rate_per_h",
+            s.gnss_multipath_rate_per_h,
+            0.0,
+            3600.0,
+        );
+        c.range("sim.gnss_multipath_m", s.gnss_multipath_m, 0.0, 10.0);
+        c.range(
+            "sim.gnss_multipath_duration_s",
+            s.gnss_multipath_duration_s,
+            0.1,
+            600.0,
+        );
+        for (i, w) in s.gnss_float_windows_s.iter().enumerate() {
+            if !(w[0].is_finite() && w[0] >= 0.0 && w[1].is_finite() && w[1] > 0.0) {
+                c.push(
+                    &format!("sim.gnss_float_windows_s[{i}]"),
+                    format!("{w:?}"),
+                    "must be [start_s, duration_s] with start_s >= 0 and duration_s > 0",
+                );
+            }
+        }
+        c.range("sim.gnss_float_sigma_m", s.gnss_float_sigma_m, 0.0, 10.0);
+        c.range("sim.gnss_float_tau_s", s.gnss_float_tau_s, 0.1, 3600.0);
+        c.range("sim.terrain_slope_deg", s.terrain_slope_deg, -30.0, 30.0);
+        c.range(
+            "sim.terrain_downhill_deg",
+            s.terrain_downhill_deg,
+            -360.0,
+            360.0,
+        );
+        c.range(
+            "sim.terrain_slope_amp_deg",
+            s.terrain_slope_amp_deg,
+            0.0,
+            30.0,
+        );
+        c.range(
+            "sim.terrain_wavelength_m",
+            s.terrain_wavelength_m,
+            1.0,
+            100_000.0,
+        );
+        if s.terrain_slope_deg.abs() + s.terrain_slope_amp_deg > 30.0 {
+            c.push(
+                "sim.terrain_slope_amp_deg",
+                fmt_num(s.terrain_slope_amp_deg),
+                "|sim.terrain_slope_deg| + sim.terrain_slope_amp_deg must be at most 30",
+            );
+        }
+        c.range("sim.imu_rate_hz", s.imu_rate_hz, 0.0, 1000.0);
+        c.range("sim.imu_noise_deg", s.imu_noise_deg, 0.0, 5.0);
+        c.range(
+            "sim.slip_per_roll_mps_per_deg",
+            s.slip_per_roll_mps_per_deg,
+            -1.0,
+            1.0,
+        );
+        c.range("sim.slip_mps", s.slip_mps, -2.0, 2.0);
+        c.range("sim.was_bias_deg", s.was_bias_deg, -10.0, 10.0);
+        c.range(
+            "sim.actuator_deadband_deg",
+            s.actuator_deadband_deg,
+            0.0,
+            5.0,
+        );
+        c.range(
+            "sim.actuator_backlash_deg",
+            s.actuator_backlash_deg,
+            0.0,
+            10.0,
+        );
+    }
+}

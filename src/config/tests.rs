@@ -1,0 +1,219 @@
+use super::*;
+
+#[test]
+fn turns_are_planned_no_tighter_than_the_speed_allows() {
+    let mut cfg = Config::default();
+    // 10 km/h, 2 m/s²: v²/a = 3.9 m < r_min 5 m.
+    assert_eq!(cfg.turn_radius(), cfg.vehicle.r_min_m);
+    cfg.control.speed_kmh = 15.0;
+    let v: f64 = 15.0 / 3.6;
+    assert!((cfg.turn_radius() - v * v / 2.0).abs() < 1e-12);
+    assert!(cfg.coverage_params().r_min > 8.0);
+    assert!(crate::control::ab_params(&cfg).turn.r_min > 8.0);
+}
+
+#[test]
+fn defaults_are_valid() {
+    assert!(Config::default().validate().is_empty());
+}
+
+#[test]
+fn messages_name_key_value_and_rule() {
+    let cfg = Config::parse_with(
+        "[guidance]\na = 0\n[control]\ndt_s = 2\n",
+        &["vehicle.wheelbase_m=-1".to_string()],
+    )
+    .unwrap();
+    let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
+    assert!(msgs.contains(&"guidance.a = 0: must be an integer >= 1".to_string()));
+    assert!(msgs.contains(&"control.dt_s = 2: must be in 0.005..=0.5".to_string()));
+    assert!(msgs
+        .iter()
+        .any(|m| m.starts_with("vehicle.wheelbase_m = -1: must be in")));
+    assert!(msgs.len() >= 3, "all problems at once: {msgs:?}");
+}
+
+#[test]
+fn sim_disturbance_keys_parse_and_validate() {
+    let cfg = Config::parse_with(
+        "[sim]\ngnss_float_windows_s = [[60.0, 20.0], [-1.0, 5.0]]\nwas_bias_deg = 12\n\
+         actuator_backlash_deg = -1\nterrain_slope_deg = 25\nterrain_slope_amp_deg = 10\n",
+        &[],
+    )
+    .unwrap();
+    assert_eq!(cfg.sim.gnss_float_windows_s[0], [60.0, 20.0]);
+    let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
+    assert!(msgs.contains(
+        &"sim.gnss_float_windows_s[1] = [-1.0, 5.0]: must be [start_s, duration_s] with \
+          start_s >= 0 and duration_s > 0"
+            .to_string()
+    ));
+    assert!(msgs.contains(&"sim.was_bias_deg = 12: must be in -10..=10".to_string()));
+    assert!(msgs.contains(&"sim.actuator_backlash_deg = -1: must be in 0..=10".to_string()));
+    assert!(msgs
+        .iter()
+        .any(|m| m.starts_with("sim.terrain_slope_amp_deg = 10: |sim.terrain_slope_deg|")));
+    assert_eq!(msgs.len(), 4, "{msgs:?}");
+    // The defaults are all off.
+    let d = SimConfig::default();
+    assert!(d.gnss_markov_sigma_m == 0.0 && d.gnss_multipath_rate_per_h == 0.0);
+    assert!(d.gnss_float_windows_s.is_empty() && d.terrain_slope_deg == 0.0);
+    assert!(d.imu_rate_hz == 0.0 && d.slip_mps == 0.0 && d.slip_per_roll_mps_per_deg == 0.0);
+    assert!(d.was_bias_deg == 0.0);
+    assert!(d.actuator_deadband_deg == 0.0 && d.actuator_backlash_deg == 0.0);
+}
+
+#[test]
+fn observer_and_arcs_keys_parse_and_validate() {
+    let cfg = Config::parse_with(
+        "[track]\nobserver_drift_tau_s = -1\nobserver_min_speed_mps = 0\n\
+         observer_slip_limit_mps_per_deg = 2\nobserver_coast_max_s = 700\n\
+         [job]\nkind = \"arcs\"\narc_sweep_deg = 360\nline_num = 0\n",
+        &[],
+    )
+    .unwrap();
+    assert_eq!(cfg.job.kind, JobKind::Arcs);
+    let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
+    for m in [
+        "track.observer_drift_tau_s = -1: must be in 0..=600",
+        "track.observer_min_speed_mps = 0: must be in 0.1..=10",
+        "track.observer_slip_limit_mps_per_deg = 2: must be in 0..=1",
+        "track.observer_coast_max_s = 700: must be in 0..=600",
+        "job.arc_sweep_deg = 360: must be in 1..=359",
+        "job.line_num = 0: must be in 1..=1000 when job.kind = \"arcs\"",
+    ] {
+        assert!(msgs.contains(&m.to_string()), "{m} not in {msgs:?}");
+    }
+    assert_eq!(msgs.len(), 6, "{msgs:?}");
+    // The observer is on by default (the default tracker uses it).
+    let t = TrackConfig::default();
+    assert!(t.observer_bias_tau_s > 0.0 && t.observer_drift_tau_s > 0.0);
+    assert!(t.observer_slip_tau_s > 0.0 && t.observer_coast_max_s > 0.0);
+    assert!(Config::default().validate().is_empty());
+}
+
+#[test]
+fn unknown_keys_are_rejected() {
+    let err = Config::parse_with("[control]\ndt = 0.1\n", &[]).unwrap_err();
+    assert!(err.to_string().contains("unknown field `dt`"), "{err}");
+    let err = Config::parse_with("", &["track.nope=1".into()]).unwrap_err();
+    assert!(err.to_string().contains("nope"), "{err}");
+    let err = Config::parse_with("[control]\nspeed_kmn = 9\n", &[]).unwrap_err();
+    assert!(
+        err.to_string().contains("did you mean `speed_kmh`?"),
+        "{err}"
+    );
+    let err = Config::parse_with("[vehicel]\n", &[]).unwrap_err();
+    assert!(err.to_string().contains("did you mean `vehicle`?"), "{err}");
+}
+
+#[test]
+fn overrides_parse_values_and_strings() {
+    let cfg = Config::parse_with(
+        "",
+        &[
+            "track.kind = pure_pursuit".into(),
+            "job.line_num=100".into(),
+            "job.point_b_m=[10.0, 20.5]".into(),
+        ],
+    )
+    .unwrap();
+    assert_eq!(cfg.track.kind, TrackerChoice::PurePursuit);
+    assert_eq!(cfg.job.line_num, 100);
+    assert_eq!(cfg.job.point_b_m, [10.0, 20.5]);
+    assert!(matches!(
+        Config::parse_with("", &["noequals".into()]),
+        Err(ConfigError::BadOverride(_))
+    ));
+}
+
+#[test]
+fn nan_is_a_problem_not_a_panic() {
+    let cfg = Config::parse_with("[control]\nspeed_kmh = nan\n", &[]).unwrap();
+    let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
+    assert!(msgs
+        .iter()
+        .any(|m| m.starts_with("control.speed_kmh = NaN")));
+}
+
+#[test]
+fn job_keys_are_fixed_tuning_keys_are_not() {
+    let a = Config::default();
+    let tuned = Config::parse_with(
+        "[track]\nld_min_m = 4.0\n[safety]\na_lat_max_m_s2 = 1.5\n",
+        &[],
+    )
+    .unwrap();
+    assert!(a.fixed_key_changes(&tuned).is_empty());
+    let moved =
+        Config::parse_with("[job]\nline_width_m = 4.0\n[vehicle]\nr_min_m = 6.0\n", &[]).unwrap();
+    assert_eq!(a.fixed_key_changes(&moved), vec!["job", "vehicle.r_min_m"]);
+    // [field] shapes the running field plan: a SIGHUP cannot change it either.
+    let replanned = Config::parse_with("[field]\nheadland_passes = 1\n", &[]).unwrap();
+    assert_eq!(a.fixed_key_changes(&replanned), vec!["field"]);
+}
+
+#[test]
+fn field_section_parses_validates_and_builds_params() {
+    let cfg = Config::parse_with(
+        "[field]\nswath_angle = \"fixed\"\nswath_angle_deg = 90\nroute = \"skip\"\norigin = \"config\"\n",
+        &[],
+    )
+    .unwrap();
+    let p = cfg.coverage_params();
+    assert!(
+        matches!(p.swath_angle, crate::plan::coverage::SwathAngle::Fixed { angle } if (angle - std::f64::consts::FRAC_PI_2).abs() < 1e-12)
+    );
+    assert_eq!(p.route, crate::plan::coverage::RouteOrder::Skip);
+    assert_eq!(p.line_width, cfg.job.line_width_m);
+    assert_eq!(
+        cfg.field_load_options().origin.map(|o| o.lat_deg),
+        Some(cfg.job.origin_lat_deg)
+    );
+    let bad = Config::parse_with("[field]\nboundary_tolerance_m = -1\n", &[]).unwrap();
+    assert!(bad
+        .validate()
+        .iter()
+        .any(|p| p.key == "field.boundary_tolerance_m"));
+    assert!(Config::parse_with("[field]\nswath_angle = \"diagonal\"\n", &[]).is_err());
+}
+
+#[test]
+fn maneuver_section_parses_validates_and_builds_params() {
+    let cfg = Config::parse_with(
+        "[maneuver]\ncurve = \"rs\"\nimplement_length_m = 2.0\nimplement_width_m = 3.0\n\
+         goal_patterns = [\"rlr_pnp\"]\n[vehicle]\nlength_m = 5.0\n",
+        &["maneuver.heading_step_deg=5".into()],
+    )
+    .unwrap();
+    assert!(cfg.validate().is_empty(), "{:?}", cfg.validate());
+    assert_eq!(cfg.maneuver.curve, CurveChoice::Rs);
+    let p = cfg.maneuver_params();
+    assert_eq!(p.footprint.vehicle.length_m, 5.0);
+    assert_eq!(p.footprint.implement.map(|i| i.width_m), Some(3.0));
+    assert!((p.heading_step_rad - 5f64.to_radians()).abs() < 1e-12);
+    assert!((cfg.maneuver_curve_params().kappa_max - 1.0 / cfg.vehicle.r_min_m).abs() < 1e-12);
+    let bad = Config::parse_with(
+        "[maneuver]\ngoal_patterns = [\"lrx_pn\"]\nclearance_m = 0.05\nsample_tolerance_m = 0.3\n\
+         max_expansions = 0\nreverse_penalty = 0.5\n[vehicle]\nrear_axle_from_rear_m = 9\n",
+        &[],
+    )
+    .unwrap();
+    let keys: Vec<String> = bad.validate().into_iter().map(|p| p.key).collect();
+    for k in [
+        "maneuver.goal_patterns[0]",
+        "maneuver.clearance_m",
+        "maneuver.max_expansions",
+        "maneuver.reverse_penalty",
+        "vehicle.rear_axle_from_rear_m",
+    ] {
+        assert!(keys.iter().any(|x| x == k), "{k} in {keys:?}");
+    }
+    assert!(Config::parse_with("[maneuver]\ncurve = \"dubins\"\n", &[]).is_err());
+}
+
+#[test]
+fn r_min_must_be_steerable() {
+    let cfg = Config::parse_with("[vehicle]\nr_min_m = 1.0\n", &[]).unwrap();
+    assert!(cfg.validate().iter().any(|p| p.key == "vehicle.r_min_m"));
+}

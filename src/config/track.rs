@@ -1,0 +1,237 @@
+//! `[track]`: the local path, the steering law and its helpers (observer, integral action,
+//! lost-motion compensation).
+//!
+//! Owns the section's keys, their defaults and their range checks.
+
+use super::check::Checker;
+use serde::{Deserialize, Serialize};
+
+/// Which tracker steers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum TrackerChoice {
+    /// Pure pursuit on a latency-compensated, dead-reckoned pose (the default).
+    #[default]
+    Predictive,
+    /// Plain seed-000 pure pursuit on the latest fix: the reference.
+    PurePursuit,
+    /// Stanley steering on the same latency-compensated, dead-reckoned pose.
+    Stanley,
+}
+
+/// `[track]`: local path and tracker.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrackConfig {
+    /// "predictive" (default) or "pure_pursuit" (plain reference).
+    pub kind: TrackerChoice,
+    /// Minimum look-ahead distance, m.
+    pub ld_min_m: f64,
+    /// Look-ahead growth with speed, s: Ld = max(ld_min_m, ld_gain_s · v).
+    pub ld_gain_s: f64,
+    /// Global points before the nearest one used as local-path nodes.
+    pub local_nodes_before: usize,
+    /// Global points after the nearest one used as local-path nodes.
+    pub local_nodes_after: usize,
+    /// B-spline tangent length at each node, m.
+    pub tangent_length_m: f64,
+    /// Local path sample spacing, m.
+    pub local_spacing_m: f64,
+    /// Known GNSS latency (fix measured this long before it arrives), s. Predictive only.
+    pub gnss_latency_s: f64,
+    /// Extra prediction horizon (about the actuator dead time), s. Predictive only.
+    pub lead_time_s: f64,
+    /// Stanley cross-track gain k, 1/s: δ = ψ + atan(k·e / (v + stanley_soft_speed_mps)).
+    pub stanley_gain_per_s: f64,
+    /// Stanley softening speed, m/s.
+    pub stanley_soft_speed_mps: f64,
+    /// Integral action on the XTE, rad of wheel angle per (m · s); 0 = off.
+    pub integral_gain_rad_per_m_s: f64,
+    /// Largest wheel-angle offset the integral action may learn, degrees.
+    pub integral_limit_deg: f64,
+    /// The integral action learns only while |XTE| is below this, m.
+    pub integral_capture_m: f64,
+    /// The integral action learns only above this speed, m/s.
+    pub integral_min_speed_mps: f64,
+    /// Disturbance observer (predictive tracker only; see
+    /// [`ObserverParams`](crate::estimate::ObserverParams)): time constant of the wheel-angle
+    /// offset estimate, s (0 = off).
+    pub observer_bias_tau_s: f64,
+    /// Time constant of the world-frame drift (slip) estimate, s (0 = off).
+    pub observer_drift_tau_s: f64,
+    /// The observer learns only above this speed, m/s.
+    pub observer_min_speed_mps: f64,
+    /// Largest wheel-angle offset the observer may estimate, degrees.
+    pub observer_bias_limit_deg: f64,
+    /// Largest drift speed the observer may estimate, m/s.
+    pub observer_drift_limit_mps: f64,
+    /// Time constant of the slope-slip coefficient (lateral slip per degree of IMU roll) at 2°
+    /// of roll, s (0 = off).
+    pub observer_slip_tau_s: f64,
+    /// Largest slope-slip coefficient, m/s per degree of roll.
+    pub observer_slip_limit_mps_per_deg: f64,
+    /// Through an RTK-float period, dead-reckon from the last fixed position for at most this
+    /// long instead of following the float positions, s (0 = off).
+    pub observer_coast_max_s: f64,
+    /// Lost-motion compensation (predictive tracker only; see
+    /// [`LostMotion`](crate::track::lost_motion::LostMotion)): time constant of the steering's
+    /// lost-motion (backlash + actuator deadband) estimate, s (0 = off).
+    pub lost_motion_tau_s: f64,
+    /// The command is pushed the other way only when the measured wheel angle is past the
+    /// demand by this much, degrees (above the wheel-angle sensor's noise).
+    pub lost_motion_threshold_deg: f64,
+    /// Largest lost motion the compensation may learn, degrees.
+    pub lost_motion_limit_deg: f64,
+    /// The estimate learns only this long after the push direction changed, with a steady
+    /// demand, s (about the actuator's settling time).
+    pub lost_motion_settle_s: f64,
+}
+
+impl Default for TrackConfig {
+    fn default() -> Self {
+        TrackConfig {
+            kind: TrackerChoice::Predictive,
+            ld_min_m: 3.0,
+            ld_gain_s: 1.2,
+            local_nodes_before: 1,
+            local_nodes_after: 10,
+            tangent_length_m: 0.25,
+            local_spacing_m: 0.1,
+            gnss_latency_s: 0.05,
+            lead_time_s: 0.05,
+            stanley_gain_per_s: 2.5,
+            stanley_soft_speed_mps: 1.0,
+            integral_gain_rad_per_m_s: 0.0,
+            integral_limit_deg: 3.0,
+            integral_capture_m: 0.3,
+            integral_min_speed_mps: 0.5,
+            observer_bias_tau_s: 20.0,
+            observer_drift_tau_s: 60.0,
+            observer_min_speed_mps: 1.0,
+            observer_bias_limit_deg: 3.0,
+            observer_drift_limit_mps: 0.3,
+            observer_slip_tau_s: 30.0,
+            observer_slip_limit_mps_per_deg: 0.05,
+            observer_coast_max_s: 30.0,
+            lost_motion_tau_s: 5.0,
+            lost_motion_threshold_deg: 0.1,
+            lost_motion_limit_deg: 1.0,
+            lost_motion_settle_s: 0.5,
+        }
+    }
+}
+
+impl TrackConfig {
+    /// Range checks of `[track]`.
+    pub(crate) fn validate(&self, c: &mut Checker) {
+        let t = self;
+        c.range("track.ld_min_m", t.ld_min_m, 0.2, 50.0);
+        c.range("track.ld_gain_s", t.ld_gain_s, 0.0, 10.0);
+        if t.local_nodes_after < 1 {
+            c.push(
+                "track.local_nodes_after",
+                t.local_nodes_after.to_string(),
+                "must be an integer >= 1",
+            );
+        }
+        if t.local_nodes_before + t.local_nodes_after > 64 {
+            c.push(
+                "track.local_nodes_after",
+                t.local_nodes_after.to_string(),
+                "local_nodes_before + local_nodes_after must be <= 64",
+            );
+        }
+        c.range("track.tangent_length_m", t.tangent_length_m, 0.01, 5.0);
+        c.range("track.local_spacing_m", t.local_spacing_m, 0.01, 1.0);
+        c.range("track.gnss_latency_s", t.gnss_latency_s, 0.0, 1.0);
+        c.range("track.lead_time_s", t.lead_time_s, 0.0, 1.0);
+        c.range("track.stanley_gain_per_s", t.stanley_gain_per_s, 0.0, 50.0);
+        c.range(
+            "track.stanley_soft_speed_mps",
+            t.stanley_soft_speed_mps,
+            0.01,
+            10.0,
+        );
+        c.range(
+            "track.integral_gain_rad_per_m_s",
+            t.integral_gain_rad_per_m_s,
+            0.0,
+            1.0,
+        );
+        c.range("track.integral_limit_deg", t.integral_limit_deg, 0.0, 10.0);
+        c.range("track.integral_capture_m", t.integral_capture_m, 0.01, 5.0);
+        c.range(
+            "track.integral_min_speed_mps",
+            t.integral_min_speed_mps,
+            0.0,
+            10.0,
+        );
+        c.range(
+            "track.observer_bias_tau_s",
+            t.observer_bias_tau_s,
+            0.0,
+            600.0,
+        );
+        c.range(
+            "track.observer_drift_tau_s",
+            t.observer_drift_tau_s,
+            0.0,
+            600.0,
+        );
+        c.range(
+            "track.observer_min_speed_mps",
+            t.observer_min_speed_mps,
+            0.1,
+            10.0,
+        );
+        c.range(
+            "track.observer_bias_limit_deg",
+            t.observer_bias_limit_deg,
+            0.0,
+            10.0,
+        );
+        c.range(
+            "track.observer_drift_limit_mps",
+            t.observer_drift_limit_mps,
+            0.0,
+            2.0,
+        );
+        c.range(
+            "track.observer_slip_tau_s",
+            t.observer_slip_tau_s,
+            0.0,
+            600.0,
+        );
+        c.range(
+            "track.observer_slip_limit_mps_per_deg",
+            t.observer_slip_limit_mps_per_deg,
+            0.0,
+            1.0,
+        );
+        c.range(
+            "track.observer_coast_max_s",
+            t.observer_coast_max_s,
+            0.0,
+            600.0,
+        );
+        c.range("track.lost_motion_tau_s", t.lost_motion_tau_s, 0.0, 600.0);
+        c.range(
+            "track.lost_motion_threshold_deg",
+            t.lost_motion_threshold_deg,
+            0.0,
+            2.0,
+        );
+        c.range(
+            "track.lost_motion_limit_deg",
+            t.lost_motion_limit_deg,
+            0.0,
+            5.0,
+        );
+        c.range(
+            "track.lost_motion_settle_s",
+            t.lost_motion_settle_s,
+            0.0,
+            10.0,
+        );
+    }
+}
