@@ -202,8 +202,7 @@ impl SimNode {
             self.sim.set_command(cmd.angle.to_radians());
         } else {
             // The driver holds the wheels.
-            let w = self.sim.true_state().wheel_angle;
-            self.sim.set_command(w);
+            self.sim.hold_wheels();
         }
     }
 
@@ -257,7 +256,7 @@ impl SimNode {
                     if let Ok(f) = self.gnss.pack(&CogSogRapid {
                         sid: self.sid as f64,
                         cog_reference: 0.0,
-                        cog: Some((heading / 1e-4).floor() * 1e-4),
+                        cog: Some((north_cw_from_yaw(m.course) / 1e-4).floor() * 1e-4),
                         sog: Some(speed),
                     }) {
                         out.push((ts, f));
