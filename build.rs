@@ -19,6 +19,36 @@ fn snake(name: &str) -> String {
     out
 }
 
+/// `operator_override` → `OperatorOverride`.
+fn camel(name: &str) -> String {
+    let mut out = String::new();
+    let mut up = true;
+    for c in name.chars() {
+        if c == '_' || c == ' ' || c == '-' {
+            up = true;
+        } else if up {
+            out.push(c.to_ascii_uppercase());
+            up = false;
+        } else {
+            out.push(c);
+        }
+    }
+    if out.starts_with(|c: char| c.is_ascii_digit()) {
+        out.insert(0, 'V');
+    }
+    out
+}
+
+/// The smallest unsigned type holding `bits` bits.
+fn uint_for(bits: u64) -> &'static str {
+    match bits {
+        0..=8 => "u8",
+        9..=16 => "u16",
+        17..=32 => "u32",
+        _ => "u64",
+    }
+}
+
 fn attr_u64(v: &AttributeValue) -> u64 {
     match v {
         AttributeValue::Uint(u) => *u,
@@ -56,6 +86,7 @@ fn main() {
 
     let mut table = String::new();
     let mut types = String::new();
+    let mut enums = String::new();
     writeln!(table, "/// Every message of the DBC, in file order.").unwrap();
     writeln!(table, "pub static MESSAGES: &[MessageDef] = &[").unwrap();
     for (index, m) in dbc.messages.iter().enumerate() {
@@ -112,15 +143,15 @@ fn main() {
             }
             let na = sig_attr(m.id, &s.name, "AgNotAvailable") == 1;
             let signed = s.value_type == ValueType::Signed;
-            let choices = dbc
+            let descs: Vec<(i64, String)> = dbc
                 .value_descriptions_for_signal(m.id, &s.name)
-                .map(|v| {
-                    v.iter()
-                        .map(|d| format!("({}, {:?})", d.id, d.description))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                })
+                .map(|v| v.iter().map(|d| (d.id, d.description.clone())).collect())
                 .unwrap_or_default();
+            let choices = descs
+                .iter()
+                .map(|(id, d)| format!("({id}, {d:?})"))
+                .collect::<Vec<_>>()
+                .join(", ");
             writeln!(
                 table,
                 "        SignalDef {{ name: {:?}, start_bit: {}, size: {}, signed: {signed}, factor: {}, offset: {}, min: {}, max: {}, unit: {:?}, role: {role}, not_available: {na}, choices: &[{choices}] }},",
@@ -136,7 +167,32 @@ fn main() {
             .unwrap();
             if role == "Role::Value" {
                 let field = snake(&s.name);
-                let ty = if na { "Option<f64>" } else { "f64" };
+                // A signal with a value table is a generated enum (`{Message}{Signal}`), with
+                // `Other(raw)` for raw values the table does not name.
+                let enum_name = format!("{}{}", m.name, s.name);
+                let is_enum = !descs.is_empty();
+                if is_enum {
+                    assert!(
+                        s.factor == 1.0 && s.offset == 0.0 && !signed,
+                        "{}.{}: a value table needs an unsigned raw signal (factor 1, offset 0)",
+                        m.name,
+                        s.name
+                    );
+                    write_enum(
+                        &mut enums,
+                        &enum_name,
+                        m.name.as_str(),
+                        &s.name,
+                        s.size,
+                        &descs,
+                    );
+                }
+                let base = if is_enum { enum_name.as_str() } else { "f64" };
+                let ty = if na {
+                    format!("Option<{base}>")
+                } else {
+                    base.to_string()
+                };
                 writeln!(
                     fields,
                     "    /// `{}`: {} [{} ..= {}]{}{}.\n    pub {field}: {ty},",
@@ -152,28 +208,125 @@ fn main() {
                     }
                 )
                 .unwrap();
-                if na {
-                    writeln!(from_values, "            {field}: v[{si}],").unwrap();
-                    writeln!(to_values, "        v[{si}] = self.{field};").unwrap();
-                } else {
-                    writeln!(from_values, "            {field}: v[{si}].unwrap_or(0.0),").unwrap();
-                    writeln!(to_values, "        v[{si}] = Some(self.{field});").unwrap();
+                let raw = uint_for(s.size);
+                match (is_enum, na) {
+                    (false, true) => {
+                        writeln!(from_values, "            {field}: v[{si}],").unwrap();
+                        writeln!(to_values, "        v[{si}] = self.{field};").unwrap();
+                    }
+                    (false, false) => {
+                        writeln!(from_values, "            {field}: v[{si}].unwrap_or(0.0),")
+                            .unwrap();
+                        writeln!(to_values, "        v[{si}] = Some(self.{field});").unwrap();
+                    }
+                    (true, true) => {
+                        writeln!(
+                            from_values,
+                            "            {field}: v[{si}].map(|x| {enum_name}::from_raw(x as {raw})),"
+                        )
+                        .unwrap();
+                        writeln!(
+                            to_values,
+                            "        v[{si}] = self.{field}.map(|e| e.raw() as f64);"
+                        )
+                        .unwrap();
+                    }
+                    (true, false) => {
+                        writeln!(
+                            from_values,
+                            "            {field}: {enum_name}::from_raw(v[{si}].unwrap_or(0.0) as {raw}),"
+                        )
+                        .unwrap();
+                        writeln!(
+                            to_values,
+                            "        v[{si}] = Some(self.{field}.raw() as f64);"
+                        )
+                        .unwrap();
+                    }
                 }
             }
         }
         writeln!(table, "    ] }},").unwrap();
         writeln!(
             types,
-            "/// {comment}\n#[derive(Debug, Clone, Copy, PartialEq, Default)]\npub struct {name} {{\n{fields}}}\n\nimpl DbcMessage for {name} {{\n    const INDEX: usize = {index};\n    fn from_values(v: &[Option<f64>]) -> Self {{\n        {name} {{\n{from_values}        }}\n    }}\n    fn to_values(&self, v: &mut [Option<f64>]) {{\n{to_values}    }}\n}}\n",
+            "/// {comment}\n#[derive(Debug, Clone, Copy, PartialEq)]\npub struct {name} {{\n{fields}}}\n\nimpl DbcMessage for {name} {{\n    const INDEX: usize = {index};\n    fn from_values(v: &[Option<f64>]) -> Self {{\n        {name} {{\n{from_values}        }}\n    }}\n    fn to_values(&self, v: &mut [Option<f64>]) {{\n{to_values}    }}\n}}\n",
             name = m.name,
         )
         .unwrap();
     }
     writeln!(table, "];").unwrap();
+    // The message enum: one variant per message, for dispatch with one `match`.
+    let mut message = String::from(
+        "/// Every message of the DBC as its typed value: the node dispatches on it.\n#[derive(Debug, Clone, Copy, PartialEq)]\npub enum Message {\n",
+    );
+    let mut message_of = String::from(
+        "/// The typed message for message `index` of [`MESSAGES`] and its decoded values.\npub fn message_of(index: usize, v: &[Option<f64>]) -> Option<Message> {\n    Some(match index {\n",
+    );
+    for m in &dbc.messages {
+        writeln!(message, "    {0}({0}),", m.name).unwrap();
+        writeln!(
+            message_of,
+            "        {0}::INDEX => Message::{0}({0}::from_values(v)),",
+            m.name
+        )
+        .unwrap();
+    }
+    message.push_str("}\n");
+    message_of.push_str("        _ => return None,\n    })\n}\n");
     let out = std::path::Path::new(&std::env::var("OUT_DIR").expect("OUT_DIR")).join("dbc_gen.rs");
     std::fs::write(
         &out,
-        format!("// Generated by build.rs from {path}. Do not edit.\n\n{table}\n{types}"),
+        format!(
+            "// Generated by build.rs from {path}. Do not edit.\n\n{table}\n{enums}\n{types}\n{message}\n{message_of}"
+        ),
     )
     .expect("write generated codec");
+}
+
+/// A value table as an enum: `from_raw` / `raw`, `Other(raw)` for unnamed raw values.
+fn write_enum(
+    out: &mut String,
+    name: &str,
+    message: &str,
+    signal: &str,
+    size: u64,
+    descs: &[(i64, String)],
+) {
+    let raw = uint_for(size);
+    let variants: Vec<(i64, String)> = descs.iter().map(|(id, d)| (*id, camel(d))).collect();
+    for (i, (_, v)) in variants.iter().enumerate() {
+        assert!(
+            v != "Other" && !variants[..i].iter().any(|(_, w)| w == v),
+            "{message}.{signal}: value name {v} is used twice or is reserved"
+        );
+    }
+    writeln!(
+        out,
+        "/// `{message}.{signal}` (the DBC's value table).\n#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]\npub enum {name} {{"
+    )
+    .unwrap();
+    for ((id, v), (_, d)) in variants.iter().zip(descs) {
+        writeln!(out, "    /// {id}: `{d}`.\n    {v},").unwrap();
+    }
+    writeln!(
+        out,
+        "    /// A raw value the table does not name.\n    Other({raw}),\n}}\n\nimpl {name} {{\n    /// The value for a raw code.\n    pub fn from_raw(raw: {raw}) -> Self {{\n        match raw {{"
+    )
+    .unwrap();
+    for (id, v) in &variants {
+        writeln!(out, "            {id} => {name}::{v},").unwrap();
+    }
+    writeln!(
+        out,
+        "            other => {name}::Other(other),\n        }}\n    }}\n    /// The raw code.\n    pub fn raw(self) -> {raw} {{\n        match self {{"
+    )
+    .unwrap();
+    for (id, v) in &variants {
+        writeln!(out, "            {name}::{v} => {id},").unwrap();
+    }
+    writeln!(
+        out,
+        "            {name}::Other(raw) => raw,\n        }}\n    }}\n}}\n"
+    )
+    .unwrap();
 }

@@ -4,7 +4,7 @@
 
 use agsteer::can::codec::{
     crc8_except, decode, encode, encode_values, find_name, CodecError, CounterCheck, Packer, Role,
-    SteeringCommand, WheelAngle, MAX_SIGNALS, MESSAGES,
+    SteeringCommand, SteeringCommandMode, WheelAngle, WheelAngleStatus, MAX_SIGNALS, MESSAGES,
 };
 use serde_json::Value;
 
@@ -80,7 +80,7 @@ fn packer_fills_counters_and_crcs_and_the_parser_checks_them() {
     for k in 0..40u32 {
         let msg = SteeringCommand {
             angle: (k as f64) * 0.5 - 10.0,
-            mode: 1.0,
+            mode: SteeringCommandMode::Engaged,
         };
         let f = packer.pack(&msg).unwrap();
         assert_eq!(f.id & 0xFF, 0x2A);
@@ -93,7 +93,7 @@ fn packer_fills_counters_and_crcs_and_the_parser_checks_them() {
     let f = packer
         .pack(&SteeringCommand {
             angle: 1.0,
-            mode: 1.0,
+            mode: SteeringCommandMode::Engaged,
         })
         .unwrap();
     let mut bad = f.data;
@@ -113,7 +113,7 @@ fn out_of_range_missing_and_not_available() {
         encode(
             &WheelAngle {
                 angle: Some(90.5),
-                status: 0.0
+                status: WheelAngleStatus::Ok
             },
             0,
             0x13
@@ -124,7 +124,7 @@ fn out_of_range_missing_and_not_available() {
         encode(
             &SteeringCommand {
                 angle: f64::NAN,
-                mode: 0.0
+                mode: SteeringCommandMode::Disengaged
             },
             0,
             0x2A
@@ -134,7 +134,7 @@ fn out_of_range_missing_and_not_available() {
     let f = encode(
         &WheelAngle {
             angle: None,
-            status: 0.0,
+            status: WheelAngleStatus::Ok,
         },
         3,
         0x13,
@@ -146,7 +146,7 @@ fn out_of_range_missing_and_not_available() {
     let f = encode(
         &WheelAngle {
             angle: Some(0.005),
-            status: 0.0,
+            status: WheelAngleStatus::Ok,
         },
         0,
         0x13,
@@ -156,7 +156,7 @@ fn out_of_range_missing_and_not_available() {
     let f = encode(
         &WheelAngle {
             angle: Some(0.015),
-            status: 0.0,
+            status: WheelAngleStatus::Ok,
         },
         0,
         0x13,
@@ -170,7 +170,7 @@ fn any_source_address_matches_by_pgn() {
     let f = encode(
         &WheelAngle {
             angle: Some(1.0),
-            status: 0.0,
+            status: WheelAngleStatus::Ok,
         },
         0,
         0x77,

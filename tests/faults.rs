@@ -250,7 +250,7 @@ impl Bench {
             let f = self
                 .terminal
                 .pack(&agsteer::can::codec::OperatorCommand {
-                    command: 1.0,
+                    command: agsteer::can::codec::OperatorCommandCommand::Engage,
                     nudge: 0.0,
                     job: 0.0,
                 })

@@ -14,8 +14,9 @@
 //! builds); the seed is fixed, `AGSTEER_PROPTEST_SEED` picks another.
 
 use agsteer::can::codec::{
-    self, CounterCheck, OperatorCommand, Packer, PositionRapid, VesselHeading, WheelAngle,
-    WheelSpeed, MESSAGES,
+    self, CounterCheck, OperatorCommand, OperatorCommandCommand, Packer, PositionRapid,
+    VesselHeading, VesselHeadingReference, WheelAngle, WheelAngleStatus, WheelSpeed,
+    WheelSpeedDirection, WheelSpeedKeySwitch, MESSAGES,
 };
 use agsteer::can::fastpacket::split;
 use agsteer::can::gnss::GnssPosition;
@@ -495,7 +496,7 @@ fn run_node_case(cfg: &Config, inputs: &[In]) -> Result<(), TestCaseError> {
                     heading: Some(0.0),
                     deviation: None,
                     variation: None,
-                    reference: 0.0,
+                    reference: VesselHeadingReference::True,
                 }) {
                     feed(&mut node, t, f);
                 }
@@ -538,12 +539,12 @@ fn run_node_case(cfg: &Config, inputs: &[In]) -> Result<(), TestCaseError> {
                 if *skip {
                     let _ = was.pack(&WheelAngle {
                         angle: Some(0.0),
-                        status: 0.0,
+                        status: WheelAngleStatus::Ok,
                     });
                 }
                 if let Ok(mut f) = was.pack(&WheelAngle {
                     angle: Some(*angle),
-                    status: *status as f64,
+                    status: WheelAngleStatus::from_raw(*status),
                 }) {
                     if *corrupt {
                         f.data[7] ^= 0xA5;
@@ -558,15 +559,15 @@ fn run_node_case(cfg: &Config, inputs: &[In]) -> Result<(), TestCaseError> {
                     speed: Some(*v),
                     distance: Some(0.0),
                     max_time_tractor_power: 0.0,
-                    key_switch: 1.0,
-                    direction: 1.0,
+                    key_switch: WheelSpeedKeySwitch::NotOff,
+                    direction: WheelSpeedDirection::Forward,
                 }) {
                     feed(&mut node, t, f);
                 }
             }
             In::Operator(c) => {
                 if let Ok(f) = terminal.pack(&OperatorCommand {
-                    command: *c as f64,
+                    command: OperatorCommandCommand::from_raw(*c),
                     nudge: 0.0,
                     job: 0.0,
                 }) {
@@ -599,7 +600,10 @@ fn run_node_case(cfg: &Config, inputs: &[In]) -> Result<(), TestCaseError> {
                 });
                 let steer =
                     steer.ok_or_else(|| TestCaseError::fail("no steering frame this period"))?;
-                prop_assert_eq!(steer.mode == 1.0, cmd.engaged);
+                prop_assert_eq!(
+                    steer.mode == codec::SteeringCommandMode::Engaged,
+                    cmd.engaged
+                );
                 if cmd.engaged {
                     prop_assert!(steer.angle.to_radians().abs() <= p.max_wheel_angle + 1e-3);
                     if let Some(prev) = last_cmd {

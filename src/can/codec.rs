@@ -72,6 +72,7 @@ pub trait DbcMessage: Sized {
 #[allow(clippy::approx_constant)] // DBC ranges such as 6.2831 rad are data, not π.
 mod generated {
     use super::{DbcMessage, MessageDef, Role, SignalDef};
+    // Generated value-table enums are matched by name; not every one is used in every build.
     include!(concat!(env!("OUT_DIR"), "/dbc_gen.rs"));
 }
 pub use generated::*;
@@ -170,6 +171,10 @@ pub struct Decoded {
 }
 
 impl Decoded {
+    /// The typed message, for dispatch with one `match`.
+    pub fn message(&self) -> Option<Message> {
+        message_of(self.index, &self.values)
+    }
     /// The typed message.
     pub fn to<M: DbcMessage>(&self) -> Option<M> {
         (self.index == M::INDEX).then(|| M::from_values(&self.values))

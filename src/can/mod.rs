@@ -53,10 +53,3 @@ pub struct TimedFrame {
     pub t: f64,
     pub frame: Frame,
 }
-
-/// DirectionRequest.Direction values (the DBC's VAL_ table).
-pub mod direction_request {
-    pub const STOP: f64 = 0.0;
-    pub const FORWARD: f64 = 1.0;
-    pub const REVERSE: f64 = 2.0;
-}

@@ -4,17 +4,18 @@
 
 use super::{ControlError, Controller};
 use crate::can::codec::{
-    self, CodecError, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, GnssPositionData,
-    GuidanceStatus, GuidanceSystemCommand, ImuAttitude, OperatorCommand, Packer, PositionRapid,
-    SteeringCommand, VesselHeading, WheelAngle, WheelSpeed,
+    DirectionRequest, DirectionRequestDirection, GuidanceStatus, GuidanceStatusState,
+    GuidanceSystemCommand, GuidanceSystemCommandCommandStatus, Packer, SteeringCommand,
+    SteeringCommandMode,
 };
-use crate::can::fastpacket::Reassembler;
-use crate::can::gnss::{yaw_from_north_cw, GnssPosition, METHOD_RTK_FIXED, METHOD_RTK_FLOAT};
 use crate::can::{Frame, TimedFrame};
 use crate::config::{Config, OutputKind};
 use crate::estimate::GnssFix;
 use crate::geo::wgs84::{EnuFrame, LatLon};
+use crate::geo::Direction;
 use crate::guidance::progress::Progress;
+use crate::input::can::CanAdapter;
+use crate::input::{CheckedLink, Input, OperatorCommand, PositionInput, SensorStatus};
 use crate::safety::{
     CheckedInput, FaultCode, FixQuality, SafetyState, SteeringCommand as Cmd, Supervisor,
 };
@@ -26,14 +27,6 @@ const HEADING_MAX_AGE: f64 = 0.5;
 const ROLL_MAX_AGE: f64 = 0.5;
 /// A 129029 quality older than this no longer vouches for positions, s.
 const QUALITY_MAX_AGE: f64 = 2.0;
-
-/// Operator commands (OperatorCommand.Command).
-pub mod operator {
-    pub const ENGAGE: f64 = 1.0;
-    pub const DISENGAGE: f64 = 2.0;
-    pub const PAUSE: f64 = 3.0;
-    pub const RESUME: f64 = 4.0;
-}
 
 /// What `agsteer status` and the guidance status frame report.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -60,8 +53,8 @@ pub struct ControllerNode {
     supervisor: Supervisor,
     enu: EnuFrame,
     packer: Packer,
-    counters: CounterCheck,
-    fast: Reassembler,
+    /// Frames → inputs.
+    can: CanAdapter,
     output: OutputKind,
     heading: Option<(f64, f64)>,
     /// Latest IMU roll: (time s, rad, positive right side down).
@@ -79,7 +72,7 @@ pub struct ControllerNode {
     approach_refused: bool,
     /// Guidance failed in the previous period (its error already logged).
     guidance_failing: bool,
-    last_request: Option<f64>,
+    last_request: Option<DirectionRequestDirection>,
 }
 
 /// How the node handles a change of driving direction (SPEC §4: the daemon asks for it on the
@@ -94,30 +87,18 @@ struct CuspParams {
     min_speed: f64,
 }
 
-use crate::can::direction_request;
-
-fn request_of(d: crate::geo::Direction) -> f64 {
+fn request_of(d: Direction) -> DirectionRequestDirection {
     match d {
-        crate::geo::Direction::Forward => direction_request::FORWARD,
-        crate::geo::Direction::Reverse => direction_request::REVERSE,
+        Direction::Forward => DirectionRequestDirection::Forward,
+        Direction::Reverse => DirectionRequestDirection::Reverse,
     }
 }
 
-fn quality_of(method: u8) -> FixQuality {
-    match method {
-        METHOD_RTK_FIXED => FixQuality::RtkFixed,
-        METHOD_RTK_FLOAT => FixQuality::RtkFloat,
-        0 => FixQuality::None,
-        _ => FixQuality::Other,
-    }
-}
-
-fn checked_input(name: &str) -> Option<CheckedInput> {
-    match name {
-        "WheelAngle" => Some(CheckedInput::WheelAngle),
-        "OperatorCommand" => Some(CheckedInput::Operator),
-        "ImuAttitude" => Some(CheckedInput::Imu),
-        _ => None,
+fn checked_input(link: CheckedLink) -> CheckedInput {
+    match link {
+        CheckedLink::WheelAngle => CheckedInput::WheelAngle,
+        CheckedLink::Operator => CheckedInput::Operator,
+        CheckedLink::Imu => CheckedInput::Imu,
     }
 }
 
@@ -152,8 +133,7 @@ impl ControllerNode {
                 lon_deg: cfg.job.origin_lon_deg,
             }),
             packer: Packer::new(cfg.bus.source_address),
-            counters: CounterCheck::default(),
-            fast: Reassembler::default(),
+            can: CanAdapter::default(),
             output: cfg.bus.output,
             heading: None,
             roll: None,
@@ -219,128 +199,134 @@ impl ControllerNode {
         &self.enu
     }
 
-    /// One received frame.
+    /// One received frame: the CAN adapter's inputs, in order.
     pub fn on_frame(&mut self, tf: &TimedFrame) {
-        let t = tf.t;
-        let d = match codec::decode(tf.frame.id, tf.frame.payload()) {
-            Ok(d) => d,
-            Err(CodecError::UnknownId(_)) => return,
-            Err(_) => {
-                self.status.bad_frames += 1;
-                if let Some((_, def)) = codec::find(tf.frame.id) {
-                    if let Some(input) = checked_input(def.name) {
-                        self.supervisor.on_frame_check(input, false);
-                    }
-                }
-                return;
-            }
-        };
-        if let Some(input) = checked_input(d.def.name) {
-            let ok = self.counters.check(&d);
-            self.supervisor.on_frame_check(input, ok);
-            if !ok {
-                self.status.bad_frames += 1;
-                return;
-            }
+        for input in self.can.on_frame(tf) {
+            self.on_input(&input);
         }
-        if let Some(m) = d.to::<WheelAngle>() {
-            if let Some(deg) = m.angle {
-                let a = deg.to_radians();
-                self.supervisor
-                    .on_wheel_angle(t, a, m.status == 2.0, m.status == 1.0);
-                self.ctrl.on_wheel_angle(t, a);
-            }
-        } else if let Some(m) = d.to::<PositionRapid>() {
-            let (Some(lat), Some(lon)) = (m.latitude, m.longitude) else {
-                return;
-            };
-            let antenna = self.enu.to_enu(LatLon {
-                lat_deg: lat,
-                lon_deg: lon,
-            });
-            let heading = self
-                .heading
-                .filter(|(th, _)| t - th <= HEADING_MAX_AGE)
-                .map(|(_, h)| h);
-            let q = match self.quality {
-                Some((tq, q)) if t - tq <= QUALITY_MAX_AGE => q,
-                _ => FixQuality::None,
-            };
-            self.ctrl
-                .set_fix_quality(q == FixQuality::RtkFixed, q == FixQuality::RtkFloat);
-            self.ctrl.on_fix(&GnssFix {
-                t_received: t,
-                antenna,
-                heading,
-                speed: self.speed,
-                roll: self
-                    .roll
-                    .filter(|(tr, _)| t - tr <= ROLL_MAX_AGE)
-                    .map(|(_, r)| r),
-            });
-            self.status.fix = q;
-            self.supervisor.on_gnss(t, q);
-        } else if let Some(m) = d.to::<ImuAttitude>() {
-            if let Some(deg) = m.roll.filter(|r| r.is_finite()) {
-                self.roll = Some((t, deg.to_radians()));
-            }
-        } else if let Some(m) = d.to::<VesselHeading>() {
-            if let Some(h) = m.heading {
-                self.heading = Some((t, yaw_from_north_cw(h)));
-            }
-        } else if let Some(m) = d.to::<CogSogRapid>() {
-            if let Some(sog) = m.sog {
-                if self.heading.is_none() {
-                    // SOG has no sign: keep the direction the wheel-speed frame reported.
-                    self.speed = if self.speed < 0.0 { -sog } else { sog };
+    }
+
+    /// One input, from any adapter (CAN, serial GNSS, the simulator).
+    pub fn on_input(&mut self, input: &Input) {
+        match *input {
+            Input::FrameCheck(c) => {
+                if !c.ok {
+                    self.status.bad_frames += 1;
+                }
+                if let Some(link) = c.link {
+                    self.supervisor.on_frame_check(checked_input(link), c.ok);
                 }
             }
-        } else if let Some(m) = d.to::<WheelSpeed>() {
-            if let Some(v) = m.speed {
-                let v = if m.direction == 0.0 { -v } else { v };
-                self.speed = v;
-                self.supervisor.on_speed(t, v);
+            Input::WheelAngle(w) => {
+                if let Some(a) = w.angle {
+                    self.supervisor.on_wheel_angle(
+                        w.t,
+                        a,
+                        w.status == SensorStatus::OperatorOverride,
+                        w.status == SensorStatus::Fault,
+                    );
+                    self.ctrl.on_wheel_angle(w.t, a);
+                }
             }
-        } else if d.index == GnssPositionData::INDEX {
-            match self.fast.push(d.source, tf.frame.payload()) {
-                Ok(Some(payload)) => match GnssPosition::decode(payload) {
-                    Ok(g) => self.quality = Some((t, quality_of(g.method))),
-                    Err(_) => self.status.bad_frames += 1,
-                },
-                Ok(None) => {}
-                Err(_) => self.status.bad_frames += 1,
+            Input::Position(p) => self.on_position(&p),
+            Input::Quality(q) => self.quality = Some((q.t, q.quality)),
+            Input::Attitude(a) => {
+                if let Some(roll) = a.roll {
+                    self.roll = Some((a.t, roll));
+                }
             }
-        } else if let Some(m) = d.to::<OperatorCommand>() {
-            match m.command {
-                c if c == operator::ENGAGE || c == operator::RESUME => {
-                    match self.ctrl.plan_approach(t) {
-                        Some(Ok(parts)) => {
-                            self.approach_refused = false;
-                            tracing::info!(parts, "approach path to the line start planned")
-                        }
-                        // Logged once per run of refusals (an operator may hold the button).
-                        Some(Err(e)) if !self.approach_refused => {
-                            self.approach_refused = true;
-                            tracing::warn!("no approach path: {e}")
-                        }
-                        _ => {}
+            Input::Heading(h) => self.heading = Some((h.t, h.heading)),
+            Input::CourseSpeed(c) => {
+                if let Some(sog) = c.speed_mps {
+                    if self.heading.is_none() {
+                        // SOG has no sign: keep the direction the wheel-speed frame reported.
+                        self.speed = if self.speed < 0.0 { -sog } else { sog };
                     }
-                    self.supervisor.request_engage()
                 }
-                c if c == operator::DISENGAGE || c == operator::PAUSE => {
-                    self.supervisor.request_disengage()
-                }
-                _ => {}
             }
+            Input::WheelSpeed(s) => {
+                if let Some(v) = s.speed_mps {
+                    let v = if s.direction == Some(Direction::Reverse) {
+                        -v
+                    } else {
+                        v
+                    };
+                    self.speed = v;
+                    self.supervisor.on_speed(s.t, v);
+                }
+            }
+            Input::Operator(o) => self.on_operator(o.t, o.command),
+        }
+    }
+
+    /// A GNSS antenna position: the one place a fix enters the controller, with the latest
+    /// heading, roll and fix quality that are fresh enough.
+    fn on_position(&mut self, p: &PositionInput) {
+        let t = p.t;
+        let antenna = self.enu.to_enu(LatLon {
+            lat_deg: p.lat_deg,
+            lon_deg: p.lon_deg,
+        });
+        let heading = self
+            .heading
+            .filter(|(th, _)| t - th <= HEADING_MAX_AGE)
+            .map(|(_, h)| h);
+        let q = match (p.quality, self.quality) {
+            (Some(q), _) => q,
+            (None, Some((tq, q))) if t - tq <= QUALITY_MAX_AGE => q,
+            _ => FixQuality::None,
+        };
+        self.ctrl
+            .set_fix_quality(q == FixQuality::RtkFixed, q == FixQuality::RtkFloat);
+        self.ctrl.on_fix(&GnssFix {
+            t_received: t,
+            antenna,
+            heading,
+            speed: self.speed,
+            roll: self
+                .roll
+                .filter(|(tr, _)| t - tr <= ROLL_MAX_AGE)
+                .map(|(_, r)| r),
+        });
+        self.status.fix = q;
+        self.supervisor.on_gnss(t, q);
+    }
+
+    fn on_operator(&mut self, t: f64, command: OperatorCommand) {
+        match command {
+            OperatorCommand::Engage | OperatorCommand::Resume => {
+                match self.ctrl.plan_approach(t) {
+                    Some(Ok(parts)) => {
+                        self.approach_refused = false;
+                        tracing::info!(parts, "approach path to the line start planned")
+                    }
+                    // Logged once per run of refusals (an operator may hold the button).
+                    Some(Err(e)) if !self.approach_refused => {
+                        self.approach_refused = true;
+                        tracing::warn!("no approach path: {e}")
+                    }
+                    _ => {}
+                }
+                self.supervisor.request_engage()
+            }
+            OperatorCommand::Disengage | OperatorCommand::Pause => {
+                self.supervisor.request_disengage()
+            }
+            // Not implemented yet (issue 16 point 5).
+            OperatorCommand::None
+            | OperatorCommand::Nudge { .. }
+            | OperatorCommand::SetA
+            | OperatorCommand::SetB
+            | OperatorCommand::SelectJob { .. }
+            | OperatorCommand::Unknown { .. } => {}
         }
     }
 
     /// The direction to request this period, for segment jobs and approach paths (AB jobs
     /// are driven forward and send none unless an approach path came first). Before a cusp: stop once within the stopping distance; when
     /// stopped near the cusp, move on to the next segment and request its direction.
-    fn direction_request(&mut self, c: &super::ControlOutput) -> Option<f64> {
-        use crate::geo::Direction;
-        use direction_request::STOP;
+    fn direction_request(&mut self, c: &super::ControlOutput) -> Option<DirectionRequestDirection> {
+        const STOP: DirectionRequestDirection = DirectionRequestDirection::Stop;
         let p = self.cusps;
         let g = self.ctrl.guidance();
         // AB jobs send none, unless an approach path has made the node ask for a direction.
@@ -430,11 +416,15 @@ impl ControllerNode {
             .step(t, c.wheel_angle, c.xte, c.heading_error);
         self.ctrl.set_engaged(cmd.engaged);
         let angle_deg = cmd.wheel_angle.to_degrees().clamp(-90.0, 90.0);
-        let engaged = if cmd.engaged { 1.0 } else { 0.0 };
+
         if matches!(self.output, OutputKind::Angle | OutputKind::Both) {
             if let Ok(f) = self.packer.pack(&SteeringCommand {
                 angle: angle_deg,
-                mode: engaged,
+                mode: if cmd.engaged {
+                    SteeringCommandMode::Engaged
+                } else {
+                    SteeringCommandMode::Disengaged
+                },
             }) {
                 out.push(f);
             }
@@ -444,7 +434,11 @@ impl ControllerNode {
             let k = (-cmd.curvature * 1000.0).clamp(-8032.0, 8031.75);
             if let Ok(f) = self.packer.pack(&GuidanceSystemCommand {
                 curvature: k,
-                command_status: engaged,
+                command_status: if cmd.engaged {
+                    GuidanceSystemCommandCommandStatus::IntendedToSteer
+                } else {
+                    GuidanceSystemCommandCommandStatus::NotIntendedToSteer
+                },
             }) {
                 out.push(f);
             }
@@ -467,7 +461,7 @@ impl ControllerNode {
         if self.ticks % self.status_every == 0 {
             let s = &self.status;
             let msg = GuidanceStatus {
-                state: s.state.code() as f64,
+                state: GuidanceStatusState::from_raw(s.state.code()),
                 fault: (s.fault as u8).min(15) as f64,
                 xte: s
                     .xte_m

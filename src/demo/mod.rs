@@ -11,7 +11,7 @@ use crate::can::bus::{CanBus, MemBus};
 use crate::can::codec::{OperatorCommand, Packer};
 use crate::can::Frame;
 use crate::config::{Config, TrackerChoice};
-use crate::control::node::{operator, ControllerNode};
+use crate::control::node::ControllerNode;
 use crate::control::ControlError;
 use crate::geo::{left_normal, signed_offset, v2, Pose, Vec2};
 use crate::guidance::progress::{Phase, Progress};
@@ -568,7 +568,7 @@ pub fn run(
         let st = node.status();
         if st.state == SafetyState::Ready && !(opts.no_reengage && engagements > 0) {
             if let Ok(f) = terminal.pack(&OperatorCommand {
-                command: operator::ENGAGE,
+                command: crate::can::codec::OperatorCommandCommand::Engage,
                 nudge: 0.0,
                 job: 0.0,
             }) {

@@ -17,6 +17,8 @@
 //! and courses are yaw, counter-clockwise from East, in (-π, π]; speeds m/s; positive wheel
 //! angle turns left.
 
+pub mod can;
+
 use serde::Serialize;
 
 /// Where an input came from.
@@ -53,6 +55,8 @@ pub enum HeadingReference {
     True,
     /// Magnetic: usable only with the magnetic variation applied.
     Magnetic,
+    /// The sender did not say (NMEA 2000: error or not available).
+    Unknown,
 }
 
 /// A GNSS antenna position.
@@ -119,6 +123,93 @@ pub struct AttitudeInput {
     pub pitch: Option<f64>,
 }
 
+/// The steered wheels' angle (a wheel-angle sensor).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct WheelAngleInput {
+    pub t: f64,
+    pub source: SourceId,
+    /// Front-wheel angle, rad, positive left.
+    pub angle: Option<f64>,
+    pub status: SensorStatus,
+}
+
+/// What a sensor says of itself.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorStatus {
+    Ok,
+    /// The sensor reports a fault of its own.
+    Fault,
+    /// The driver is turning the wheel (the steering gives way to him).
+    OperatorOverride,
+    /// A status code the sender's definition does not name.
+    Unknown,
+}
+
+/// Wheel-based speed and driving direction (the tractor's own measurement).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct WheelSpeedInput {
+    pub t: f64,
+    pub source: SourceId,
+    /// Speed, m/s, without sign.
+    pub speed_mps: Option<f64>,
+    /// The direction the tractor says it is driving; `None` when not available or in error.
+    pub direction: Option<crate::geo::Direction>,
+}
+
+/// A command from the operator's terminal.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "command", rename_all = "snake_case")]
+pub enum OperatorCommand {
+    None,
+    Engage,
+    Disengage,
+    Pause,
+    Resume,
+    /// Shift the line sideways, m, positive left.
+    Nudge {
+        offset_m: f64,
+    },
+    SetA,
+    SetB,
+    SelectJob {
+        job: u8,
+    },
+    /// A command code the sender's definition does not name.
+    Unknown {
+        code: u8,
+    },
+}
+
+/// An operator command with its arrival.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OperatorInput {
+    pub t: f64,
+    pub source: SourceId,
+    pub command: OperatorCommand,
+}
+
+/// An input whose frames carry a rolling counter and a CRC (safety-relevant links).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckedLink {
+    WheelAngle,
+    Operator,
+    Imu,
+}
+
+/// The integrity check of one received frame or message: a bad length, CRC, counter or
+/// reassembly. The supervisor counts a checked link's results; every failure is a bad frame.
+/// A frame that fails produces no other input.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FrameCheckInput {
+    pub t: f64,
+    pub source: SourceId,
+    /// The checked link the frame belongs to, if any.
+    pub link: Option<CheckedLink>,
+    pub ok: bool,
+}
+
 /// Anything the controller is told. Adapters produce these; the controller node consumes
 /// them (see the module contract).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -129,6 +220,10 @@ pub enum Input {
     CourseSpeed(CourseSpeedInput),
     Heading(HeadingInput),
     Attitude(AttitudeInput),
+    WheelAngle(WheelAngleInput),
+    WheelSpeed(WheelSpeedInput),
+    Operator(OperatorInput),
+    FrameCheck(FrameCheckInput),
 }
 
 impl Input {
@@ -140,6 +235,10 @@ impl Input {
             Input::CourseSpeed(i) => i.t,
             Input::Heading(i) => i.t,
             Input::Attitude(i) => i.t,
+            Input::WheelAngle(i) => i.t,
+            Input::WheelSpeed(i) => i.t,
+            Input::Operator(i) => i.t,
+            Input::FrameCheck(i) => i.t,
         }
     }
 
@@ -151,6 +250,10 @@ impl Input {
             Input::CourseSpeed(i) => i.source,
             Input::Heading(i) => i.source,
             Input::Attitude(i) => i.source,
+            Input::WheelAngle(i) => i.source,
+            Input::WheelSpeed(i) => i.source,
+            Input::Operator(i) => i.source,
+            Input::FrameCheck(i) => i.source,
         }
     }
 }

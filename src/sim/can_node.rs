@@ -10,10 +10,11 @@
 
 use super::{FixQuality, SimOutput, Simulator};
 use crate::can::codec::{
-    self, CogSogRapid, CounterCheck, DbcMessage, DirectionRequest, ImuAttitude, Packer,
-    PositionRapid, SteeringCommand, VesselHeading, WheelAngle, WheelSpeed,
+    self, CogSogRapid, CogSogRapidCogReference, CounterCheck, DbcMessage, DirectionRequest,
+    DirectionRequestDirection, ImuAttitude, Packer, PositionRapid, SteeringCommand,
+    SteeringCommandMode, VesselHeading, VesselHeadingReference, WheelAngle, WheelAngleStatus,
+    WheelSpeed, WheelSpeedDirection, WheelSpeedKeySwitch,
 };
-use crate::can::direction_request::{REVERSE, STOP};
 use crate::can::fastpacket::split;
 use crate::can::gnss::{north_cw_from_yaw, GnssPosition, METHOD_RTK_FIXED, METHOD_RTK_FLOAT};
 use crate::can::{Frame, TimedFrame};
@@ -181,10 +182,11 @@ impl SimNode {
         };
         if let Some(r) = d.to::<DirectionRequest>() {
             // The tractor obeys: brake to a stop, or head for the cruise speed either way.
-            self.forward = r.direction != STOP && r.direction != REVERSE;
+            use DirectionRequestDirection::{Reverse, Stop};
+            self.forward = !matches!(r.direction, Stop | Reverse);
             let target = match r.direction {
-                x if x == STOP => 0.0,
-                x if x == REVERSE => -self.cruise,
+                Stop => 0.0,
+                Reverse => -self.cruise,
                 _ => self.cruise,
             };
             self.sim.set_speed_target(target);
@@ -197,7 +199,7 @@ impl SimNode {
             self.rejected += 1;
             return;
         }
-        self.engaged = cmd.mode == 1.0;
+        self.engaged = cmd.mode == SteeringCommandMode::Engaged;
         if self.engaged {
             self.sim.set_command(cmd.angle.to_radians());
         } else {
@@ -248,14 +250,14 @@ impl SimNode {
                         heading: Some((heading / 1e-4).floor() * 1e-4),
                         deviation: None,
                         variation: None,
-                        reference: 0.0,
+                        reference: VesselHeadingReference::True,
                     }) {
                         out.push((ts, f));
                     }
                     let speed = m.speed.abs().min(655.32);
                     if let Ok(f) = self.gnss.pack(&CogSogRapid {
                         sid: self.sid as f64,
-                        cog_reference: 0.0,
+                        cog_reference: CogSogRapidCogReference::True,
                         cog: Some((north_cw_from_yaw(m.course) / 1e-4).floor() * 1e-4),
                         sog: Some(speed),
                     }) {
@@ -303,8 +305,12 @@ impl SimNode {
                             speed: Some(v.abs().min(64.254)),
                             distance: Some(self.distance.rem_euclid(4_211_081.0)),
                             max_time_tractor_power: 255.0,
-                            key_switch: 1.0,
-                            direction: if v < 0.0 { 0.0 } else { 1.0 },
+                            key_switch: WheelSpeedKeySwitch::NotOff,
+                            direction: if v < 0.0 {
+                                WheelSpeedDirection::Reverse
+                            } else {
+                                WheelSpeedDirection::Forward
+                            },
                         }) {
                             out.push((ts, f));
                         }
@@ -320,9 +326,9 @@ impl SimNode {
             return;
         }
         let status = if self.scenario.active(FaultKind::OperatorOverride, ts) {
-            2.0
+            WheelAngleStatus::OperatorOverride
         } else {
-            0.0
+            WheelAngleStatus::Ok
         };
         let Ok(mut f) = self.was.pack(&WheelAngle {
             angle: Some(angle.to_degrees().clamp(-90.0, 90.0)),
