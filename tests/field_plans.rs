@@ -138,15 +138,15 @@ mod end_to_end {
                 eprintln!(
                     "{name}: covered {:.5} outside {:.3e} m² intrusions {} turn points outside {} \
                  max curvature {:.4}",
-                    m.covered_fraction,
+                    m.working_area_covered_fraction,
                     m.outside_area_m2,
                     m.obstacle_intrusions,
                     m.turn_points_outside,
                     m.max_curvature
                 );
                 let mut fail = |what: String| failures.push(format!("{name}: {what}"));
-                if m.covered_fraction < 0.995 {
-                    fail(format!("covered {}", m.covered_fraction));
+                if m.working_area_covered_fraction < 0.995 {
+                    fail(format!("covered {}", m.working_area_covered_fraction));
                 }
                 if m.outside_area_m2 >= 1e-6 {
                     fail(format!("outside {} m²", m.outside_area_m2));

@@ -136,6 +136,8 @@ enum Command {
         #[arg(long)]
         json: bool,
         #[command(flatten)]
+        options: plan_cmd::PlanOptions,
+        #[command(flatten)]
         cfg: ConfigArgs,
     },
     /// Plan a manoeuvre with reversing between two poses (local metres) on a map: prints the
@@ -215,8 +217,11 @@ fn main() -> ExitCode {
             config,
             out,
             json,
+            options,
             cfg,
-        } => load_config(&config, &cfg.set).and_then(|c| run_plan(&field, &c, &out, json)),
+        } => {
+            load_config(&config, &cfg.set).and_then(|c| run_plan(&field, &c, &out, json, &options))
+        }
         Command::Dbc { cmd } => dbc_cmd::run(cmd),
         Command::Maneuver {
             config,
@@ -278,8 +283,21 @@ fn main() -> ExitCode {
     }
 }
 
-fn run_plan(field: &Path, cfg: &Config, out: &Path, json: bool) -> Result<u8> {
-    plan_cmd::run(field, cfg, out, json, agsteer::plan::coverage::plan_field)
+fn run_plan(
+    field: &Path,
+    cfg: &Config,
+    out: &Path,
+    json: bool,
+    options: &plan_cmd::PlanOptions,
+) -> Result<u8> {
+    plan_cmd::run(
+        field,
+        cfg,
+        out,
+        json,
+        options,
+        agsteer::plan::coverage::plan_field,
+    )
 }
 
 fn parse_curve(s: &str) -> Result<agsteer::config::CurveChoice, String> {
@@ -455,7 +473,7 @@ fn run_demo(
         let r = &run.report;
         if let Some((fj, p)) = &field {
             println!(
-                "plan of {}: {} cells, {} swaths, {} segments, {:.0} m ({:.0} m work, {:.0} m turns, {:.0} m transit); covered {:.2} % of the working area, outside {:.3} m²; planned in {:.0} ms",
+                "plan of {}: {} cells, {} swaths, {} segments, {:.0} m ({:.0} m work, {:.0} m turns, {:.0} m transit); field worked {:.2} %, outside {:.3} m²; planned in {:.0} ms",
                 fj.title(),
                 p.cells,
                 p.swaths,

@@ -1,14 +1,34 @@
 //! `agsteer plan`: plan coverage of a field (GeoJSON or ISO 11783-10 TASKDATA) and write
-//! `plan.geojson`, `plan.svg` and `metrics.json` into the output directory.
+//! `plan.geojson`, `plan.svg` and `metrics.json` into the output directory; or, with
+//! `--sweep`, plan every field of a directory at several widths and turning radii and report
+//! the independent metrics of each plan.
 
 use agsteer::config::Config;
 use agsteer::field::load_field;
 use agsteer::field::output::{plan_geojson, plan_svg, PlanSummary};
-use agsteer::plan::coverage::metrics::plan_metrics;
+use agsteer::plan::coverage::metrics::checks::{check_plan, ViolationKind};
+use agsteer::plan::coverage::metrics::{area_and_pieces, plan_metrics, unreachable_ground};
 use agsteer::plan::coverage::{CoverageParams, Field, FieldPlan};
 use anyhow::{Context, Result};
-use std::path::Path;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+/// Options of `agsteer plan` besides the field, configuration and output directory.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct PlanOptions {
+    /// Plan every .geojson/.xml field of the directory given as --field (or the one file) at
+    /// every --widths × --r-mins and print the independent metrics of each plan and a summary;
+    /// writes OUT/sweep.json.
+    #[arg(long)]
+    pub sweep: bool,
+    /// Implement widths of the sweep, m.
+    #[arg(long, value_delimiter = ',', default_value = "3,6,12,36")]
+    pub widths: Vec<f64>,
+    /// Turning radii of the sweep, m.
+    #[arg(long, value_delimiter = ',', default_value = "5,8")]
+    pub r_mins: Vec<f64>,
+}
 
 /// Run a step, reporting on stderr if it takes more than a second.
 pub fn timed<T>(what: &str, f: impl FnOnce() -> T) -> (T, Duration) {
@@ -40,11 +60,15 @@ pub fn run<E>(
     cfg: &Config,
     out: &Path,
     json: bool,
-    planner: impl FnOnce(&Field, &CoverageParams) -> Result<FieldPlan, E>,
+    options: &PlanOptions,
+    planner: impl Fn(&Field, &CoverageParams) -> Result<FieldPlan, E>,
 ) -> Result<u8>
 where
     E: std::error::Error + Send + Sync + 'static,
 {
+    if options.sweep {
+        return sweep(field_path, cfg, out, options, planner);
+    }
     let text = std::fs::read_to_string(field_path)
         .with_context(|| format!("reading field {}", field_path.display()))?;
     let loaded = load_field(&text, &cfg.field_load_options())
@@ -79,13 +103,13 @@ where
         println!("{summary_json}");
     } else {
         println!(
-            "{title}: {} cells, {} swaths, {} turns, {:.0} m total; covered {:.2} % of the working area, {:.2} % of the field; outside {:.3} m²; {:.0} ms",
+            "{title}: {} cells, {} swaths, {} turns, {:.0} m total; field worked {:.2} % (working area {:.2} %); outside {:.3} m²; {:.0} ms",
             s.cells,
             s.swaths,
             s.turns,
             s.total_length_m,
             100.0 * s.covered_fraction,
-            100.0 * s.field_covered_fraction,
+            100.0 * s.working_area_covered_fraction,
             s.outside_area_m2,
             s.plan_time_ms
         );
@@ -103,5 +127,229 @@ where
             out.display()
         );
     }
+    Ok(0)
+}
+
+/// One plan of a sweep, by the independent metrics. Fractions 0–1, lengths m, areas m².
+#[derive(Debug, Clone, Serialize)]
+struct SweepRow {
+    field: String,
+    field_ha: f64,
+    line_width_m: f64,
+    r_min_m: f64,
+    headland_passes: usize,
+    /// The planner's error, if it gave no plan.
+    error: Option<String>,
+    swaths: usize,
+    covered_fraction: f64,
+    working_area_covered_fraction: f64,
+    overlap_fraction: f64,
+    unworked_m2: f64,
+    unreachable_m2: f64,
+    unreachable_pieces: usize,
+    outside_area_m2: f64,
+    outside_length_m: f64,
+    obstacle_length_m: f64,
+    obstacle_footprint_m2: f64,
+    /// Violations of the hard guarantees, by kind.
+    outside_violations: usize,
+    obstacle_violations: usize,
+    footprint_violations: usize,
+    curvature_violations: usize,
+    max_curvature_ratio: f64,
+    plan_time_ms: f64,
+}
+
+fn field_files(path: &Path) -> Result<Vec<PathBuf>> {
+    if path.is_file() {
+        return Ok(vec![path.to_path_buf()]);
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(path)
+        .with_context(|| format!("reading directory {}", path.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let n = p.to_string_lossy().to_lowercase();
+            n.ends_with(".geojson") || n.ends_with(".xml")
+        })
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+fn sweep<E>(
+    dir: &Path,
+    cfg: &Config,
+    out: &Path,
+    options: &PlanOptions,
+    planner: impl Fn(&Field, &CoverageParams) -> Result<FieldPlan, E>,
+) -> Result<u8>
+where
+    E: std::error::Error + Send + Sync + 'static,
+{
+    let mut rows = Vec::new();
+    println!(
+        "{:<28} {:>6} {:>4} {:>3} {:>2} {:>8} {:>7} {:>9} {:>9} {:>8} {:>7} {:>7} {:>5} {:>7}",
+        "field",
+        "ha",
+        "w",
+        "r",
+        "hp",
+        "worked%",
+        "overlap",
+        "unworked",
+        "unreach",
+        "out m²",
+        "out m",
+        "obst m",
+        "curv",
+        "ms"
+    );
+    for path in field_files(dir)? {
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default();
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("reading field {}", path.display()))?;
+        let loaded = match load_field(&text, &cfg.field_load_options()) {
+            Ok(l) => l,
+            Err(e) => {
+                println!("{name:<28} not read: {e}");
+                continue;
+            }
+        };
+        let field_ha = loaded.cleanup.area_after_m2 / 1e4;
+        for &w in &options.widths {
+            for &r in &options.r_mins {
+                let mut params = cfg.coverage_params();
+                params.line_width = w;
+                params.r_min = r;
+                let start = Instant::now();
+                let plan = planner(&loaded.field, &params);
+                let plan_time_ms = start.elapsed().as_secs_f64() * 1e3;
+                let mut row = SweepRow {
+                    field: name.clone(),
+                    field_ha,
+                    line_width_m: w,
+                    r_min_m: r,
+                    headland_passes: params.headland_passes,
+                    error: None,
+                    swaths: 0,
+                    covered_fraction: 0.0,
+                    working_area_covered_fraction: 0.0,
+                    overlap_fraction: 0.0,
+                    unworked_m2: loaded.cleanup.area_after_m2,
+                    unreachable_m2: 0.0,
+                    unreachable_pieces: 0,
+                    outside_area_m2: 0.0,
+                    outside_length_m: 0.0,
+                    obstacle_length_m: 0.0,
+                    obstacle_footprint_m2: 0.0,
+                    outside_violations: 0,
+                    obstacle_violations: 0,
+                    footprint_violations: 0,
+                    curvature_violations: 0,
+                    max_curvature_ratio: 0.0,
+                    plan_time_ms,
+                };
+                let (unreachable_m2, unreachable_pieces) =
+                    area_and_pieces(&unreachable_ground(&loaded.field, w, r), 1.0);
+                row.unreachable_m2 = unreachable_m2;
+                row.unreachable_pieces = unreachable_pieces;
+                match plan {
+                    Err(e) => row.error = Some(e.to_string()),
+                    Ok(plan) => {
+                        let m = plan_metrics(&loaded.field, &plan, w);
+                        let v = check_plan(&loaded.field, &plan, w, r);
+                        let count = |k: ViolationKind| v.iter().filter(|x| x.kind == k).count();
+                        row.swaths = plan.swaths;
+                        row.covered_fraction = m.covered_fraction;
+                        row.working_area_covered_fraction = m.working_area_covered_fraction;
+                        row.overlap_fraction = m.overlap_fraction;
+                        row.unworked_m2 = m.unworked_area_m2;
+                        row.outside_area_m2 = m.outside_area_m2;
+                        row.outside_length_m = m.outside_length_m;
+                        row.obstacle_length_m = m.obstacle_length_m;
+                        row.obstacle_footprint_m2 = m.obstacle_footprint_m2;
+                        row.outside_violations = count(ViolationKind::OutsideBoundary);
+                        row.obstacle_violations = count(ViolationKind::InsideObstacle);
+                        row.footprint_violations = count(ViolationKind::FootprintNotClear);
+                        row.curvature_violations = count(ViolationKind::Curvature);
+                        row.max_curvature_ratio = m.max_curvature * r;
+                    }
+                }
+                let worked = match &row.error {
+                    Some(e) => format!("error: {e}"),
+                    None => format!("{:.2}", 100.0 * row.covered_fraction),
+                };
+                println!(
+                    "{:<28} {:>6.2} {:>4} {:>3} {:>2} {:>8} {:>7.4} {:>9.1} {:>9.1} {:>8.1} {:>7.1} {:>7.1} {:>5} {:>7.1}",
+                    row.field,
+                    row.field_ha,
+                    w,
+                    r,
+                    row.headland_passes,
+                    worked,
+                    row.overlap_fraction,
+                    row.unworked_m2,
+                    row.unreachable_m2,
+                    row.outside_area_m2,
+                    row.outside_length_m,
+                    row.obstacle_length_m,
+                    row.curvature_violations,
+                    row.plan_time_ms
+                );
+                rows.push(row);
+            }
+        }
+    }
+    let mut worked: Vec<f64> = rows.iter().map(|r| r.covered_fraction).collect();
+    let min = worked.iter().copied().fold(f64::INFINITY, f64::min);
+    let med = median(&mut worked);
+    let max_overlap = rows.iter().map(|r| r.overlap_fraction).fold(0.0, f64::max);
+    let errors = rows.iter().filter(|r| r.error.is_some()).count();
+    let violating = rows
+        .iter()
+        .filter(|r| {
+            r.outside_violations
+                + r.obstacle_violations
+                + r.footprint_violations
+                + r.curvature_violations
+                > 0
+        })
+        .count();
+    let worst = rows
+        .iter()
+        .filter(|r| r.field_ha <= 100.0)
+        .max_by(|a, b| a.plan_time_ms.total_cmp(&b.plan_time_ms));
+    println!(
+        "{} plans: field worked median {:.2} %, min {:.2} %; overlap max {:.2} %; {} plans with violations; {} errors",
+        rows.len(),
+        100.0 * med,
+        100.0 * min,
+        100.0 * max_overlap,
+        violating,
+        errors
+    );
+    if let Some(w) = worst {
+        println!(
+            "slowest plan of a field ≤ 100 ha: {:.1} ms ({} at w {} m, r_min {} m)",
+            w.plan_time_ms, w.field, w.line_width_m, w.r_min_m
+        );
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let path = out.join("sweep.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&rows)? + "\n")
+        .with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {}", path.display());
     Ok(0)
 }

@@ -6,6 +6,8 @@
 //! implement's edge is square to the path) and round joins, by `geo`'s buffer; all the
 //! segments of one kind are stroked and merged in one sweep.
 
+pub mod checks;
+
 use super::{Field, FieldPlan, PlanSegment, SegmentKind};
 use crate::geo::polygon::{contains_point, point_segment_distance};
 use crate::geo::{cross, Vec2};
@@ -25,17 +27,27 @@ pub struct PlanMetrics {
     pub working_area_m2: f64,
     /// Area of the field (boundary minus obstacles), m².
     pub field_area_m2: f64,
-    /// Union of the work and detour footprints ∩ working area, over the working area.
+    /// The whole field worked: union of the work, detour and headland footprints ∩ field, over
+    /// the field area (boundary minus obstacles).
     pub covered_fraction: f64,
-    /// Union of the work, detour and headland footprints ∩ field, over the field area.
-    pub field_covered_fraction: f64,
+    /// Union of the work and detour footprints ∩ working area, over the working area.
+    pub working_area_covered_fraction: f64,
+    /// Field area no working footprint covers (field − work, detour and headland footprints),
+    /// m².
+    pub unworked_area_m2: f64,
     /// (Σ footprint areas of the working passes − area of their union) / area of the union,
     /// for work, detour and headland segments.
     pub overlap_fraction: f64,
     /// Footprint of every segment (all kinds) outside the field boundary, m².
     pub outside_area_m2: f64,
+    /// Length of path (all kinds) outside the field boundary, m.
+    pub outside_length_m: f64,
     /// Path points (all kinds) inside an obstacle inflated by `line_width/2`.
     pub obstacle_intrusions: usize,
+    /// Length of path (all kinds) inside an obstacle, m.
+    pub obstacle_length_m: f64,
+    /// Footprint of the working passes (work, detour, headland) inside obstacles, m².
+    pub obstacle_footprint_m2: f64,
     /// Largest three-point curvature over all segments, 1/m.
     pub max_curvature: f64,
     /// Largest three-point curvature of each segment, in plan order, 1/m.
@@ -167,14 +179,30 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
     let all_fp = footprint(plan.segments.iter(), line_width);
 
     let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
-    let covered_fraction = ratio(
+    let working_area_covered_fraction = ratio(
         work_fp.intersection(&working).unsigned_area(),
         working_area_m2,
     );
-    let field_covered_fraction = ratio(
-        passes_fp.intersection(&field_poly).unsigned_area(),
-        field_area_m2,
+    let worked_m2 = passes_fp.intersection(&field_poly).unsigned_area();
+    let covered_fraction = ratio(worked_m2, field_area_m2);
+    let unworked_area_m2 = (field_area_m2 - worked_m2).max(0.0);
+    let obstacle_footprint_m2 = passes_fp.intersection(&obstacles).unsigned_area();
+    let paths = MultiLineString::new(
+        plan.segments
+            .iter()
+            .map(|s| merged(&s.points))
+            .filter(|pts| pts.len() >= 2)
+            .map(|pts| LineString::new(pts.iter().map(coord).collect()))
+            .collect(),
     );
+    let length = |m: &MultiLineString<f64>| -> f64 {
+        use geo::{Euclidean, Length};
+        m.0.iter()
+            .map(|l| Euclidean.length(l))
+            .fold(0.0, |a, b| a + b)
+    };
+    let outside_length_m = length(&boundary_poly.clip(&paths, true));
+    let obstacle_length_m = length(&obstacles.clip(&paths, false));
     let sum_single: f64 = of(plan, &[Work, Detour, Headland])
         .map(|s| footprint(std::iter::once(s), line_width).unsigned_area())
         .sum();
@@ -225,10 +253,14 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
         working_area_m2,
         field_area_m2,
         covered_fraction,
-        field_covered_fraction,
+        working_area_covered_fraction,
+        unworked_area_m2,
         overlap_fraction,
         outside_area_m2,
+        outside_length_m,
         obstacle_intrusions,
+        obstacle_length_m,
+        obstacle_footprint_m2,
         max_curvature: segment_max_curvature.iter().copied().fold(0.0, f64::max),
         segment_max_curvature,
         turn_points_outside,
@@ -245,6 +277,47 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
         turns: plan.segments.iter().filter(|s| s.kind == Turn).count(),
         reversals,
     }
+}
+
+/// The field (boundary minus obstacles) as a `geo` multipolygon.
+pub fn field_polygon(field: &Field) -> MultiPolygon<f64> {
+    MultiPolygon::new(vec![to_geo_polygon(&field.boundary, &field.obstacles)])
+}
+
+/// Ground of the field that no working footprint (work, detour, headland) covers.
+pub fn unworked_ground(field: &Field, plan: &FieldPlan, line_width: f64) -> MultiPolygon<f64> {
+    use SegmentKind::*;
+    let passes = plan
+        .segments
+        .iter()
+        .filter(|s| matches!(s.kind, Work | Detour | Headland));
+    field_polygon(field).difference(&footprint(passes, line_width))
+}
+
+/// Ground the implement cannot reach driving forward and turning no tighter than `r_min`:
+/// the field minus its opening by `r_min + line_width/2` (the union of every disc of that
+/// radius inside the field). A pass rounding a convex corner on an arc of radius `r_min`
+/// sweeps exactly such a disc's edge with the outer edge of its footprint, so what lies
+/// outside every such disc (sharp corners, necks narrower than the disc) is left to hand work
+/// or to reversing manoeuvres.
+pub fn unreachable_ground(field: &Field, line_width: f64, r_min: f64) -> MultiPolygon<f64> {
+    let radius = r_min + 0.5 * line_width;
+    let f = field_polygon(field);
+    let style = |d: f64| BufferStyle::new(d).line_join(LineJoin::Round(JOIN_ANGLE));
+    let opened = f
+        .buffer_with_style(style(-radius))
+        .buffer_with_style(style(radius));
+    f.difference(&opened)
+}
+
+/// Area (m²) and number of pieces of at least `min_piece_m2` of a multipolygon.
+pub fn area_and_pieces(mp: &MultiPolygon<f64>, min_piece_m2: f64) -> (f64, usize) {
+    let area = mp.unsigned_area();
+    let pieces =
+        mp.0.iter()
+            .filter(|p| p.unsigned_area() >= min_piece_m2)
+            .count();
+    (area, pieces)
 }
 
 #[cfg(test)]

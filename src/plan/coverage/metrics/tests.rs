@@ -47,7 +47,7 @@ fn exact_cover_has_full_coverage_no_overlap_nothing_outside() {
         "{}",
         m.covered_fraction
     );
-    assert!((m.field_covered_fraction - 1.0).abs() < 1e-9);
+    assert!((m.working_area_covered_fraction - 1.0).abs() < 1e-9);
     assert!(m.overlap_fraction.abs() < 1e-9, "{}", m.overlap_fraction);
     assert!(m.outside_area_m2 < 1e-6, "{}", m.outside_area_m2);
     assert!((m.work_length_m - 600.0).abs() < 1e-9);
