@@ -162,6 +162,8 @@ fn parse_with<C>(text: &str, coord: Coord<C>) -> Result<Parsed<C>, FieldError> {
         name: None,
         boundaries: Vec::new(),
         obstacles: Vec::new(),
+        guidance: Vec::new(),
+        warnings: Vec::new(),
     };
     let mut add = |index: Option<usize>, feature: &Value, geom: Option<&Value>| {
         let name = label(index, feature);

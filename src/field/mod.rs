@@ -24,6 +24,7 @@ mod taskdata;
 
 pub use clean::{clean_ring, RingCleanup};
 pub use job::{FieldJob, FieldJobError};
+pub use taskdata::{GuidanceKind, PartfieldInfo};
 
 use crate::geo::polygon::{contains_point, segments_intersect, signed_area};
 use crate::geo::wgs84::{EnuFrame, LatLon};
@@ -83,6 +84,30 @@ pub struct LoadedField {
     pub origin: LatLon,
     pub field: Field,
     pub cleanup: CleanupReport,
+    /// Guidance patterns of the field (TASKDATA GGP/GPN), local metres.
+    pub guidance: Vec<GuidanceLine>,
+    /// What was skipped or changed while reading (unused PLN/LSG types, obstacles cut out of
+    /// the boundary, …), one sentence each naming the element.
+    pub warnings: Vec<String>,
+}
+
+/// A guidance pattern read with a field: an AB line (two points) or a reference curve.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GuidanceLine {
+    /// The element it came from (PFD, GPN id and designator).
+    pub name: String,
+    pub kind: GuidanceKind,
+    /// Points in order, local ENU metres.
+    pub points: Vec<Vec2>,
+}
+
+impl GuidanceLine {
+    /// Direction from the first to the last point, rad CCW from East.
+    pub fn heading(&self) -> Option<f64> {
+        let (a, b) = (self.points.first()?, self.points.last()?);
+        let d = b - a;
+        (d.norm() > 1e-6).then(|| d.y.atan2(d.x))
+    }
 }
 
 impl LoadedField {
@@ -125,6 +150,50 @@ pub enum FieldError {
     NoBoundary,
     #[error("{count} boundary polygons found ({features}); exactly one field boundary is supported (mark the others \"obstacle\": true or split the file)")]
     SeveralBoundaries { count: usize, features: String },
+    #[error("{count} fields with a boundary in the file ({fields}); choose one by its id or name (agsteer plan --list shows them, --field-id chooses)")]
+    SeveralFields { count: usize, fields: String },
+    #[error("no field \"{wanted}\" in the file (by PFD id or name); the file holds: {available}")]
+    NoSuchField { wanted: String, available: String },
+    #[error("text encoding: {0}")]
+    Encoding(String),
+    #[error("TASKDATA.XML names the external file {name}.XML (XFR), which is missing")]
+    MissingExternal { name: String },
+}
+
+/// The text of a field file from its bytes: UTF-8 with or without a byte-order mark, or
+/// UTF-16 (little or big endian, with a byte-order mark or starting with '<').
+pub fn decode_text(bytes: &[u8]) -> Result<String, FieldError> {
+    let utf16 = |body: &[u8], little: bool| -> Result<String, FieldError> {
+        if body.len() % 2 != 0 {
+            return Err(FieldError::Encoding(format!(
+                "UTF-16 text of odd length ({} bytes)",
+                body.len()
+            )));
+        }
+        let units: Vec<u16> = body
+            .chunks_exact(2)
+            .map(|c| {
+                if little {
+                    u16::from_le_bytes([c[0], c[1]])
+                } else {
+                    u16::from_be_bytes([c[0], c[1]])
+                }
+            })
+            .collect();
+        String::from_utf16(&units).map_err(|e| FieldError::Encoding(format!("UTF-16: {e}")))
+    };
+    match bytes {
+        [0xEF, 0xBB, 0xBF, rest @ ..] => std::str::from_utf8(rest)
+            .map(str::to_string)
+            .map_err(|e| FieldError::Encoding(format!("UTF-8: {e}"))),
+        [0xFF, 0xFE, rest @ ..] => utf16(rest, true),
+        [0xFE, 0xFF, rest @ ..] => utf16(rest, false),
+        [b'<', 0, ..] => utf16(bytes, true),
+        [0, b'<', ..] => utf16(bytes, false),
+        _ => std::str::from_utf8(bytes)
+            .map(str::to_string)
+            .map_err(|e| FieldError::Encoding(format!("UTF-8: {e}"))),
+    }
 }
 
 /// A map in local metres for manoeuvres: GeoJSON with `[x, y]` positions in metres (no
@@ -162,31 +231,76 @@ pub(crate) struct RawPolygon<C = LatLon> {
     pub holes: Vec<Vec<C>>,
 }
 
-/// Load a field from GeoJSON or TASKDATA text, chosen by the first non-blank character.
+/// A guidance pattern as read, before projection.
+#[derive(Debug, Clone)]
+pub(crate) struct RawGuidance {
+    pub label: String,
+    pub kind: GuidanceKind,
+    pub points: Vec<LatLon>,
+}
+
+/// Load a field from GeoJSON or TASKDATA text, chosen by the first non-blank character (a
+/// byte-order mark is skipped). A TASKDATA file must hold one field with a boundary; see
+/// [`load_field_with`] for external files and for choosing one of several.
 pub fn load_field(text: &str, options: &LoadOptions) -> Result<LoadedField, FieldError> {
+    load_field_with(text, &[], None, options)
+}
+
+/// [`load_field`] with the external partfield files a TASKDATA.XML names
+/// ([`external_partfield_files`]; (name, text) pairs, read by the caller) and the partfield to
+/// read (its id or designator; `None` = the only one with a boundary).
+pub fn load_field_with(
+    text: &str,
+    externals: &[(String, String)],
+    select: Option<&str>,
+    options: &LoadOptions,
+) -> Result<LoadedField, FieldError> {
+    let text = text.trim_start_matches('\u{feff}');
     match text.trim_start().chars().next() {
         Some('{') => load_geojson(text, options),
-        Some('<') => load_taskdata(text, options),
+        Some('<') => {
+            let parsed = taskdata::parse(text, externals, select)?;
+            assemble(parsed, options)
+        }
         _ => Err(FieldError::UnknownFormat),
     }
 }
 
+/// The external files (XFR, e.g. "PFD00000" for `PFD00000.XML`) of a TASKDATA.XML that hold
+/// partfields; empty for GeoJSON.
+pub fn external_partfield_files(text: &str) -> Result<Vec<String>, FieldError> {
+    let text = text.trim_start_matches('\u{feff}');
+    if text.trim_start().starts_with('<') {
+        taskdata::external_partfield_files(text)
+    } else {
+        Ok(Vec::new())
+    }
+}
+
+/// Every partfield of a TASKDATA file (and its external partfield files).
+pub fn list_fields(
+    text: &str,
+    externals: &[(String, String)],
+) -> Result<Vec<PartfieldInfo>, FieldError> {
+    taskdata::list(text.trim_start_matches('\u{feff}'), externals)
+}
+
 /// Load a field from GeoJSON text (see the module docs).
 pub fn load_geojson(text: &str, options: &LoadOptions) -> Result<LoadedField, FieldError> {
-    let parsed = geojson::parse(text)?;
-    assemble(parsed.name, parsed.boundaries, parsed.obstacles, options)
+    assemble(geojson::parse(text)?, options)
 }
 
 /// Load a field from ISO 11783-10 TASKDATA.XML text (see the module docs).
 pub fn load_taskdata(text: &str, options: &LoadOptions) -> Result<LoadedField, FieldError> {
-    let parsed = taskdata::parse(text)?;
-    assemble(parsed.name, parsed.boundaries, parsed.obstacles, options)
+    assemble(taskdata::parse(text, &[], None)?, options)
 }
 
 pub(crate) struct Parsed<C = LatLon> {
     pub name: Option<String>,
     pub boundaries: Vec<RawPolygon<C>>,
     pub obstacles: Vec<RawPolygon<C>>,
+    pub guidance: Vec<RawGuidance>,
+    pub warnings: Vec<String>,
 }
 
 pub(crate) fn check_coordinate(feature: &str, lat: f64, lon: f64) -> Result<LatLon, FieldError> {
@@ -305,12 +419,14 @@ fn ring_inside(inner: &[Vec2], outer: &[Vec2]) -> bool {
     true
 }
 
-fn assemble(
-    name: Option<String>,
-    boundaries: Vec<RawPolygon>,
-    mut obstacles: Vec<RawPolygon>,
-    options: &LoadOptions,
-) -> Result<LoadedField, FieldError> {
+fn assemble(parsed: Parsed, options: &LoadOptions) -> Result<LoadedField, FieldError> {
+    let Parsed {
+        name,
+        boundaries,
+        mut obstacles,
+        guidance,
+        mut warnings,
+    } = parsed;
     let boundary = single_boundary(boundaries)?;
     let origin = options
         .origin
@@ -323,7 +439,7 @@ fn assemble(
             ..Default::default()
         },
     };
-    let (outer, a_before, a_after) = acc.ring(
+    let (mut outer, a_before, a_after) = acc.ring(
         &frame,
         &boundary.exterior,
         &boundary.label,
@@ -349,14 +465,39 @@ fn assemble(
             tol,
         )?;
         if !ring_inside(&ring, &outer) {
-            return Err(FieldError::ObstacleOutside {
-                feature: obstacle.label.clone(),
-            });
+            // Parcels often exclude a pond or a farmyard that touches their edge: cut it out
+            // of the boundary. One wholly outside is not the field's.
+            match cut_out(&outer, &ring) {
+                Some(cut) => {
+                    let removed = signed_area(&outer) - signed_area(&cut);
+                    warnings.push(format!(
+                        "{}: obstacle touches or crosses the boundary; cut out of the field ({removed:.1} m²)",
+                        obstacle.label
+                    ));
+                    area_before -= removed;
+                    area_after -= removed;
+                    outer = cut;
+                }
+                None => {
+                    return Err(FieldError::ObstacleOutside {
+                        feature: obstacle.label.clone(),
+                    })
+                }
+            }
+            continue;
         }
         area_before -= before;
         area_after -= after;
         field_obstacles.push(ring);
     }
+    // A boundary cut after some obstacles were kept may now cross them: keep those inside.
+    field_obstacles.retain(|o| ring_inside(o, &outer));
+    let frame_guidance = |g: &RawGuidance| GuidanceLine {
+        name: g.label.clone(),
+        kind: g.kind,
+        points: g.points.iter().map(|p| frame.to_enu(*p)).collect(),
+    };
+    let guidance: Vec<GuidanceLine> = guidance.iter().map(frame_guidance).collect();
     let mut report = acc.report;
     report.area_before_m2 = area_before;
     report.area_after_m2 = area_after;
@@ -375,7 +516,26 @@ fn assemble(
             obstacles: field_obstacles,
         },
         cleanup: report,
+        guidance,
+        warnings,
     })
+}
+
+/// `outer` minus `cut` when they overlap: the largest remaining piece, CCW, without holes
+/// (`None` when they do not overlap or nothing is left).
+fn cut_out(outer: &[Vec2], cut: &[Vec2]) -> Option<Vec<Vec2>> {
+    use crate::plan::coverage::geometry::{from_geo, to_geo};
+    use geo::BooleanOps;
+    let a = to_geo(&(outer.to_vec(), vec![]));
+    let b = to_geo(&(cut.to_vec(), vec![]));
+    if a.intersection(&b).0.is_empty() {
+        return None;
+    }
+    let rest = from_geo(&a.difference(&b));
+    rest.into_iter()
+        .map(|(ring, _)| ring)
+        .max_by(|x, y| signed_area(x).total_cmp(&signed_area(y)))
+        .filter(|r| r.len() >= 3)
 }
 
 #[cfg(test)]

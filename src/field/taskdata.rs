@@ -1,6 +1,15 @@
-//! ISO 11783-10 `TASKDATA.XML` partfield reader (PFD → PLN → LSG → PNT).
+//! ISO 11783-10 `TASKDATA.XML` partfield reader (PFD → PLN → LSG → PNT; GGP → GPN → LSG),
+//! as terminals and farm software write it: partfields in the main file or in external files
+//! (`XFR A="PFD00000"` → `PFD00000.XML`, root `XFC`), several partfields in one file, types
+//! this reader has no use for skipped with a warning naming them.
+//!
+//! Codes (ISO 11783-10 PLN A, LSG A, GPN C): PLN 1 partfield boundary, 2 treatment zone,
+//! 3 water surface, 4 building, 5 road, 6 obstacle, 7 flag, 8 other, 9 mainfield, 10 headland,
+//! 11 buffer zone, 12 windbreak; LSG 1 polygon exterior, 2 polygon interior, 3 tram line,
+//! 4 sampling route, 5 guidance pattern, 6 drainage, 7 fence, 8 flag, 9 obstacle; GPN 1 AB,
+//! 2 A+, 3 curve, 4 pivot, 5 spiral.
 
-use super::{check_coordinate, FieldError, Parsed, RawPolygon};
+use super::{check_coordinate, FieldError, Parsed, RawGuidance, RawPolygon};
 use crate::geo::wgs84::LatLon;
 use roxmltree::{Document, Node};
 
@@ -8,22 +17,92 @@ use roxmltree::{Document, Node};
 const PLN_BOUNDARY: &str = "1";
 /// PLN types that are obstacles to driving: 3 water, 4 building, 6 obstacle, 12 windbreak.
 const PLN_OBSTACLES: [&str; 4] = ["3", "4", "6", "12"];
-/// LSG type A: 1 polygon exterior, 2 polygon interior.
+/// LSG type A: 1 polygon exterior, 2 polygon interior, 5 guidance pattern.
 const LSG_EXTERIOR: &str = "1";
 const LSG_INTERIOR: &str = "2";
+const LSG_GUIDANCE: &str = "5";
 
-fn node_label(node: &Node, what: &str, index: usize) -> String {
-    let mut s = format!("{what} {index}");
-    if let Some(id) = node.attribute("A").filter(|_| what == "PFD") {
-        s.push_str(&format!(" (id {id})"));
+fn pln_type_name(t: &str) -> &'static str {
+    match t {
+        "1" => "partfield boundary",
+        "2" => "treatment zone",
+        "3" => "water surface",
+        "4" => "building",
+        "5" => "road",
+        "6" => "obstacle",
+        "7" => "flag",
+        "8" => "other",
+        "9" => "mainfield",
+        "10" => "headland",
+        "11" => "buffer zone",
+        "12" => "windbreak",
+        _ => "unknown type",
     }
-    if let Some(name) = node.attribute("B").filter(|_| what == "PLN") {
-        s.push_str(&format!(" \"{name}\""));
+}
+
+fn lsg_type_name(t: &str) -> &'static str {
+    match t {
+        "1" => "polygon exterior",
+        "2" => "polygon interior",
+        "3" => "tram line",
+        "4" => "sampling route",
+        "5" => "guidance pattern",
+        "6" => "drainage",
+        "7" => "fence",
+        "8" => "flag",
+        "9" => "obstacle",
+        _ => "unknown type",
     }
-    if let Some(name) = node.attribute("C").filter(|_| what == "PFD") {
-        s.push_str(&format!(" \"{name}\""));
+}
+
+/// Kind of a guidance pattern (GPN attribute C).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GuidanceKind {
+    /// Type 1: a straight AB line.
+    AbLine,
+    /// Type 2: A plus a heading.
+    APlus,
+    /// Type 3: a reference curve.
+    Curve,
+    /// Type 4: a pivot.
+    Pivot,
+    /// Type 5: a spiral.
+    Spiral,
+    /// Anything else.
+    Other,
+}
+
+impl GuidanceKind {
+    fn from_code(code: Option<&str>) -> Self {
+        match code.map(str::trim) {
+            Some("1") => GuidanceKind::AbLine,
+            Some("2") => GuidanceKind::APlus,
+            Some("3") => GuidanceKind::Curve,
+            Some("4") => GuidanceKind::Pivot,
+            Some("5") => GuidanceKind::Spiral,
+            _ => GuidanceKind::Other,
+        }
     }
-    s
+}
+
+/// One partfield of a TASKDATA file, as `agsteer plan --list` shows it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PartfieldInfo {
+    /// PFD attribute A (e.g. "PFD1").
+    pub id: String,
+    /// PFD attribute C, the name the farmer gave it.
+    pub designator: Option<String>,
+    /// PFD attribute D, the area the file states, m².
+    pub stated_area_m2: Option<f64>,
+    /// The file holding it ("TASKDATA.XML" or the external file's name).
+    pub file: String,
+    /// Boundary polygons (PLN type 1 with an exterior).
+    pub boundaries: usize,
+    /// Obstacle polygons (PLN types 3, 4, 6, 12 with an exterior).
+    pub obstacles: usize,
+    /// Guidance patterns (GPN).
+    pub guidance_patterns: usize,
 }
 
 fn ring(feature: &str, lsg: &Node) -> Result<Vec<LatLon>, FieldError> {
@@ -44,58 +123,221 @@ fn ring(feature: &str, lsg: &Node) -> Result<Vec<LatLon>, FieldError> {
         .collect()
 }
 
-fn polygon(feature: &str, pln: &Node) -> Result<RawPolygon, FieldError> {
+/// The polygon of a PLN: its exterior and interior LSGs; other LSG types are skipped with a
+/// warning. `None` (with a warning) when it has no exterior.
+fn polygon(
+    feature: &str,
+    pln: &Node,
+    warnings: &mut Vec<String>,
+) -> Result<Option<RawPolygon>, FieldError> {
     let mut exterior = None;
     let mut holes = Vec::new();
-    for lsg in pln.children().filter(|n| n.has_tag_name("LSG")) {
-        match lsg.attribute("A") {
-            Some(LSG_EXTERIOR) if exterior.is_none() => exterior = Some(ring(feature, &lsg)?),
-            Some(LSG_EXTERIOR) => {
+    for (k, lsg) in pln.children().filter(|n| n.has_tag_name("LSG")).enumerate() {
+        let t = lsg.attribute("A").unwrap_or("").trim();
+        match t {
+            LSG_EXTERIOR if exterior.is_none() => exterior = Some(ring(feature, &lsg)?),
+            LSG_EXTERIOR => {
                 return Err(FieldError::NotAPolygon {
                     feature: feature.to_string(),
                     detail: "more than one exterior LSG".into(),
                 })
             }
-            Some(LSG_INTERIOR) => holes.push(ring(feature, &lsg)?),
-            _ => {}
+            LSG_INTERIOR => holes.push(ring(feature, &lsg)?),
+            other => warnings.push(format!(
+                "{feature}: LSG {k} of type {other} ({}) skipped",
+                lsg_type_name(other)
+            )),
         }
     }
-    let exterior = exterior.ok_or_else(|| FieldError::NotAPolygon {
-        feature: feature.to_string(),
-        detail: "PLN without an exterior LSG (A=\"1\")".into(),
-    })?;
-    Ok(RawPolygon {
+    let Some(exterior) = exterior else {
+        warnings.push(format!(
+            "{feature}: no polygon exterior (LSG A=\"1\"), skipped"
+        ));
+        return Ok(None);
+    };
+    Ok(Some(RawPolygon {
         label: feature.to_string(),
         exterior,
         holes,
-    })
+    }))
 }
 
-pub(crate) fn parse(text: &str) -> Result<Parsed, FieldError> {
-    let doc = Document::parse(text).map_err(|e| FieldError::Xml(e.to_string()))?;
-    let mut out = Parsed {
-        name: None,
-        boundaries: Vec::new(),
-        obstacles: Vec::new(),
+fn pfd_label(pfd: &Node) -> String {
+    let id = pfd.attribute("A").unwrap_or("?");
+    let mut s = if id.to_ascii_uppercase().starts_with("PFD") {
+        id.to_string()
+    } else {
+        format!("PFD {id}")
     };
-    let pfds = doc.descendants().filter(|n| n.has_tag_name("PFD"));
-    for (i, pfd) in pfds.enumerate() {
-        let pfd_label = node_label(&pfd, "PFD", i);
-        let mut boundaries = Vec::new();
-        let mut obstacles = Vec::new();
-        for (j, pln) in pfd.children().filter(|n| n.has_tag_name("PLN")).enumerate() {
-            let label = format!("{pfd_label} {}", node_label(&pln, "PLN", j));
-            match pln.attribute("A") {
-                Some(PLN_BOUNDARY) => boundaries.push(polygon(&label, &pln)?),
-                Some(t) if PLN_OBSTACLES.contains(&t) => obstacles.push(polygon(&label, &pln)?),
-                _ => {}
+    if let Some(name) = pfd.attribute("C") {
+        s.push_str(&format!(" \"{name}\""));
+    }
+    s
+}
+
+/// Names of the external files (XFR attribute A, e.g. "PFD00000") that hold partfields; the
+/// caller reads `NAME.XML` next to TASKDATA.XML and passes its text to [`parse`].
+pub fn external_partfield_files(text: &str) -> Result<Vec<String>, FieldError> {
+    let doc = Document::parse(text).map_err(|e| FieldError::Xml(e.to_string()))?;
+    Ok(doc
+        .root_element()
+        .children()
+        .filter(|n| n.has_tag_name("XFR"))
+        .filter_map(|n| n.attribute("A"))
+        .filter(|a| a.trim().to_ascii_uppercase().starts_with("PFD"))
+        .map(|a| a.trim().to_string())
+        .collect())
+}
+
+/// Every PFD of the main document and of the external files, with the name of its file.
+fn documents<'a>(
+    text: &'a str,
+    externals: &'a [(String, String)],
+) -> Result<Vec<(String, Document<'a>)>, FieldError> {
+    let mut docs = vec![(
+        "TASKDATA.XML".to_string(),
+        Document::parse(text).map_err(|e| FieldError::Xml(e.to_string()))?,
+    )];
+    for (name, body) in externals {
+        let doc = Document::parse(body)
+            .map_err(|e| FieldError::Xml(format!("external file {name}.XML: {e}")))?;
+        docs.push((format!("{name}.XML"), doc));
+    }
+    Ok(docs)
+}
+
+/// The partfields of a TASKDATA file and its external partfield files.
+pub fn list(text: &str, externals: &[(String, String)]) -> Result<Vec<PartfieldInfo>, FieldError> {
+    let docs = documents(text, externals)?;
+    let mut out = Vec::new();
+    for (file, doc) in &docs {
+        for pfd in doc.descendants().filter(|n| n.has_tag_name("PFD")) {
+            let plns: Vec<Node> = pfd.children().filter(|n| n.has_tag_name("PLN")).collect();
+            let with_exterior = |types: &[&str]| {
+                plns.iter()
+                    .filter(|p| types.contains(&p.attribute("A").unwrap_or("").trim()))
+                    .filter(|p| {
+                        p.children()
+                            .any(|l| l.has_tag_name("LSG") && l.attribute("A") == Some("1"))
+                    })
+                    .count()
+            };
+            out.push(PartfieldInfo {
+                id: pfd.attribute("A").unwrap_or("").to_string(),
+                designator: pfd.attribute("C").map(str::to_string),
+                stated_area_m2: pfd.attribute("D").and_then(|d| d.trim().parse().ok()),
+                file: file.clone(),
+                boundaries: with_exterior(&[PLN_BOUNDARY]),
+                obstacles: with_exterior(&PLN_OBSTACLES),
+                guidance_patterns: pfd.descendants().filter(|n| n.has_tag_name("GPN")).count(),
+            });
+        }
+    }
+    Ok(out)
+}
+
+fn guidance(pfd: &Node, label: &str) -> Result<Vec<RawGuidance>, FieldError> {
+    let mut out = Vec::new();
+    for gpn in pfd.descendants().filter(|n| n.has_tag_name("GPN")) {
+        let name = format!(
+            "{label} GPN {}{}",
+            gpn.attribute("A").unwrap_or("?"),
+            gpn.attribute("B")
+                .map(|b| format!(" \"{b}\""))
+                .unwrap_or_default()
+        );
+        let Some(lsg) = gpn.children().find(|n| {
+            n.has_tag_name("LSG") && n.attribute("A").map(str::trim) == Some(LSG_GUIDANCE)
+        }) else {
+            continue;
+        };
+        let points = ring(&name, &lsg)?;
+        if points.len() >= 2 {
+            out.push(RawGuidance {
+                label: name,
+                kind: GuidanceKind::from_code(gpn.attribute("C")),
+                points,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Read the partfield `select` (its id, PFD attribute A, or its designator, attribute C) or,
+/// without one, the only partfield that has a boundary.
+pub(crate) fn parse(
+    text: &str,
+    externals: &[(String, String)],
+    select: Option<&str>,
+) -> Result<Parsed, FieldError> {
+    let docs = documents(text, externals)?;
+    let pfds: Vec<Node> = docs
+        .iter()
+        .flat_map(|(_, d)| d.descendants().filter(|n| n.has_tag_name("PFD")))
+        .collect();
+    let has_boundary = |pfd: &Node| {
+        pfd.children()
+            .any(|n| n.has_tag_name("PLN") && n.attribute("A").map(str::trim) == Some(PLN_BOUNDARY))
+    };
+    let names = |it: &mut dyn Iterator<Item = &Node>| -> String {
+        it.map(pfd_label).collect::<Vec<_>>().join(", ")
+    };
+    let chosen = match select.map(str::trim) {
+        Some(want) => pfds
+            .iter()
+            .find(|p| p.attribute("A").map(str::trim) == Some(want))
+            .or_else(|| {
+                pfds.iter().find(|p| {
+                    p.attribute("C")
+                        .is_some_and(|c| c.trim().eq_ignore_ascii_case(want))
+                })
+            })
+            .ok_or_else(|| FieldError::NoSuchField {
+                wanted: want.to_string(),
+                available: names(&mut pfds.iter()),
+            })?,
+        None => {
+            let with: Vec<&Node> = pfds.iter().filter(|p| has_boundary(p)).collect();
+            match with.as_slice() {
+                [] => return Err(FieldError::NoBoundary),
+                [one] => *one,
+                many => {
+                    return Err(FieldError::SeveralFields {
+                        count: many.len(),
+                        fields: names(&mut many.iter().copied()),
+                    })
+                }
             }
         }
-        if !boundaries.is_empty() {
-            out.name = pfd.attribute("C").map(str::to_string);
-            out.boundaries = boundaries;
-            out.obstacles = obstacles;
-            break;
+    };
+    let label = pfd_label(chosen);
+    let mut out = Parsed {
+        name: chosen.attribute("C").map(str::to_string),
+        boundaries: Vec::new(),
+        obstacles: Vec::new(),
+        guidance: guidance(chosen, &label)?,
+        warnings: Vec::new(),
+    };
+    for (j, pln) in chosen
+        .children()
+        .filter(|n| n.has_tag_name("PLN"))
+        .enumerate()
+    {
+        let t = pln.attribute("A").unwrap_or("").trim();
+        let mut feature = format!("{label} PLN {j} (type {t}, {})", pln_type_name(t));
+        if let Some(name) = pln.attribute("B") {
+            feature.push_str(&format!(" \"{name}\""));
+        }
+        if t == PLN_BOUNDARY {
+            if let Some(p) = polygon(&feature, &pln, &mut out.warnings)? {
+                out.boundaries.push(p);
+            }
+        } else if PLN_OBSTACLES.contains(&t) {
+            if let Some(p) = polygon(&feature, &pln, &mut out.warnings)? {
+                out.obstacles.push(p);
+            }
+        } else {
+            out.warnings.push(format!("{feature}: not used, skipped"));
         }
     }
     Ok(out)

@@ -4,8 +4,10 @@
 //! the independent metrics of each plan.
 
 use agsteer::config::Config;
-use agsteer::field::load_field;
 use agsteer::field::output::{plan_geojson, plan_svg, PlanSummary};
+use agsteer::field::{
+    decode_text, external_partfield_files, list_fields, load_field_with, GuidanceKind, LoadedField,
+};
 use agsteer::plan::coverage::metrics::checks::{check_plan, ViolationKind};
 use agsteer::plan::coverage::metrics::{area_and_pieces, plan_metrics, unreachable_ground};
 use agsteer::plan::coverage::{CoverageParams, Field, FieldPlan};
@@ -28,6 +30,122 @@ pub struct PlanOptions {
     /// Turning radii of the sweep, m.
     #[arg(long, value_delimiter = ',', default_value = "5,8")]
     pub r_mins: Vec<f64>,
+    /// List the fields (TASKDATA partfields) of the file and exit.
+    #[arg(long)]
+    pub list: bool,
+    /// The field to plan when the file holds several: its PFD id (e.g. PFD3) or its name.
+    #[arg(long, value_name = "ID_OR_NAME")]
+    pub field_id: Option<String>,
+}
+
+/// Read a file's text (UTF-8 or UTF-16, with or without a byte-order mark).
+fn read_text(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    decode_text(&bytes).with_context(|| format!("reading {}", path.display()))
+}
+
+/// The external partfield files a TASKDATA.XML names (XFR), read from its directory
+/// (NAME.XML, any case).
+fn read_externals(path: &Path, text: &str) -> Result<Vec<(String, String)>> {
+    let names = external_partfield_files(text).with_context(|| format!("{}", path.display()))?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let entries: Vec<PathBuf> = std::fs::read_dir(if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    })
+    .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+    .unwrap_or_default();
+    names
+        .into_iter()
+        .map(|name| {
+            let want = format!("{name}.xml");
+            let file = entries
+                .iter()
+                .find(|p| {
+                    p.file_name()
+                        .is_some_and(|f| f.to_string_lossy().eq_ignore_ascii_case(&want))
+                })
+                .with_context(|| {
+                    format!(
+                        "{} names the external file {name}.XML (XFR), which is not in {}",
+                        path.display(),
+                        dir.display()
+                    )
+                })?;
+            Ok((name, read_text(file)?))
+        })
+        .collect()
+}
+
+/// Read a field file (GeoJSON or TASKDATA with its external files), the partfield `select`.
+pub fn read_field(path: &Path, select: Option<&str>, cfg: &Config) -> Result<LoadedField> {
+    let text = read_text(path)?;
+    let externals = read_externals(path, &text)?;
+    load_field_with(&text, &externals, select, &cfg.field_load_options())
+        .with_context(|| format!("field {}", path.display()))
+}
+
+fn list(path: &Path) -> Result<u8> {
+    let text = read_text(path)?;
+    let externals = read_externals(path, &text)?;
+    let fields = list_fields(&text, &externals).with_context(|| format!("{}", path.display()))?;
+    println!(
+        "{:<12} {:<36} {:>10} {:>10} {:>9} {:>8}  file",
+        "id", "name", "stated ha", "boundaries", "obstacles", "guidance"
+    );
+    for f in &fields {
+        println!(
+            "{:<12} {:<36} {:>10} {:>10} {:>9} {:>8}  {}",
+            f.id,
+            f.designator.as_deref().unwrap_or("-"),
+            f.stated_area_m2
+                .map(|a| format!("{:.2}", a / 1e4))
+                .unwrap_or_else(|| "-".into()),
+            f.boundaries,
+            f.obstacles,
+            f.guidance_patterns,
+            f.file
+        );
+    }
+    println!(
+        "{} fields; plan one with --field-id ID_OR_NAME",
+        fields.len()
+    );
+    Ok(0)
+}
+
+/// The coverage parameters for a field: the configuration's, with the swaths parallel to the
+/// field's first AB line (or reference curve's ends) when it has one and the configuration
+/// does not fix the angle. Returns the parameters and a note saying which line was used.
+pub fn params_for(cfg: &Config, loaded: &LoadedField) -> (CoverageParams, Option<String>) {
+    use agsteer::plan::coverage::SwathAngle;
+    let mut params = cfg.coverage_params();
+    if matches!(params.swath_angle, SwathAngle::Fixed { .. }) {
+        return (params, None);
+    }
+    let line = loaded
+        .guidance
+        .iter()
+        .find(|g| g.kind == GuidanceKind::AbLine)
+        .or_else(|| {
+            loaded
+                .guidance
+                .iter()
+                .find(|g| g.kind == GuidanceKind::Curve)
+        });
+    match line.and_then(|g| g.heading().map(|h| (g, h))) {
+        Some((g, angle)) => {
+            params.swath_angle = SwathAngle::Fixed { angle };
+            let note = format!(
+                "swaths parallel to the field's guidance line {} ({:.1}°)",
+                g.name,
+                angle.to_degrees().rem_euclid(180.0)
+            );
+            (params, Some(note))
+        }
+        None => (params, None),
+    }
 }
 
 /// Run a step, reporting on stderr if it takes more than a second.
@@ -69,11 +187,17 @@ where
     if options.sweep {
         return sweep(field_path, cfg, out, options, planner);
     }
-    let text = std::fs::read_to_string(field_path)
-        .with_context(|| format!("reading field {}", field_path.display()))?;
-    let loaded = load_field(&text, &cfg.field_load_options())
-        .with_context(|| format!("field {}", field_path.display()))?;
-    let params = cfg.coverage_params();
+    if options.list {
+        return list(field_path);
+    }
+    let loaded = read_field(field_path, options.field_id.as_deref(), cfg)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    let (params, guidance_note) = params_for(cfg, &loaded);
+    if let Some(note) = &guidance_note {
+        eprintln!("{note}");
+    }
     let (plan, plan_time) = timed("planning", || planner(&loaded.field, &params));
     let plan = plan.with_context(|| format!("planning {}", field_path.display()))?;
     let (metrics, metrics_time) = timed("metrics", || {
@@ -218,12 +342,10 @@ where
             .file_stem()
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default();
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("reading field {}", path.display()))?;
-        let loaded = match load_field(&text, &cfg.field_load_options()) {
+        let loaded = match read_field(&path, None, cfg) {
             Ok(l) => l,
             Err(e) => {
-                println!("{name:<28} not read: {e}");
+                println!("{name:<28} not read: {e:#}");
                 continue;
             }
         };
@@ -241,7 +363,7 @@ where
                     field_ha,
                     line_width_m: w,
                     r_min_m: r,
-                    headland_passes: params.headland_passes,
+                    headland_passes: agsteer::plan::coverage::headland::passes(&params),
                     error: None,
                     swaths: 0,
                     covered_fraction: 0.0,

@@ -1,14 +1,29 @@
-//! Headland (seed 003): the working area is the boundary shrunk by w/2 + passes·w, with the
-//! obstacles grown by w/2; the headland passes are driveable closed tracks around the field.
+//! Headland (seed 003): driveable closed passes around the field and around the large
+//! obstacles, and the working area inside them, which the swaths cover.
+//!
+//! Pass k runs at w/2 + k·w from the edge, so the passes' footprints tile the headland from the
+//! edge to passes·w, and the working area is the boundary shrunk by passes·w (the obstacles
+//! grown likewise): the outermost swaths' footprints meet the innermost pass's. Where a corner
+//! is sharper than the vehicle turns, a pass cannot follow the offset there: at a convex corner
+//! it rounds the corner on an arc of radius r_min (an opening of the offset area); at a reflex
+//! corner of the field (a convex corner of an obstacle) the offset area is cut by a disc of
+//! radius r_min that contains the offset's own arc about the corner, then opened, so the pass
+//! bends on radius r_min and keeps at least its offset from the corner. The ground between
+//! such a bend and the corner is what the metrics report as unworked near the corner; the pass
+//! keeps its offset everywhere else (the whole ring is no longer raised to r_min).
 
 use super::geometry::{offset, Area};
 use super::CoverageParams;
-use crate::geo::{cross, Vec2};
+use crate::geo::{cross, v2, Vec2};
 use geo::BooleanOps;
 
 /// Added to every offset the implement must keep, m: round joins are drawn with chords,
 /// which cut up to 0.3 mm inside a 6 m arc.
 pub const CHORD_MARGIN: f64 = 0.005;
+
+/// Room for the extra length of continuous-curvature turns (clothoid entries) beyond an arc
+/// turn, m.
+const TURN_ROOM_MARGIN: f64 = 0.5;
 
 /// How far a path's chords may cut inside its arcs, m: points `point_spacing` apart on an arc
 /// of radius ≥ r_min sag by at most spacing²/(8·r_min), plus [`CHORD_MARGIN`].
@@ -27,11 +42,39 @@ pub fn has_reflex_vertex(ring: &[Vec2]) -> bool {
     })
 }
 
-/// The area inside which swath centre lines stay: the boundary shrunk by
-/// w/2 + headland_passes·w, minus the obstacles with their own headland
-/// ([`obstacle_headland_width`], smoothed by a closing of radius r_min).
+/// Width of headland the turns at the swath ends need, m: a U-turn between adjacent swaths
+/// (w ≥ 2·r_min) reaches w/2 beyond the swath end, a turn between swaths at least 2·r_min
+/// apart (the skip order) up to r_min + w/2; the implement reaches another w/2, and
+/// continuous-curvature entries a little more.
+pub fn turn_room(p: &CoverageParams) -> f64 {
+    let w = p.line_width;
+    let reach = if w + 1e-3 >= 2.0 * p.r_min {
+        0.5 * w
+    } else {
+        p.r_min + 0.5 * w
+    };
+    reach + 0.5 * w + TURN_ROOM_MARGIN
+}
+
+/// Headland passes planned: the configured number, raised so the headland is as wide as the
+/// turns at the swath ends need ([`turn_room`]); without that room the swaths would stop short
+/// of the headland and leave a strip unworked.
+pub fn passes(p: &CoverageParams) -> usize {
+    let needed = (turn_room(p) / p.line_width - 1e-9).ceil().max(0.0) as usize;
+    p.headland_passes.max(needed)
+}
+
+/// Offset of headland pass `k` from the field edge (or an obstacle's), m: w/2 + k·w plus the
+/// chord margin.
+pub fn pass_offset(p: &CoverageParams, k: usize) -> f64 {
+    p.line_width / 2.0 + k as f64 * p.line_width + chord_margin(p)
+}
+
+/// The area inside which the swaths' footprints lie (the working area): the boundary shrunk
+/// by passes·w, minus the obstacles with their own headland ([`obstacle_headland_width`],
+/// smoothed by a closing of radius r_min).
 pub fn working_area(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Vec<Area> {
-    let inset = p.line_width / 2.0 + p.headland_passes as f64 * p.line_width;
+    let inset = passes(p) as f64 * p.line_width;
     let outer = offset(&[(boundary.to_vec(), vec![])], -inset);
     if obstacles.is_empty() {
         return outer;
@@ -42,19 +85,12 @@ pub fn working_area(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoveragePara
     super::geometry::from_geo(&a.difference(&b))
 }
 
-/// Offset of obstacle pass `k` (0 = nearest the obstacle) from the obstacle's edge, m:
-/// w/2 + k·w, but at least `r_min`: the pass rounds the obstacle's corners on arcs of that
-/// radius about them.
-pub fn obstacle_pass_offset(p: &CoverageParams, k: usize) -> f64 {
-    (p.line_width / 2.0 + k as f64 * p.line_width).max(p.r_min) + chord_margin(p)
-}
-
 /// Width of the headland around every obstacle, m: out to the outer edge of the outermost
 /// obstacle pass (w/2 when there are no headland passes).
 pub fn obstacle_headland_width(p: &CoverageParams) -> f64 {
-    match p.headland_passes {
+    match passes(p) {
         0 => p.line_width / 2.0,
-        n => obstacle_pass_offset(p, n - 1) + p.line_width / 2.0,
+        n => n as f64 * p.line_width,
     }
 }
 
@@ -66,19 +102,107 @@ pub fn closing(obstacles: &[Vec<Vec2>], distance: f64, r: f64) -> Vec<Area> {
     offset(&offset(&rings, distance + r), -r)
 }
 
+/// A disc as a polygon whose chords stay outside the circle (vertices on radius
+/// r / cos(step/2)), so the disc is contained.
+fn disc(centre: Vec2, r: f64) -> Area {
+    let n = ((std::f64::consts::TAU / 0.05).ceil() as usize).max(16);
+    let step = std::f64::consts::TAU / n as f64;
+    let rr = r / (0.5 * step).cos();
+    (
+        (0..n)
+            .map(|i| {
+                let a = i as f64 * step;
+                centre + v2(rr * a.cos(), rr * a.sin())
+            })
+            .collect(),
+        vec![],
+    )
+}
+
+/// Unit bisector of the corner at `ring[i]` pointing to the ring's left (the inside of a
+/// counter-clockwise ring); `None` for a spike that folds back on itself.
+fn left_bisector(ring: &[Vec2], i: usize) -> Option<Vec2> {
+    let n = ring.len();
+    let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+    let left = |d: Vec2| v2(-d.y, d.x);
+    let n1 = left(b - a).try_normalize(1e-12)?;
+    let n2 = left(c - b).try_normalize(1e-12)?;
+    (n1 + n2).try_normalize(1e-9)
+}
+
+/// Discs of radius `r` that hold the offset's arc of radius `d` about every vertex of `ring`
+/// where `ring` turns right (reflex for the area on its left), centred `r − d` beyond the
+/// vertex on the right: a pass going round them bends on radius `r` and stays `d` clear.
+fn corner_discs(ring: &[Vec2], d: f64, r: f64) -> Vec<Area> {
+    if r <= d {
+        return Vec::new();
+    }
+    let n = ring.len();
+    (0..n)
+        .filter(|&i| {
+            let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+            cross(&(b - a), &(c - b)) < -1e-9
+        })
+        .filter_map(|i| left_bisector(ring, i).map(|m| disc(ring[i] - m * (r - d), r)))
+        .collect()
+}
+
+fn union(a: &[Area], b: &[Area]) -> Vec<Area> {
+    let a = geo::MultiPolygon::new(a.iter().map(super::geometry::to_geo).collect());
+    let b = geo::MultiPolygon::new(b.iter().map(super::geometry::to_geo).collect());
+    super::geometry::from_geo(&a.union(&b))
+}
+
+fn difference(a: &[Area], b: &[Area]) -> Vec<Area> {
+    let a = geo::MultiPolygon::new(a.iter().map(super::geometry::to_geo).collect());
+    let b = geo::MultiPolygon::new(b.iter().map(super::geometry::to_geo).collect());
+    super::geometry::from_geo(&a.difference(&b))
+}
+
+/// Closed tracks (first point repeated last) along every ring of `areas`, resampled.
+fn tracks_of(areas: &[Area], spacing: f64) -> Vec<Vec<Vec2>> {
+    areas
+        .iter()
+        .flat_map(|(outer, holes)| std::iter::once(outer).chain(holes.iter()))
+        .filter(|ring| ring.len() >= 3)
+        .map(|ring| {
+            let mut closed = ring.clone();
+            closed.push(ring[0]);
+            resample(&closed, spacing)
+        })
+        .collect()
+}
+
 /// Headland passes around the obstacles, nearest the obstacle first: closed tracks (first point
-/// repeated last) at [`obstacle_pass_offset`] from them, every corner an arc of radius ≥ r_min,
+/// repeated last) at [`pass_offset`] from them, every corner an arc of radius ≥ r_min,
 /// resampled to `point_spacing`. Obstacles whose passes meet share them.
 pub fn obstacle_tracks(obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Vec<Vec<Vec2>> {
     let mut tracks = Vec::new();
     if obstacles.is_empty() {
         return tracks;
     }
-    for k in 0..p.headland_passes {
-        for (ring, _) in closing(obstacles, obstacle_pass_offset(p, k), p.r_min) {
-            let mut closed = ring.clone();
-            closed.push(ring[0]);
-            tracks.push(resample(&closed, p.point_spacing));
+    for k in 0..passes(p) {
+        let d = pass_offset(p, k);
+        let rings: Vec<Area> = obstacles.iter().map(|o| (o.clone(), vec![])).collect();
+        let mut grown = offset(&rings, d);
+        // An obstacle's convex corners turn right for the field around it: walk each obstacle
+        // clockwise so they are the right-hand turns.
+        let discs: Vec<Area> = obstacles
+            .iter()
+            .flat_map(|o| {
+                let cw: Vec<Vec2> = o.iter().rev().copied().collect();
+                corner_discs(&cw, d, p.r_min)
+            })
+            .collect();
+        if !discs.is_empty() {
+            grown = union(&grown, &discs);
+        }
+        // Closing: the concave junctions rounded to r_min, outwards only.
+        let closed = offset(&offset(&grown, p.r_min), -p.r_min);
+        for (ring, _) in closed {
+            let mut c = ring.clone();
+            c.push(ring[0]);
+            tracks.push(resample(&c, p.point_spacing));
         }
     }
     tracks
@@ -96,36 +220,24 @@ pub fn subtract_obstacles(areas: &[Area], obstacles: &[Vec<Vec2>], margin: f64) 
             .collect::<Vec<_>>(),
         margin,
     );
-    let a = geo::MultiPolygon::new(areas.iter().map(super::geometry::to_geo).collect());
-    let b = geo::MultiPolygon::new(grown.iter().map(super::geometry::to_geo).collect());
-    super::geometry::from_geo(&a.difference(&b))
-}
-
-/// Offset of headland pass `k` from the boundary, m: w/2 + k·w, but never below `r_min` when
-/// the boundary has a reflex corner (there the pass follows an arc of that radius about the
-/// corner, and a tighter one could not be driven).
-pub fn pass_offset(boundary: &[Vec2], p: &CoverageParams, k: usize) -> f64 {
-    let d = p.line_width / 2.0 + k as f64 * p.line_width;
-    if has_reflex_vertex(boundary) {
-        d.max(p.r_min) + chord_margin(p)
-    } else {
-        d + CHORD_MARGIN
-    }
+    difference(areas, &grown)
 }
 
 /// The headland passes, outermost first: closed tracks (first point repeated last) at
-/// [`pass_offset`] from the boundary with convex corners rounded to `r_min` (an opening: shrink
-/// by offset + r_min, grow by r_min), resampled to `point_spacing`.
+/// [`pass_offset`] from the boundary, convex corners rounded to r_min (an opening: shrink by
+/// r_min, grow by r_min) and reflex corners bent round a disc of radius r_min
+/// ([`corner_discs`]), resampled to `point_spacing`.
 pub fn headland_tracks(boundary: &[Vec2], p: &CoverageParams) -> Vec<Vec<Vec2>> {
     let mut tracks = Vec::new();
-    for k in 0..p.headland_passes {
-        let d = pass_offset(boundary, p, k);
-        let shrunk = offset(&[(boundary.to_vec(), vec![])], -(d + p.r_min));
-        for (ring, _) in offset(&shrunk, p.r_min) {
-            let mut closed = ring.clone();
-            closed.push(ring[0]);
-            tracks.push(resample(&closed, p.point_spacing));
+    for k in 0..passes(p) {
+        let d = pass_offset(p, k);
+        let mut area = offset(&[(boundary.to_vec(), vec![])], -d);
+        let discs = corner_discs(boundary, d, p.r_min);
+        if !discs.is_empty() {
+            area = difference(&area, &discs);
         }
+        let opened = offset(&offset(&area, -p.r_min), p.r_min);
+        tracks.extend(tracks_of(&opened, p.point_spacing));
     }
     tracks
 }
@@ -189,9 +301,9 @@ mod tests {
         ];
         let p = params();
         let t = headland_tracks(&b, &p);
-        assert_eq!(t.len(), 2);
+        assert_eq!(t.len(), 3);
         for (k, track) in t.iter().enumerate() {
-            let d = pass_offset(&b, &p, k);
+            let d = pass_offset(&p, k);
             for q in track {
                 let edge = q.x.min(200.0 - q.x).min(q.y).min(100.0 - q.y);
                 assert!(edge >= d - 0.05, "pass {k}: {q:?} at {edge} < {d}");
@@ -203,7 +315,9 @@ mod tests {
                 assert!(k3 <= 1.0 / p.r_min * 1.05 + 1e-6, "curvature {k3}");
             }
         }
+        // Passes of 6 m at r_min 6 m: turns need 6 + 3 + 3 + 0.5 m → 3 passes, 18 m.
+        assert_eq!(passes(&p), 3);
         let wa = working_area(&b, &[], &p);
-        assert!((super::super::geometry::area_m2(&wa[0]) - 170.0 * 70.0).abs() < 1.0);
+        assert!((super::super::geometry::area_m2(&wa[0]) - 164.0 * 64.0).abs() < 1.0);
     }
 }
