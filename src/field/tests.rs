@@ -176,8 +176,22 @@ fn invalid_input_gives_errors_naming_the_feature() {
     let e = err(&collection(&[feature(&[&two], "")]));
     assert!(e.contains("feature 0") && e.contains("at least 3"), "{e}");
 
+    // An obstacle across the boundary is cut out of the field, with a warning naming it;
+    // one wholly outside is an error.
     let outer = rect(0.0, 0.0, 100.0, 100.0);
-    let outside = rect(90.0, 90.0, 150.0, 120.0);
+    let across = rect(90.0, 90.0, 150.0, 120.0);
+    let f = load_field(
+        &collection(&[
+            feature(&[&outer], ""),
+            feature(&[&across], r#""obstacle":true,"name":"barn""#),
+        ]),
+        &opts(),
+    )
+    .unwrap();
+    assert!(f.field.obstacles.is_empty());
+    assert!((f.cleanup.area_after_m2 - 9900.0).abs() < 0.01);
+    assert!(f.warnings[0].contains("feature 1 \"barn\"") && f.warnings[0].contains("cut out"));
+    let outside = rect(190.0, 190.0, 250.0, 220.0);
     let e = err(&collection(&[
         feature(&[&outer], ""),
         feature(&[&outside], r#""obstacle":true,"name":"barn""#),
@@ -258,7 +272,7 @@ fn taskdata_boundary_interior_ring_and_obstacle_polygon() {
         .replace(r#"C="Pentagon""#, r#"C="P""#)
         .replacen("C=\"5", "C=\"x5", 1);
     let e = load_field(&broken, &opts()).unwrap_err().to_string();
-    assert!(e.contains("PFD 0 (id PFD1)") && e.contains("PNT 0"), "{e}");
+    assert!(e.contains("PFD1 \"P\" PLN 0") && e.contains("PNT 0"), "{e}");
 }
 
 #[test]
