@@ -220,6 +220,7 @@ where
         "plan.svg",
         plan_svg(&loaded.field, &plan, loaded.origin, Some(&metrics), &title),
     )?;
+    let violations = check_plan(&loaded.field, &plan, params.line_width, params.r_min);
     let s = PlanSummary::new(&loaded, &plan, &metrics, plan_time, metrics_time);
     let summary_json = serde_json::to_string_pretty(&s)?;
     write("metrics.json", format!("{summary_json}\n"))?;
@@ -250,6 +251,16 @@ where
             "wrote {0}/plan.geojson, {0}/plan.svg, {0}/metrics.json",
             out.display()
         );
+    }
+    if !violations.is_empty() {
+        for v in &violations {
+            eprintln!("violation: {v}");
+        }
+        eprintln!(
+            "error: the plan breaks its guarantees in {} places (listed above); it was written for inspection but must not be driven",
+            violations.len()
+        );
+        return Ok(4);
     }
     Ok(0)
 }

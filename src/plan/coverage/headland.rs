@@ -21,6 +21,16 @@ use geo::BooleanOps;
 /// which cut up to 0.3 mm inside a 6 m arc.
 pub const CHORD_MARGIN: f64 = 0.005;
 
+/// The passes bend on radius `r_min · SMOOTHING_RADIUS_FACTOR`: their points lie on chords of
+/// the arcs, and three-point curvature over such points reads up to ~3 % above the arc's.
+pub const SMOOTHING_RADIUS_FACTOR: f64 = 1.05;
+
+/// Depth by which a disc laid over a concave kink of a pass reaches past the kink, m.
+const KINK_DISC_DEPTH: f64 = 0.02;
+
+/// Rounds of finding concave kinks in the passes and cutting them away.
+const KINK_ROUNDS: usize = 4;
+
 /// Room for the extra length of continuous-curvature turns (clothoid entries) beyond an arc
 /// turn, m.
 const TURN_ROOM_MARGIN: f64 = 0.5;
@@ -181,6 +191,7 @@ pub fn obstacle_tracks(obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Vec<Vec<V
     if obstacles.is_empty() {
         return tracks;
     }
+    let rs = p.r_min * SMOOTHING_RADIUS_FACTOR;
     for k in 0..passes(p) {
         let d = pass_offset(p, k);
         let rings: Vec<Area> = obstacles.iter().map(|o| (o.clone(), vec![])).collect();
@@ -191,14 +202,14 @@ pub fn obstacle_tracks(obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Vec<Vec<V
             .iter()
             .flat_map(|o| {
                 let cw: Vec<Vec2> = o.iter().rev().copied().collect();
-                corner_discs(&cw, d, p.r_min)
+                corner_discs(&cw, d, rs)
             })
             .collect();
         if !discs.is_empty() {
             grown = union(&grown, &discs);
         }
         // Closing: the concave junctions rounded to r_min, outwards only.
-        let closed = offset(&offset(&grown, p.r_min), -p.r_min);
+        let closed = offset(&offset(&grown, rs), -rs);
         for (ring, _) in closed {
             let mut c = ring.clone();
             c.push(ring[0]);
@@ -228,18 +239,73 @@ pub fn subtract_obstacles(areas: &[Area], obstacles: &[Vec<Vec2>], margin: f64) 
 /// r_min, grow by r_min) and reflex corners bent round a disc of radius r_min
 /// ([`corner_discs`]), resampled to `point_spacing`.
 pub fn headland_tracks(boundary: &[Vec2], p: &CoverageParams) -> Vec<Vec<Vec2>> {
+    let rs = p.r_min * SMOOTHING_RADIUS_FACTOR;
     let mut tracks = Vec::new();
     for k in 0..passes(p) {
         let d = pass_offset(p, k);
         let mut area = offset(&[(boundary.to_vec(), vec![])], -d);
-        let discs = corner_discs(boundary, d, p.r_min);
+        let discs = corner_discs(boundary, d, rs);
         if !discs.is_empty() {
             area = difference(&area, &discs);
         }
-        let opened = offset(&offset(&area, -p.r_min), p.r_min);
+        // The opening rounds the convex corners; concave kinks that the offset itself made
+        // (where offsets of distant edges meet) are cut away by discs and opened again.
+        let mut opened = offset(&offset(&area, -rs), rs);
+        for _ in 0..KINK_ROUNDS {
+            let kinks = concave_kinks(&opened, p.point_spacing, p.r_min);
+            if kinks.is_empty() {
+                break;
+            }
+            let discs: Vec<Area> = kinks
+                .iter()
+                .map(|(q, out)| disc(q + out * (rs - KINK_DISC_DEPTH), rs))
+                .collect();
+            opened = offset(&offset(&difference(&opened, &discs), -rs), rs);
+        }
         tracks.extend(tracks_of(&opened, p.point_spacing));
     }
     tracks
+}
+
+/// Points of the areas' rings, resampled to `spacing`, where a ring bends away from its area
+/// tighter than `r_min` (three-point curvature), each with the unit normal pointing out of
+/// the area.
+fn concave_kinks(areas: &[Area], spacing: f64, r_min: f64) -> Vec<(Vec2, Vec2)> {
+    let mut out = Vec::new();
+    for (outer, holes) in areas {
+        // Outer rings are CCW with the area on the left; holes are CCW too (from_geo) with the
+        // area on their right.
+        for (ring, area_left) in
+            std::iter::once((outer, true)).chain(holes.iter().map(|h| (h, false)))
+        {
+            if ring.len() < 3 {
+                continue;
+            }
+            let mut closed = ring.clone();
+            closed.push(ring[0]);
+            let pts = resample(&closed, spacing);
+            let n = pts.len().saturating_sub(1); // last = first
+            if n < 3 {
+                continue;
+            }
+            for i in 0..n {
+                let (a, b, c) = (pts[(i + n - 1) % n], pts[i], pts[(i + 1) % n]);
+                let turn = cross(&(b - a), &(c - b));
+                let concave = if area_left { turn < 0.0 } else { turn > 0.0 };
+                let chord = (c - a).norm();
+                if !concave || chord < 1e-9 {
+                    continue;
+                }
+                let k = 2.0 * turn.abs() / ((b - a).norm() * (c - b).norm() * chord);
+                if k > 1.0 / r_min {
+                    let t = (c - a) / chord;
+                    let left = v2(-t.y, t.x);
+                    out.push((b, if area_left { -left } else { left }));
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Points evenly spaced by arc length along a polyline, about `spacing` m apart, from its
