@@ -200,6 +200,97 @@ pub fn plan_geojson(
     serde_json::to_string_pretty(&doc).unwrap_or_default()
 }
 
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// `TASKDATA.XML` (ISO 11783-10, version 4.3) for a terminal: one partfield (PFD1) with the
+/// field boundary (PLN type 1: LSG type 1 exterior, LSG type 2 for each obstacle) and one
+/// guidance group holding the plan's lines in driving order: every work swath as an AB line
+/// (GPN type 1, points A and B) and every headland pass as a curve (GPN type 3), each as an
+/// LSG type 5. Coordinates WGS-84 degrees with 9 decimals (0.1 mm).
+pub fn plan_taskdata(field: &Field, plan: &FieldPlan, origin: LatLon, name: &str) -> String {
+    use std::fmt::Write;
+    let frame = EnuFrame::new(origin);
+    let pnt = |out: &mut String, kind: u8, p: &Vec2| {
+        let ll = frame.to_latlon(*p);
+        let _ = write!(
+            out,
+            r#"<PNT A="{kind}" C="{:.9}" D="{:.9}"/>"#,
+            ll.lat_deg, ll.lon_deg
+        );
+    };
+    let ring = |out: &mut String, lsg_type: u8, pts: &[Vec2]| {
+        let _ = write!(out, r#"<LSG A="{lsg_type}">"#);
+        for p in pts.iter().chain(pts.first()) {
+            pnt(out, 2, p);
+        }
+        out.push_str("</LSG>");
+    };
+    let area = crate::geo::polygon::signed_area(&field.boundary)
+        - field
+            .obstacles
+            .iter()
+            .map(|o| crate::geo::polygon::signed_area(o).abs())
+            .sum::<f64>();
+    let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let _ = writeln!(
+        x,
+        r#"<ISO11783_TaskData VersionMajor="4" VersionMinor="3" ManagementSoftwareManufacturer="agsteer" ManagementSoftwareVersion="{}" DataTransferOrigin="1">"#,
+        env!("CARGO_PKG_VERSION")
+    );
+    let _ = write!(
+        x,
+        r#"<PFD A="PFD1" C="{}" D="{}">"#,
+        xml_escape(name),
+        area.max(0.0).round() as u64
+    );
+    x.push_str(r#"<PLN A="1" B="boundary">"#);
+    ring(&mut x, 1, &field.boundary);
+    for o in &field.obstacles {
+        ring(&mut x, 2, o);
+    }
+    x.push_str("</PLN>\n");
+    x.push_str(r#"<GGP A="GGP1" B="agsteer plan">"#);
+    let mut n = 0;
+    for s in &plan.segments {
+        let (kind, label) = match s.kind {
+            SegmentKind::Work => (1, "swath"),
+            SegmentKind::Headland => (3, "headland pass"),
+            _ => continue,
+        };
+        let (Some(first), Some(last)) = (s.points.first(), s.points.last()) else {
+            continue;
+        };
+        n += 1;
+        let _ = write!(
+            x,
+            r#"<GPN A="GPN{n}" B="{label} {n} (segment {})" C="{kind}"><LSG A="5">"#,
+            s.index
+        );
+        if kind == 1 {
+            pnt(&mut x, 6, first);
+            pnt(&mut x, 7, last);
+        } else {
+            let k = s.points.len();
+            for (i, p) in s.points.iter().enumerate() {
+                let t = match i {
+                    0 => 6,
+                    _ if i + 1 == k => 7,
+                    _ => 9,
+                };
+                pnt(&mut x, t, p);
+            }
+        }
+        x.push_str("</LSG></GPN>\n");
+    }
+    x.push_str("</GGP></PFD>\n</ISO11783_TaskData>\n");
+    x
+}
+
 /// `plan.svg`: field, obstacles, headland area, working area, segments coloured by kind with
 /// their driving-order index at each segment start and an arrow dot at each work segment's
 /// end, a legend, key figures, a scale bar and a north arrow.

@@ -4,7 +4,7 @@
 //! the independent metrics of each plan.
 
 use agsteer::config::Config;
-use agsteer::field::output::{plan_geojson, plan_svg, PlanSummary};
+use agsteer::field::output::{plan_geojson, plan_svg, plan_taskdata, PlanSummary};
 use agsteer::field::{
     decode_text, external_partfield_files, list_fields, load_field_with, GuidanceKind, LoadedField,
 };
@@ -217,6 +217,10 @@ where
         plan_geojson(&loaded.field, &plan, loaded.origin, Some(&metrics)),
     )?;
     write(
+        "TASKDATA.XML",
+        plan_taskdata(&loaded.field, &plan, loaded.origin, &title),
+    )?;
+    write(
         "plan.svg",
         plan_svg(&loaded.field, &plan, loaded.origin, Some(&metrics), &title),
     )?;
@@ -248,7 +252,7 @@ where
             s.cleanup.area_error_pct
         );
         println!(
-            "wrote {0}/plan.geojson, {0}/plan.svg, {0}/metrics.json",
+            "wrote {0}/plan.geojson, {0}/plan.svg, {0}/TASKDATA.XML, {0}/metrics.json",
             out.display()
         );
     }
