@@ -10,7 +10,7 @@ use agsteer::field::{
 };
 use agsteer::plan::coverage::metrics::checks::{check_plan, ViolationKind};
 use agsteer::plan::coverage::metrics::{area_and_pieces, plan_metrics, unreachable_ground};
-use agsteer::plan::coverage::{CoverageParams, Field, FieldPlan};
+use agsteer::plan::coverage::{headland, CoverageParams, Field, FieldPlan};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -200,6 +200,24 @@ where
     }
     let (plan, plan_time) = timed("planning", || planner(&loaded.field, &params));
     let plan = plan.with_context(|| format!("planning {}", field_path.display()))?;
+    if plan.swaths == 0 {
+        let area = (
+            loaded.field.boundary.clone(),
+            loaded.field.obstacles.clone(),
+        );
+        let width = agsteer::plan::coverage::geometry::inscribed_width(&area);
+        let reason = headland::no_swath_fits(width, &params)
+            .map(|n| n.to_string())
+            .unwrap_or_else(|| {
+                format!(
+                    "no swath fits the field ({width:.1} m wide at its widest, implement {:.1} m, turn diameter {:.1} m)",
+                    params.line_width,
+                    2.0 * params.r_min
+                )
+            });
+        eprintln!("error: {}: {reason}", field_path.display());
+        return Ok(5);
+    }
     let (metrics, metrics_time) = timed("metrics", || {
         plan_metrics(&loaded.field, &plan, params.line_width)
     });

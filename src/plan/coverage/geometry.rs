@@ -61,6 +61,23 @@ pub fn offset(areas: &[Area], distance: f64) -> Vec<Area> {
     from_geo(&mp.buffer_with_style(style))
 }
 
+/// Width of the widest strip of `area` (boundary minus holes): twice the radius of the
+/// largest circle inside it, found by bisection on inward offsets to 1 cm, m.
+pub fn inscribed_width(area: &Area) -> f64 {
+    let (lo, hi) = crate::geo::polygon::bbox(area.0.iter()).unwrap_or((v2(0.0, 0.0), v2(0.0, 0.0)));
+    let (mut inside, mut outside) = (0.0, 0.5 * (hi - lo).x.min((hi - lo).y) + 0.01);
+    let one = std::slice::from_ref(area);
+    while outside - inside > 0.005 {
+        let mid = 0.5 * (inside + outside);
+        if offset(one, -mid).is_empty() {
+            outside = mid;
+        } else {
+            inside = mid;
+        }
+    }
+    2.0 * inside
+}
+
 /// Rotate `p` by `angle` rad counter-clockwise about the origin.
 #[inline]
 pub fn rotate(p: &Vec2, angle: f64) -> Vec2 {

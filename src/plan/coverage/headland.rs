@@ -33,7 +33,7 @@ const KINK_ROUNDS: usize = 4;
 
 /// Room for the extra length of continuous-curvature turns (clothoid entries) beyond an arc
 /// turn, m.
-const TURN_ROOM_MARGIN: f64 = 0.5;
+const TURN_ROOM_MARGIN: f64 = 0.25;
 
 /// How far a path's chords may cut inside its arcs, m: points `point_spacing` apart on an arc
 /// of radius ≥ r_min sag by at most spacing²/(8·r_min), plus [`CHORD_MARGIN`].
@@ -52,18 +52,12 @@ pub fn has_reflex_vertex(ring: &[Vec2]) -> bool {
     })
 }
 
-/// Width of headland the turns at the swath ends need, m: a U-turn between adjacent swaths
-/// (w ≥ 2·r_min) reaches w/2 beyond the swath end, a turn between swaths at least 2·r_min
-/// apart (the skip order) up to r_min + w/2; the implement reaches another w/2, and
-/// continuous-curvature entries a little more.
+/// Width of headland the turns at the swath ends need, m: a pi turn (arcs of r_min joined by
+/// a straight, or a semicircle when the swaths are 2·r_min apart) reaches r_min beyond the
+/// swath end whatever the spacing, the implement another w/2, and continuous-curvature entries
+/// a little more.
 pub fn turn_room(p: &CoverageParams) -> f64 {
-    let w = p.line_width;
-    let reach = if w + 1e-3 >= 2.0 * p.r_min {
-        0.5 * w
-    } else {
-        p.r_min + 0.5 * w
-    };
-    reach + 0.5 * w + TURN_ROOM_MARGIN
+    p.r_min + 0.5 * p.line_width + TURN_ROOM_MARGIN
 }
 
 /// Headland passes planned: the configured number, raised so the headland is as wide as the
@@ -72,6 +66,69 @@ pub fn turn_room(p: &CoverageParams) -> f64 {
 pub fn passes(p: &CoverageParams) -> usize {
     let needed = (turn_room(p) / p.line_width - 1e-9).ceil().max(0.0) as usize;
     p.headland_passes.max(needed)
+}
+
+/// Why no swath fits a field, with the numbers a farmer needs to change the job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NoSwathFits {
+    /// Width of the field's widest strip (twice the largest inscribed circle's radius), m.
+    pub field_width: f64,
+    pub line_width: f64,
+    /// 2·r_min, m.
+    pub turn_diameter: f64,
+    /// Headland passes the turns need at this width ([`passes`]) and their width, m.
+    pub passes: usize,
+    pub headland_width: f64,
+    /// The largest implement width (0.5 m steps) at which a swath fits inside the headland
+    /// (`None` below 0.5 m).
+    pub largest_width: Option<f64>,
+}
+
+impl std::fmt::Display for NoSwathFits {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let why = if self.field_width < self.line_width {
+            format!(
+                "the field is {:.1} m wide at its widest, narrower than the implement ({:.1} m)",
+                self.field_width, self.line_width
+            )
+        } else {
+            format!(
+                "the field is {:.1} m wide at its widest; the {} headland pass(es) the turns need ({:.1} m each side, turn diameter {:.1} m, implement {:.1} m) leave no room for a swath",
+                self.field_width, self.passes, self.headland_width, self.turn_diameter, self.line_width
+            )
+        };
+        match self.largest_width {
+            Some(w) => write!(f, "no swath fits: {why}; the largest implement width that leaves room for swaths here is {w:.1} m"),
+            None => write!(f, "no swath fits: {why}; no implement width of 0.5 m or more leaves room for swaths here"),
+        }
+    }
+}
+
+/// `Some` when the field is too narrow for any swath inside the headland at these parameters.
+pub fn no_swath_fits(field_width: f64, p: &CoverageParams) -> Option<NoSwathFits> {
+    let room = |q: &CoverageParams| field_width > 2.0 * passes(q) as f64 * q.line_width + 1e-6;
+    if room(p) {
+        return None;
+    }
+    let mut q = p.clone();
+    let mut largest = None;
+    let mut w = (p.line_width * 2.0).floor() / 2.0;
+    while w >= 0.5 {
+        q.line_width = w;
+        if room(&q) && w <= field_width {
+            largest = Some(w);
+            break;
+        }
+        w -= 0.5;
+    }
+    Some(NoSwathFits {
+        field_width,
+        line_width: p.line_width,
+        turn_diameter: 2.0 * p.r_min,
+        passes: passes(p),
+        headland_width: passes(p) as f64 * p.line_width,
+        largest_width: largest,
+    })
 }
 
 /// Offset of headland pass `k` from the field edge (or an obstacle's), m: w/2 + k·w plus the
@@ -367,7 +424,7 @@ mod tests {
         ];
         let p = params();
         let t = headland_tracks(&b, &p);
-        assert_eq!(t.len(), 3);
+        assert_eq!(t.len(), 2);
         for (k, track) in t.iter().enumerate() {
             let d = pass_offset(&p, k);
             for q in track {
@@ -381,9 +438,9 @@ mod tests {
                 assert!(k3 <= 1.0 / p.r_min * 1.05 + 1e-6, "curvature {k3}");
             }
         }
-        // Passes of 6 m at r_min 6 m: turns need 6 + 3 + 3 + 0.5 m → 3 passes, 18 m.
-        assert_eq!(passes(&p), 3);
+        // Passes of 6 m at r_min 6 m: turns need 6 + 3 + 0.25 m → 2 passes, 12 m.
+        assert_eq!(passes(&p), 2);
         let wa = working_area(&b, &[], &p);
-        assert!((super::super::geometry::area_m2(&wa[0]) - 164.0 * 64.0).abs() < 1.0);
+        assert!((super::super::geometry::area_m2(&wa[0]) - 176.0 * 76.0).abs() < 1.0);
     }
 }

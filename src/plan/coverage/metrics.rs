@@ -205,7 +205,7 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
     let obstacle_length_m = length(&obstacles.clip(&paths, false));
     let sum_single: f64 = of(plan, &[Work, Detour, Headland])
         .map(|s| footprint(std::iter::once(s), line_width).unsigned_area())
-        .sum();
+        .fold(0.0, |a, b| a + b);
     let union_area = passes_fp.unsigned_area();
     let overlap_fraction = ratio((sum_single - union_area).max(0.0), union_area);
     let outside_area_m2 = all_fp.difference(&boundary_poly).unsigned_area();
@@ -239,7 +239,7 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
             .iter()
             .filter(|s| s.kind == k)
             .map(|s| crate::geo::polygon::polyline_length(&s.points))
-            .sum()
+            .fold(0.0, |a, b| a + b)
     };
     let reversals = plan
         .segments
