@@ -20,6 +20,7 @@ pub mod field;
 pub mod geo;
 pub mod guidance;
 pub mod input;
+pub mod io;
 pub mod plan;
 pub mod safety;
 pub mod sim;
