@@ -7,5 +7,7 @@
 
 pub mod decoder;
 pub mod framer;
+pub mod pty;
 #[cfg(test)]
 mod tests;
+pub mod transport;
