@@ -63,7 +63,8 @@ fn start(cfg: StreamConfig) -> Running {
         StreamPorts {
             inputs: tx,
             rtcm: Some(rtcm_rx),
-            link_age: None,
+            last_rtcm: None,
+            position: None,
             status: status.clone(),
         },
     ));

@@ -7,6 +7,7 @@
 
 pub mod decoder;
 pub mod framer;
+pub mod ntrip;
 pub mod pty;
 #[cfg(test)]
 mod tests;

@@ -16,8 +16,9 @@
 //! libudev, nothing but Rust and libc to build.
 
 use super::decoder::{DecoderParams, GnssDecoder, StreamCounters};
+use super::ntrip::GgaSource;
 use crate::input::nmea0183::clock::Receipt;
-use crate::input::Input;
+use crate::input::{FixQuality, Input};
 use serde::Serialize;
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
@@ -107,8 +108,11 @@ pub struct StreamPorts {
     pub inputs: mpsc::Sender<Input>,
     /// RTCM corrections to write to the receiver (from the NTRIP client).
     pub rtcm: Option<mpsc::Receiver<Vec<u8>>>,
-    /// The NTRIP link's age of corrections, s (for the decoder's correction-age cap).
-    pub link_age: Option<watch::Receiver<Option<f64>>>,
+    /// Monotonic time of the NTRIP client's last RTCM frame, s (the link's age of corrections
+    /// feeds the decoder's correction-age cap).
+    pub last_rtcm: Option<watch::Receiver<Option<f64>>>,
+    /// The receiver's latest position, for the NTRIP client's GGA.
+    pub position: Option<watch::Sender<Option<GgaSource>>>,
     pub status: SharedStatus,
 }
 
@@ -209,6 +213,8 @@ struct Sink<'a> {
     decoder: GnssDecoder,
     ports: &'a mut StreamPorts,
     limit: RateLimit,
+    /// The latest quality report, for GGA.
+    quality: (FixQuality, u8, f64),
 }
 
 impl Sink<'_> {
@@ -218,14 +224,39 @@ impl Sink<'_> {
             set_status(&self.ports.status, |s| s.dropped_bytes += data.len() as u64);
             return;
         }
-        let age = self.ports.link_age.as_ref().and_then(|a| *a.borrow());
+        let age = self
+            .ports
+            .last_rtcm
+            .as_ref()
+            .and_then(|a| *a.borrow())
+            .map(|last| (receipt.t - last).max(0.0));
         self.decoder.set_link_correction_age(age);
         let mut dropped = 0u64;
         let inputs = &self.ports.inputs;
+        let position = &self.ports.position;
+        let quality = &mut self.quality;
         self.decoder.push(
             data,
             &receipt,
             &mut |i| {
+                match &i {
+                    Input::Quality(q) => {
+                        *quality = (q.quality, q.satellites.unwrap_or(0), q.hdop.unwrap_or(1.0));
+                    }
+                    Input::Position(p) => {
+                        if let Some(tx) = position {
+                            tx.send_replace(Some(GgaSource {
+                                lat_deg: p.lat_deg,
+                                lon_deg: p.lon_deg,
+                                altitude_m: p.altitude_m.unwrap_or(0.0),
+                                quality: p.quality.unwrap_or(quality.0),
+                                satellites: quality.1,
+                                hdop: quality.2,
+                            }));
+                        }
+                    }
+                    _ => {}
+                }
                 if inputs.try_send(i).is_err() {
                     dropped += 1;
                 }
@@ -251,6 +282,7 @@ pub async fn run_stream(cfg: StreamConfig, mut ports: StreamPorts) {
         decoder: GnssDecoder::new(cfg.decoder),
         limit: RateLimit::new(cfg.max_rate_bytes_s, crate::can::bus::monotonic_s()),
         ports: &mut ports,
+        quality: (FixQuality::None, 0, 1.0),
     };
     let mut rtcm = sink.ports.rtcm.take();
     let mut backoff = cfg.backoff_min_s;
