@@ -15,6 +15,7 @@ pub mod config;
 pub mod control;
 pub mod daemon;
 pub mod demo;
+pub mod envelope;
 pub mod estimate;
 pub mod field;
 pub mod geo;
