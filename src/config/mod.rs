@@ -196,10 +196,12 @@ impl Config {
 
     /// Read, override and validate a configuration file.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Config, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text = crate::envelope::read_text(path, crate::envelope::FileKind::Config).map_err(
+            |e| ConfigError::Read {
+                path: path.display().to_string(),
+                source: e.into_io(),
+            },
+        )?;
         let cfg = Config::parse_with(&text, overrides)?;
         let problems = cfg.validate();
         if problems.is_empty() {

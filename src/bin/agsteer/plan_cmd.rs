@@ -69,8 +69,7 @@ where
     if options.sweep {
         return sweep(field_path, cfg, out, options, planner);
     }
-    let text = std::fs::read_to_string(field_path)
-        .with_context(|| format!("reading field {}", field_path.display()))?;
+    let text = agsteer::envelope::read_text(field_path, agsteer::envelope::FileKind::Field)?;
     let loaded = load_field(&text, &cfg.field_load_options())
         .with_context(|| format!("field {}", field_path.display()))?;
     let params = cfg.coverage_params();
