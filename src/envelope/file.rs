@@ -46,7 +46,7 @@ impl FileKind {
         const MIB: u64 = 1024 * 1024;
         match self {
             FileKind::Config => MIB,
-            FileKind::Field => 64 * MIB,
+            FileKind::Field => 16 * MIB,
             FileKind::Map => 16 * MIB,
             FileKind::Progress => MIB,
             FileKind::Batch => 16 * MIB,

@@ -33,8 +33,20 @@ pub const MAX_FIELD_POINTS: usize = 100_000;
 /// (Douglas–Peucker) before its quadratic checks (self-intersection, containment).
 pub const SIMPLIFY_ABOVE_POINTS: usize = 4_000;
 
+/// Most points of one ring after clean-up (and simplification): the ring checks are quadratic
+/// in it. A ring that does not simplify below it within the tolerance is refused.
+pub const MAX_RING_POINTS: usize = 10_000;
+
+/// Most points of all rings of a field or map after clean-up (containment checks are the
+/// product of an obstacle's points and the boundary's).
+pub const MAX_CLEAN_POINTS: usize = 20_000;
+
+/// Tolerance of the simplification of a large ring of a manoeuvre map (whose rings are
+/// otherwise not simplified), m.
+pub const MAP_SIMPLIFY_TOLERANCE_M: f64 = 0.01;
+
 /// Most obstacles (holes and obstacle features) in one field or map.
-pub const MAX_OBSTACLES: usize = 500;
+pub const MAX_OBSTACLES: usize = 200;
 
 /// Largest |coordinate| of a local position given in metres (AB points, manoeuvre poses, map
 /// positions), m. The local ENU frame is a flat-earth approximation about its origin; beyond a
@@ -54,7 +66,7 @@ pub const MAX_ARCS: u64 = 1_000;
 
 /// Most global-path points a job planned whole at start-up may hold: the job's total path
 /// length over `guidance.point_spacing_m` (sequential AB jobs, arcs jobs, field plans).
-pub const MAX_PATH_POINTS: f64 = 2.0e7;
+pub const MAX_PATH_POINTS: f64 = 4.0e6;
 
 /// Most lines in one block of the skip order, 2·ceil(2·r_min/w) + a (`vehicle.r_min_m`,
 /// `job.line_width_m`, `guidance.a`): a turn radius far larger than the working width makes
@@ -100,6 +112,11 @@ pub fn table() -> Vec<(&'static str, String, &'static str)> {
         (
             "ring simplified (within field.boundary_tolerance_m) above",
             format!("{SIMPLIFY_ABOVE_POINTS} points"),
+            "field reader",
+        ),
+        (
+            "points of one ring / all rings after clean-up",
+            format!("{MAX_RING_POINTS} / {MAX_CLEAN_POINTS}"),
             "field reader",
         ),
         (

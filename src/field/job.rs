@@ -55,10 +55,15 @@ pub fn load_configured(
     path: &Path,
     text: &str,
 ) -> Result<LoadedField, FieldJobError> {
-    load_field(text, &cfg.field_load_options()).map_err(|source| FieldJobError::Field {
-        path: path.to_path_buf(),
-        source,
-    })
+    load_field(text, &cfg.field_load_options())
+        .and_then(|loaded| {
+            crate::field::check_plan_size(&loaded, &cfg.coverage_params())?;
+            Ok(loaded)
+        })
+        .map_err(|source| FieldJobError::Field {
+            path: path.to_path_buf(),
+            source,
+        })
 }
 
 /// A planned field job.

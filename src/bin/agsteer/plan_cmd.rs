@@ -73,6 +73,8 @@ where
     let loaded = load_field(&text, &cfg.field_load_options())
         .with_context(|| format!("field {}", field_path.display()))?;
     let params = cfg.coverage_params();
+    agsteer::field::check_plan_size(&loaded, &params)
+        .with_context(|| format!("field {}", field_path.display()))?;
     let (plan, plan_time) = timed("planning", || planner(&loaded.field, &params));
     let plan = plan.with_context(|| format!("planning {}", field_path.display()))?;
     let (metrics, metrics_time) = timed("metrics", || {
