@@ -20,6 +20,7 @@ mod bus;
 pub(crate) mod check;
 mod control;
 mod daemon;
+mod envelope;
 mod field;
 mod guidance;
 mod job;
@@ -196,12 +197,13 @@ impl Config {
 
     /// Read, override and validate a configuration file.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Config, ConfigError> {
-        let text = crate::envelope::read_text(path, crate::envelope::FileKind::Config).map_err(
-            |e| ConfigError::Read {
-                path: path.display().to_string(),
-                source: e.into_io(),
-            },
-        )?;
+        let text =
+            crate::envelope::read_text(path, crate::envelope::FileKind::Config).map_err(|e| {
+                ConfigError::Read {
+                    path: path.display().to_string(),
+                    source: e.into_io(),
+                }
+            })?;
         let cfg = Config::parse_with(&text, overrides)?;
         let problems = cfg.validate();
         if problems.is_empty() {
@@ -228,6 +230,7 @@ impl Config {
         self.maneuver.validate(&self.vehicle, &mut c);
         self.daemon.validate(&mut c);
         self.progress.validate(&mut c);
+        envelope::validate(self, &mut c);
         c.problems
     }
 
