@@ -15,8 +15,11 @@ mod dbc_cmd;
 #[path = "../../src/bin/agsteer/maneuver_cmd.rs"]
 mod maneuver_cmd;
 
-/// Every target, by name (the corpus directory names).
-pub const TARGETS: [(&str, fn(&[u8])); 10] = [
+/// A target: its name (the corpus directory) and its entry point.
+pub type Target = (&'static str, fn(&[u8]));
+
+/// Every target.
+pub const TARGETS: [Target; 10] = [
     ("candump", candump),
     ("can_frame", can_frame),
     ("fast_packet", fast_packet),
