@@ -261,8 +261,25 @@ pub fn check_plan_size(
     loaded: &LoadedField,
     params: &crate::plan::coverage::CoverageParams,
 ) -> Result<(), FieldError> {
+    let (w, r) = (params.line_width, params.r_min);
+    let usable = |v: f64| v.is_finite() && v > 0.0;
+    if !(usable(w) && usable(r) && usable(params.point_spacing)) {
+        return Err(FieldError::Envelope {
+            what: "working width, r_min and point spacing".into(),
+            value: format!("{w} m, {r} m, {} m", params.point_spacing),
+            limit: "finite and positive".into(),
+        });
+    }
+    let block = 2.0 * (2.0 * r / w).ceil() + 1.0;
+    if block > envelope::MAX_BLOCK_LINES as f64 {
+        return Err(FieldError::Envelope {
+            what: format!("lines per block 2·ceil(2·r_min/w) + 1 at r_min {r} m and w {w} m"),
+            value: format!("{block}"),
+            limit: envelope::MAX_BLOCK_LINES.to_string(),
+        });
+    }
     let area = loaded.cleanup.area_after_m2;
-    let points = area / (params.line_width * params.point_spacing);
+    let points = area / (w * params.point_spacing);
     if points.is_nan() || points > envelope::MAX_PATH_POINTS {
         return Err(FieldError::Envelope {
             what: format!(

@@ -219,8 +219,7 @@ where
             .file_stem()
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default();
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("reading field {}", path.display()))?;
+        let text = agsteer::envelope::read_text(&path, agsteer::envelope::FileKind::Field)?;
         let loaded = match load_field(&text, &cfg.field_load_options()) {
             Ok(l) => l,
             Err(e) => {
@@ -234,6 +233,10 @@ where
                 let mut params = cfg.coverage_params();
                 params.line_width = w;
                 params.r_min = r;
+                if let Err(e) = agsteer::field::check_plan_size(&loaded, &params) {
+                    println!("{name:<28} w {w} m, r_min {r} m: {e}");
+                    continue;
+                }
                 let start = Instant::now();
                 let plan = planner(&loaded.field, &params);
                 let plan_time_ms = start.elapsed().as_secs_f64() * 1e3;
