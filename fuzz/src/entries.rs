@@ -19,10 +19,12 @@ mod maneuver_cmd;
 pub type Target = (&'static str, fn(&[u8]));
 
 /// Every target.
-pub const TARGETS: [Target; 10] = [
+pub const TARGETS: [Target; 12] = [
     ("candump", candump),
     ("can_frame", can_frame),
+    ("can_inputs", can_inputs),
     ("fast_packet", fast_packet),
+    ("gnss_stream", gnss_stream),
     ("geojson", geojson),
     ("taskdata", taskdata),
     ("map", map),
@@ -48,6 +50,53 @@ pub fn can_frame(data: &[u8]) {
     let id = u32::from_le_bytes(*id);
     let _ = agsteer::can::codec::decode(id, payload);
     let _ = agsteer::can::codec::decode(id & 0x1FFF_FFFF, &payload[..payload.len().min(8)]);
+}
+
+/// A sequence of CAN frames (4 bytes of identifier, a length byte, 8 data bytes each) through
+/// the bus adapter that turns them into inputs (codec, counters, CRCs, fast packets).
+pub fn can_inputs(data: &[u8]) {
+    let mut adapter = agsteer::input::can::CanAdapter::default();
+    for (k, rec) in data.chunks(13).enumerate() {
+        let Some((id, rest)) = rec.split_first_chunk::<4>() else {
+            return;
+        };
+        let (len, bytes) = rest.split_first().unwrap_or((&0, &[]));
+        let bytes = &bytes[..bytes.len().min(*len as usize)];
+        let tf = agsteer::can::TimedFrame {
+            t: k as f64 * 0.01,
+            frame: agsteer::can::Frame::new(u32::from_le_bytes(*id), bytes),
+        };
+        let _ = adapter.on_frame(&tf);
+    }
+}
+
+/// A GNSS byte stream (NMEA 0183, UBX, RTCM 3 mixed) through the framer and the decoders: the
+/// first byte picks the protocol (bit 0) and the chunk size the bytes arrive in.
+pub fn gnss_stream(data: &[u8]) {
+    use agsteer::input::nmea0183::{clock::Receipt, convert::StreamParams};
+    use agsteer::io::decoder::{DecoderParams, GnssDecoder, Protocol};
+    let Some((head, stream)) = data.split_first() else {
+        return;
+    };
+    let protocol = if head & 1 == 0 {
+        Protocol::Nmea0183
+    } else {
+        Protocol::Ubx
+    };
+    let mut d = GnssDecoder::new(DecoderParams {
+        protocol,
+        stream: StreamParams {
+            source: agsteer::input::SourceId::Stream(0),
+            baseline_angle: 0.0,
+            max_delay_s: 0.5,
+        },
+        max_correction_age_s: 10.0,
+    });
+    let chunk = usize::from(head >> 1).max(1);
+    for (k, c) in stream.chunks(chunk).enumerate() {
+        d.push(c, &Receipt::at(k as f64 * 0.001), &mut |_| {}, &mut |_| {});
+    }
+    let _ = d.counters();
 }
 
 /// A sequence of fast-packet frames (source address, then 8 bytes each) through the
