@@ -385,7 +385,8 @@ fn check(set: &[&str]) -> Outcome {
 fn nan_and_infinite_keys_are_refused() {
     check(&["maneuver.implement_width_m=nan"]).refused(2, &["maneuver.implement_width_m = NaN"]);
     check(&["maneuver.implement_width_m=inf"]).refused(2, &["maneuver.implement_width_m"]);
-    check(&["sim.speed_min_kmh=nan"]).refused(2, &["sim.speed_min_kmh = NaN: must be a finite number"]);
+    check(&["sim.speed_min_kmh=nan"])
+        .refused(2, &["sim.speed_min_kmh = NaN: must be a finite number"]);
     check(&["sim.speed_max_kmh=-inf"]).refused(2, &["sim.speed_max_kmh"]);
 }
 

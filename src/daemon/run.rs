@@ -333,7 +333,7 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
         if let Some(dir) = path.parent() {
             let _ = std::fs::create_dir_all(dir);
         }
-        let _ = std::fs::remove_file(&path);
+        remove_stale_socket(&path);
         let l = tokio::net::UnixListener::bind(&path).map_err(|source| DaemonError::Status {
             path: cfg.bus.status_socket.clone(),
             source,
@@ -509,9 +509,19 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
         tracing::error!("saving progress: {e}");
     }
     if !cfg.bus.status_socket.is_empty() {
-        let _ = std::fs::remove_file(&cfg.bus.status_socket);
+        remove_stale_socket(std::path::Path::new(&cfg.bus.status_socket));
     }
     Ok(())
+}
+
+/// Remove the status socket left by an earlier run: only a socket, never another file that
+/// `bus.status_socket` might name by mistake (the configuration itself, say); binding then
+/// fails with the path named.
+fn remove_stale_socket(path: &std::path::Path) {
+    use std::os::unix::fs::FileTypeExt;
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_socket()) {
+        let _ = std::fs::remove_file(path);
+    }
 }
 
 #[cfg(test)]
