@@ -523,6 +523,54 @@ fn an_svg_into_a_missing_directory_fails_and_writes_nothing() {
     assert!(left.is_empty(), "{left:?}");
 }
 
+// ---- the README ----------------------------------------------------------------------------
+
+#[test]
+fn the_readme_shows_the_envelope_as_enforced() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let table = agsteer::envelope::markdown_table();
+    assert!(
+        readme.contains(&table),
+        "README.md lacks the envelope table:\n{table}"
+    );
+    for (name, _) in entries::TARGETS {
+        assert!(
+            readme.contains(&format!("`{name}`")),
+            "README.md lacks fuzz target {name}"
+        );
+    }
+}
+
+#[test]
+fn a_demo_writes_only_into_its_output_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = run_in(
+        dir.path(),
+        &[
+            "demo",
+            "--config",
+            root().join("config/demo.toml").to_str().unwrap(),
+            "--out",
+            "out",
+            "--set",
+            "job.line_num=2",
+        ],
+        300.0,
+    );
+    assert_eq!(o.code, Some(0), "{}", o.stderr);
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, ["out"], "{left:?}");
+    let mut written: Vec<_> = std::fs::read_dir(dir.path().join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    written.sort();
+    assert_eq!(written, ["progress.json", "report.json", "trace.svg"]);
+}
+
 // ---- the fuzz corpora and arbitrary bytes through every decoder ----------------------------
 
 #[test]

@@ -86,11 +86,20 @@ pub const MAX_CONFIG_LIST: usize = 1_000;
 /// between them; a manoeuvre is a local move (a headland turn, into a bay, through a gate).
 pub const MAX_MANEUVER_DISTANCE_M: f64 = 2_000.0;
 
-/// Longest line read from a line-oriented input (candump log, manoeuvre JSON lines, status
-/// request), bytes. A longer line is reported and skipped, never held whole.
+/// Longest line read from a candump log (streamed, so only its lines are bounded), bytes. A
+/// longer line is reported and skipped, never held whole.
 pub const MAX_LINE_BYTES: usize = 64 * 1024;
 
-/// One row of the README's envelope table: (what, limit, where it is checked).
+/// The README's envelope table (Markdown), from [`table`].
+pub fn markdown_table() -> String {
+    let mut s = String::from("| input | limit | checked by |\n|---|---|---|\n");
+    for (what, limit, by) in table() {
+        s.push_str(&format!("| {what} | {limit} | {by} |\n"));
+    }
+    s
+}
+
+/// The rows of the README's envelope table: (what, limit, where it is checked).
 pub fn table() -> Vec<(&'static str, String, &'static str)> {
     let mib = |b: u64| format!("{} MiB", b / (1024 * 1024));
     let mut rows = vec![
@@ -130,12 +139,13 @@ pub fn table() -> Vec<(&'static str, String, &'static str)> {
             "config, map reader, CLI",
         ),
         (
-            "AB line / arc length",
+            "AB line length |B − A|",
             format!("{} km", MAX_LINE_LENGTH_M / 1e3),
             "config",
         ),
         ("job.line_num (AB)", MAX_LINES.to_string(), "config"),
         ("job.line_num (arcs)", MAX_ARCS.to_string(), "config"),
+        ("guidance.a", MAX_BLOCK_EXTRA.to_string(), "config"),
         (
             "lines per block 2·ceil(2·r_min/w)+a",
             MAX_BLOCK_LINES.to_string(),
@@ -157,13 +167,13 @@ pub fn table() -> Vec<(&'static str, String, &'static str)> {
             "config, CLI",
         ),
         (
-            "line of a log / JSON-lines input",
+            "line of a candump log",
             format!("{} KiB", MAX_LINE_BYTES / 1024),
-            "dbc decode, maneuver --batch",
+            "dbc decode",
         ),
     ];
     for kind in FileKind::ALL {
-        rows.push((kind.what(), mib(kind.max_bytes()), "file reader"));
+        rows.push((kind.what(), mib(kind.max_bytes()), "bounded file reader"));
     }
     rows
 }
