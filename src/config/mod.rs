@@ -7,7 +7,8 @@
 //! is deserialised, so they go through exactly the same checks as the file.
 //!
 //! One file per section (`job.rs`, `guidance.rs`, `vehicle.rs`, `control.rs`, `track.rs`,
-//! `sim.rs`, `bus.rs`, `safety.rs`, `daemon.rs`, `progress.rs`, `field.rs`, `maneuver.rs`), each
+//! `sim.rs`, `bus.rs`, `safety.rs`, `daemon.rs`, `progress.rs`, `field.rs`, `maneuver.rs`,
+//! `gnss.rs`), each
 //! holding the section's struct, its defaults and its validation; [`check`] holds the
 //! range-check helpers. This module holds the whole [`Config`], loading, `--set` overrides and
 //! the errors. It does no I/O but reading the file named to [`Config::load`].
@@ -22,6 +23,7 @@ mod control;
 mod daemon;
 mod envelope;
 mod field;
+mod gnss;
 mod guidance;
 mod job;
 mod maneuver;
@@ -36,6 +38,7 @@ pub use bus::{BusConfig, OutputKind};
 pub use control::ControlConfig;
 pub use daemon::DaemonConfig;
 pub use field::{FieldConfig, FieldOrigin, SwathAngleChoice};
+pub use gnss::{ntrip_password, GnssConfig, GnssSource, PasswordFileError, TransportKind};
 pub use guidance::GuidanceConfig;
 pub use job::{JobConfig, JobKind, LineOrder, LineSide};
 pub use maneuver::{CurveChoice, ManeuverConfig};
@@ -96,6 +99,7 @@ pub struct Config {
     pub daemon: DaemonConfig,
     pub field: FieldConfig,
     pub maneuver: ManeuverConfig,
+    pub gnss: GnssConfig,
 }
 
 /// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
@@ -230,6 +234,7 @@ impl Config {
         self.maneuver.validate(&self.vehicle, &mut c);
         self.daemon.validate(&mut c);
         self.progress.validate(&mut c);
+        self.gnss.validate(&mut c);
         envelope::validate(self, &mut c);
         c.problems
     }
@@ -261,6 +266,7 @@ impl Config {
             "bus.status_socket",
             self.bus.status_socket == new.bus.status_socket,
         );
+        check("gnss", self.gnss == new.gnss);
         check(
             "progress.state_dir",
             self.progress.state_dir == new.progress.state_dir,
