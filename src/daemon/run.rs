@@ -41,6 +41,8 @@ pub enum DaemonError {
     Maneuver(#[source] super::maneuver_file::ManeuverFileError),
     #[error("runtime: {0}")]
     Runtime(std::io::Error),
+    #[error(transparent)]
+    Gnss(#[from] crate::config::PasswordFileError),
 }
 
 /// Control-loop timing, for the status socket.
@@ -67,6 +69,9 @@ struct StatusReply<'a> {
     timing: &'a LoopStats,
     interface: &'a str,
     dt_s: f64,
+    /// The GNSS byte stream and NTRIP client, when `gnss.source` is one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gnss: Option<super::gnss::GnssStatusReply>,
 }
 
 enum BusEvent {
@@ -362,6 +367,9 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
         }
     });
 
+    // GNSS over a serial port, USB, UDP or TCP, and the NTRIP client ([gnss]).
+    let mut gnss = super::gnss::spawn(&cfg, &local)?;
+
     let dt = cfg.dt();
     let mut interval = tokio::time::interval(Duration::from_secs_f64(dt));
     interval.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
@@ -467,6 +475,16 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                         }
                         None => break,
                     },
+                    input = async {
+                        match gnss.as_mut() {
+                            Some(g) => g.inputs.recv().await,
+                            None => std::future::pending().await,
+                        }
+                    } => {
+                        if let Some(i) = input {
+                            node.on_input(&i);
+                        }
+                    }
                     conn = async {
                         match &listener {
                             Some(l) => l.accept().await,
@@ -479,6 +497,7 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                                 timing: &stats,
                                 interface: &iface,
                                 dt_s: dt,
+                                gnss: gnss.as_ref().map(|g| g.status(monotonic_s())),
                             };
                             let mut text = serde_json::to_string(&reply).unwrap_or_default();
                             text.push('\n');
