@@ -228,6 +228,7 @@ impl Config {
         self.control.validate(&mut c);
         self.track.validate(&mut c);
         self.sim.validate(&mut c);
+        self.sim.validate_plant(self.vehicle.wheelbase_m, &mut c);
         self.bus.validate(&mut c);
         self.safety.validate(&mut c);
         self.vehicle.validate_body(&mut c);
