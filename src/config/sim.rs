@@ -101,6 +101,8 @@ pub struct SimConfig {
     pub cornering_stiffness_rear_n_per_deg: f64,
     /// Tyre relaxation length, m.
     pub relaxation_length_m: f64,
+    /// Tyre-soil friction coefficient (lateral force limit / axle load).
+    pub tyre_friction: f64,
     /// Implement side draft: lateral force at the hitch, N (positive pulls right), and the
     /// hitch's distance behind the rear axle, m.
     pub implement_side_force_n: f64,
@@ -159,6 +161,7 @@ impl Default for SimConfig {
             cornering_stiffness_front_n_per_deg: 2100.0,
             cornering_stiffness_rear_n_per_deg: 4200.0,
             relaxation_length_m: 0.6,
+            tyre_friction: 0.6,
             implement_side_force_n: 0.0,
             implement_hitch_m: 1.0,
         }
@@ -293,6 +296,7 @@ impl SimConfig {
             100_000.0,
         );
         c.range("sim.relaxation_length_m", s.relaxation_length_m, 0.05, 5.0);
+        c.range("sim.tyre_friction", s.tyre_friction, 0.1, 1.5);
         c.range(
             "sim.implement_side_force_n",
             s.implement_side_force_n,
@@ -313,14 +317,16 @@ impl SimConfig {
     /// gravity between the axles.
     pub(crate) fn validate_plant(&self, wheelbase_m: f64, c: &mut Checker) {
         let s = self;
-        if !(wheelbase_m + s.wheelbase_error_m >= 0.5) {
+        let true_wheelbase = wheelbase_m + s.wheelbase_error_m;
+        if true_wheelbase.is_nan() || true_wheelbase < 0.5 {
             c.push(
                 "sim.wheelbase_error_m",
                 fmt_num(s.wheelbase_error_m),
                 "vehicle.wheelbase_m + sim.wheelbase_error_m must be at least 0.5",
             );
         }
-        if s.tyre_slip && !(s.cg_ahead_of_rear_m < wheelbase_m + s.wheelbase_error_m) {
+        if s.tyre_slip && (s.cg_ahead_of_rear_m >= true_wheelbase || s.cg_ahead_of_rear_m.is_nan())
+        {
             c.push(
                 "sim.cg_ahead_of_rear_m",
                 fmt_num(s.cg_ahead_of_rear_m),

@@ -144,6 +144,8 @@ pub fn observer_params(cfg: &Config) -> ObserverParams {
         slip_tau: t.observer_slip_tau_s,
         slip_limit: t.observer_slip_limit_mps_per_deg.to_degrees(),
         coast_max: t.observer_coast_max_s,
+        robust: t.observer_robust,
+        position_process: t.position_process_m,
     }
 }
 

@@ -48,6 +48,7 @@ pub fn sim_params(cfg: &Config) -> SimParams {
             cornering_stiffness_front: s.cornering_stiffness_front_n_per_deg.to_degrees(),
             cornering_stiffness_rear: s.cornering_stiffness_rear_n_per_deg.to_degrees(),
             relaxation_length: s.relaxation_length_m,
+            friction: s.tyre_friction,
             side_force: s.implement_side_force_n,
             hitch_behind_rear: s.implement_hitch_m,
         }),
