@@ -3,7 +3,7 @@
 //!
 //! `cargo bench --bench block_order -- --warm-up-time 1 --measurement-time 3`
 
-use agsteer::plan::abline::solve_block_order;
+use agsteer::plan::skip_order::solve_block_order;
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 
 fn bench(c: &mut Criterion) {

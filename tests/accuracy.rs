@@ -173,3 +173,48 @@ fn the_default_tracker_learns_the_steering_play_and_removes_its_weave() {
     let lost = learnt(&short, &dropout);
     assert!(lost < 0.1, "learnt {lost:.3}° while disengaged");
 }
+
+#[test]
+fn the_plant_keys_make_a_simulated_tractor_that_is_not_the_model() {
+    let set: Vec<String> = [
+        "sim.wheelbase_error_m=0.3",
+        "sim.antenna_error_forward_m=-0.2",
+        "sim.antenna_error_left_m=0.1",
+        "sim.antenna_error_up_m=0.25",
+        "sim.was_gain=1.1",
+        "sim.was_bias_deg=2",
+        "sim.tyre_slip=true",
+        "sim.cornering_stiffness_rear_n_per_deg=3000",
+        "sim.implement_side_force_n=1500",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let cfg = scenario_config("straight_10kmh", &set);
+    let p = agsteer::demo::sim_params(&cfg);
+    assert!((p.wheelbase - (cfg.vehicle.wheelbase_m + 0.3)).abs() < 1e-12);
+    assert!((p.antenna_forward - (cfg.vehicle.antenna_forward_m - 0.2)).abs() < 1e-12);
+    assert!((p.antenna_left - (cfg.vehicle.antenna_left_m + 0.1)).abs() < 1e-12);
+    assert!((p.antenna_up - (cfg.vehicle.antenna_up_m + 0.25)).abs() < 1e-12);
+    assert_eq!(p.was_gain, 1.1);
+    assert!((p.dist.was_bias - 2f64.to_radians()).abs() < 1e-12);
+    let lat = p.lateral.expect("tyre_slip switches the dynamic model on");
+    assert!((lat.cornering_stiffness_rear - 3000f64.to_degrees()).abs() < 1e-9);
+    assert_eq!(lat.side_force, 1500.0);
+    // The controller's model is untouched.
+    let nominal = scenario_config("straight_10kmh", &[]);
+    assert_eq!(cfg.vehicle, nominal.vehicle);
+    assert!(agsteer::demo::sim_params(&nominal).lateral.is_none());
+    // A side draft needs the tyres; the errors name the key.
+    let path = format!(
+        "{}/tools/scenarios/straight_10kmh.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let err = Config::load(
+        std::path::Path::new(&path),
+        &["sim.implement_side_force_n=100".to_string()],
+    )
+    .expect_err("a side draft without tyres is refused")
+    .to_string();
+    assert!(err.contains("sim.implement_side_force_n"), "{err}");
+}

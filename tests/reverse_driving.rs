@@ -6,9 +6,9 @@
 use agsteer::config::Config;
 use agsteer::demo::{run, DemoOptions};
 use agsteer::geo::{v2, Direction, Vec2};
-use agsteer::guidance::segments::{JobSegment, SegmentJob};
 use agsteer::guidance::{Event, JobPlan};
 use agsteer::plan::coverage::SegmentKind;
+use agsteer::plan::job::{JobSegment, SegmentJob};
 
 fn seg(direction: Direction, points: Vec<Vec2>) -> JobSegment {
     JobSegment {

@@ -38,14 +38,8 @@ pub enum LineOrder {
     Sequential,
 }
 
-/// Side of A→B on which the following lines are laid.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum LineSide {
-    Left,
-    #[default]
-    Right,
-}
+/// Side of A→B on which the following lines are laid (the AB planner's type).
+pub use crate::plan::types::Side as LineSide;
 
 /// `[job]`: what to drive.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -7,7 +7,8 @@
 //! is deserialised, so they go through exactly the same checks as the file.
 //!
 //! One file per section (`job.rs`, `guidance.rs`, `vehicle.rs`, `control.rs`, `track.rs`,
-//! `sim.rs`, `bus.rs`, `safety.rs`, `daemon.rs`, `progress.rs`, `field.rs`, `maneuver.rs`), each
+//! `sim.rs`, `bus.rs`, `safety.rs`, `daemon.rs`, `progress.rs`, `field.rs`, `maneuver.rs`,
+//! `gnss.rs`), each
 //! holding the section's struct, its defaults and its validation; [`check`] holds the
 //! range-check helpers. This module holds the whole [`Config`], loading, `--set` overrides and
 //! the errors. It does no I/O but reading the file named to [`Config::load`].
@@ -20,7 +21,9 @@ mod bus;
 pub(crate) mod check;
 mod control;
 mod daemon;
+mod envelope;
 mod field;
+mod gnss;
 mod guidance;
 mod job;
 mod maneuver;
@@ -35,6 +38,7 @@ pub use bus::{BusConfig, OutputKind};
 pub use control::ControlConfig;
 pub use daemon::DaemonConfig;
 pub use field::{FieldConfig, FieldOrigin, SwathAngleChoice};
+pub use gnss::{ntrip_password, GnssConfig, GnssSource, PasswordFileError, TransportKind};
 pub use guidance::GuidanceConfig;
 pub use job::{JobConfig, JobKind, LineOrder, LineSide};
 pub use maneuver::{CurveChoice, ManeuverConfig};
@@ -95,6 +99,7 @@ pub struct Config {
     pub daemon: DaemonConfig,
     pub field: FieldConfig,
     pub maneuver: ManeuverConfig,
+    pub gnss: GnssConfig,
 }
 
 /// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
@@ -196,10 +201,13 @@ impl Config {
 
     /// Read, override and validate a configuration file.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Config, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text =
+            crate::envelope::read_text(path, crate::envelope::FileKind::Config).map_err(|e| {
+                ConfigError::Read {
+                    path: path.display().to_string(),
+                    source: e.into_io(),
+                }
+            })?;
         let cfg = Config::parse_with(&text, overrides)?;
         let problems = cfg.validate();
         if problems.is_empty() {
@@ -220,12 +228,15 @@ impl Config {
         self.control.validate(&mut c);
         self.track.validate(&mut c);
         self.sim.validate(&mut c);
+        self.sim.validate_plant(self.vehicle.wheelbase_m, &mut c);
         self.bus.validate(&mut c);
         self.safety.validate(&mut c);
         self.vehicle.validate_body(&mut c);
         self.maneuver.validate(&self.vehicle, &mut c);
         self.daemon.validate(&mut c);
         self.progress.validate(&mut c);
+        self.gnss.validate(&mut c);
+        envelope::validate(self, &mut c);
         c.problems
     }
 
@@ -256,6 +267,7 @@ impl Config {
             "bus.status_socket",
             self.bus.status_socket == new.bus.status_socket,
         );
+        check("gnss", self.gnss == new.gnss);
         check(
             "progress.state_dir",
             self.progress.state_dir == new.progress.state_dir,

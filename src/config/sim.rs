@@ -81,6 +81,32 @@ pub struct SimConfig {
     pub speed_min_kmh: f64,
     pub speed_max_kmh: f64,
     pub speed_turn_angle_deg: f64,
+    // The true vehicle where it differs from the controller's model (`[vehicle]`).
+    /// True wheelbase − `vehicle.wheelbase_m`, m.
+    pub wheelbase_error_m: f64,
+    /// True antenna position − `vehicle.antenna_*_m`: forward, left, up, m.
+    pub antenna_error_forward_m: f64,
+    pub antenna_error_left_m: f64,
+    pub antenna_error_up_m: f64,
+    /// Wheel-angle sensor gain: it reads this × the true angle (+ `was_bias_deg`).
+    pub was_gain: f64,
+    /// The dynamic lateral model (tyre slip); off = the kinematic bicycle.
+    pub tyre_slip: bool,
+    /// Mass, kg; yaw moment of inertia, kg·m²; centre of gravity ahead of the rear axle, m.
+    pub mass_kg: f64,
+    pub yaw_inertia_kg_m2: f64,
+    pub cg_ahead_of_rear_m: f64,
+    /// Cornering stiffness of the front and rear axle (both tyres), N per degree of slip.
+    pub cornering_stiffness_front_n_per_deg: f64,
+    pub cornering_stiffness_rear_n_per_deg: f64,
+    /// Tyre relaxation length, m.
+    pub relaxation_length_m: f64,
+    /// Tyre-soil friction coefficient (lateral force limit / axle load).
+    pub tyre_friction: f64,
+    /// Implement side draft: lateral force at the hitch, N (positive pulls right), and the
+    /// hitch's distance behind the rear axle, m.
+    pub implement_side_force_n: f64,
+    pub implement_hitch_m: f64,
 }
 
 impl Default for SimConfig {
@@ -123,6 +149,21 @@ impl Default for SimConfig {
             speed_min_kmh: 4.0,
             speed_max_kmh: 0.0,
             speed_turn_angle_deg: 5.0,
+            wheelbase_error_m: 0.0,
+            antenna_error_forward_m: 0.0,
+            antenna_error_left_m: 0.0,
+            antenna_error_up_m: 0.0,
+            was_gain: 1.0,
+            tyre_slip: false,
+            mass_kg: 8000.0,
+            yaw_inertia_kg_m2: 18_000.0,
+            cg_ahead_of_rear_m: 1.2,
+            cornering_stiffness_front_n_per_deg: 2100.0,
+            cornering_stiffness_rear_n_per_deg: 4200.0,
+            relaxation_length_m: 0.6,
+            tyre_friction: 0.6,
+            implement_side_force_n: 0.0,
+            implement_hitch_m: 1.0,
         }
     }
 }
@@ -219,5 +260,78 @@ impl SimConfig {
             0.0,
             10.0,
         );
+        c.range("sim.wheelbase_error_m", s.wheelbase_error_m, -2.0, 2.0);
+        c.range(
+            "sim.antenna_error_forward_m",
+            s.antenna_error_forward_m,
+            -2.0,
+            2.0,
+        );
+        c.range(
+            "sim.antenna_error_left_m",
+            s.antenna_error_left_m,
+            -2.0,
+            2.0,
+        );
+        c.range("sim.antenna_error_up_m", s.antenna_error_up_m, -2.0, 2.0);
+        c.range("sim.was_gain", s.was_gain, 0.7, 1.3);
+        c.range("sim.mass_kg", s.mass_kg, 300.0, 60_000.0);
+        c.range(
+            "sim.yaw_inertia_kg_m2",
+            s.yaw_inertia_kg_m2,
+            50.0,
+            1_000_000.0,
+        );
+        c.range("sim.cg_ahead_of_rear_m", s.cg_ahead_of_rear_m, 0.01, 20.0);
+        c.range(
+            "sim.cornering_stiffness_front_n_per_deg",
+            s.cornering_stiffness_front_n_per_deg,
+            50.0,
+            100_000.0,
+        );
+        c.range(
+            "sim.cornering_stiffness_rear_n_per_deg",
+            s.cornering_stiffness_rear_n_per_deg,
+            50.0,
+            100_000.0,
+        );
+        c.range("sim.relaxation_length_m", s.relaxation_length_m, 0.05, 5.0);
+        c.range("sim.tyre_friction", s.tyre_friction, 0.1, 1.5);
+        c.range(
+            "sim.implement_side_force_n",
+            s.implement_side_force_n,
+            -50_000.0,
+            50_000.0,
+        );
+        c.range("sim.implement_hitch_m", s.implement_hitch_m, 0.0, 10.0);
+        if s.implement_side_force_n != 0.0 && !s.tyre_slip {
+            c.push(
+                "sim.implement_side_force_n",
+                fmt_num(s.implement_side_force_n),
+                "needs sim.tyre_slip = true (the kinematic model has no tyre to push against)",
+            );
+        }
+    }
+
+    /// Checks of `[sim]` against `[vehicle]`: the true wheelbase stays physical, the centre of
+    /// gravity between the axles.
+    pub(crate) fn validate_plant(&self, wheelbase_m: f64, c: &mut Checker) {
+        let s = self;
+        let true_wheelbase = wheelbase_m + s.wheelbase_error_m;
+        if true_wheelbase.is_nan() || true_wheelbase < 0.5 {
+            c.push(
+                "sim.wheelbase_error_m",
+                fmt_num(s.wheelbase_error_m),
+                "vehicle.wheelbase_m + sim.wheelbase_error_m must be at least 0.5",
+            );
+        }
+        if s.tyre_slip && (s.cg_ahead_of_rear_m >= true_wheelbase || s.cg_ahead_of_rear_m.is_nan())
+        {
+            c.push(
+                "sim.cg_ahead_of_rear_m",
+                fmt_num(s.cg_ahead_of_rear_m),
+                "must be less than the true wheelbase (vehicle.wheelbase_m + sim.wheelbase_error_m)",
+            );
+        }
     }
 }

@@ -73,6 +73,13 @@ pub struct TrackConfig {
     /// Through an RTK-float period, dead-reckon from the last fixed position for at most this
     /// long instead of following the float positions, s (0 = off).
     pub observer_coast_max_s: f64,
+    /// The observer estimates the fixes' noise and widens its gates with it; it coasts through
+    /// a jump only while the jump is a step (see
+    /// [`ObserverParams::robust`](crate::estimate::ObserverParams::robust)).
+    pub observer_robust: bool,
+    /// Position smoothing: dead-reckoning error growth per 0.1 s, m, against the estimated
+    /// noise of the fixes (0 = off; needs `observer_robust`).
+    pub position_process_m: f64,
     /// Lost-motion compensation (predictive tracker only; see
     /// [`LostMotion`](crate::track::lost_motion::LostMotion)): time constant of the steering's
     /// lost-motion (backlash + actuator deadband) estimate, s (0 = off).
@@ -113,6 +120,8 @@ impl Default for TrackConfig {
             observer_slip_tau_s: 30.0,
             observer_slip_limit_mps_per_deg: 0.05,
             observer_coast_max_s: 30.0,
+            observer_robust: true,
+            position_process_m: 0.0,
             lost_motion_tau_s: 5.0,
             lost_motion_threshold_deg: 0.1,
             lost_motion_limit_deg: 1.0,
@@ -214,6 +223,7 @@ impl TrackConfig {
             0.0,
             600.0,
         );
+        c.range("track.position_process_m", t.position_process_m, 0.0, 1.0);
         c.range("track.lost_motion_tau_s", t.lost_motion_tau_s, 0.0, 600.0);
         c.range(
             "track.lost_motion_threshold_deg",

@@ -5,14 +5,14 @@
 //! allocation-free per cycle and never does I/O: callers feed it inputs and persist the
 //! progress snapshots it hands out.
 
-use crate::config::{Config, JobKind, LineOrder, LineSide, TrackerChoice};
+use crate::config::{Config, JobKind, LineOrder, TrackerChoice};
 use crate::estimate::{
     AntennaOffset, Estimator, EstimatorParams, GnssFix, ObserverParams, VehicleEstimate,
 };
 use crate::geo::{heading_vec, left_normal, v2, Direction, Pose, Vec2};
 use crate::guidance::progress::{JobDefinition, Progress};
 use crate::guidance::{Guidance, GuidanceError, GuidanceParams, JobPlan};
-use crate::plan::abline::{AbParams, AbPlan, Side};
+use crate::plan::abline::{AbParams, AbPlan};
 use crate::plan::turns::TurnParams;
 use crate::track::local_path::LocalPathParams;
 use crate::track::lost_motion::{LostMotion, LostMotionParams};
@@ -31,10 +31,7 @@ pub fn ab_params(cfg: &Config) -> AbParams {
         line_width: cfg.job.line_width_m,
         line_num: cfg.job.line_num,
         r_min: cfg.turn_radius(),
-        side: match cfg.job.side {
-            LineSide::Left => Side::Left,
-            LineSide::Right => Side::Right,
-        },
+        side: cfg.job.side,
         block_extra: cfg.guidance.a.max(1) as u32,
         point_spacing: cfg.guidance.point_spacing_m,
         turn: TurnParams {
@@ -49,9 +46,9 @@ pub fn ab_params(cfg: &Config) -> AbParams {
 }
 
 /// The arcs job (`job.kind = "arcs"`) from the configuration.
-pub fn arcs_plan(cfg: &Config) -> Result<JobPlan, crate::plan::PlanError> {
+pub fn arcs_plan(cfg: &Config) -> Result<JobPlan, crate::plan::types::PlanError> {
     let ab = ab_params(cfg);
-    let job = crate::plan::arcs::arcs_job(&crate::plan::arcs::ArcsParams {
+    let segments = crate::plan::arcs::arcs_segments(&crate::plan::arcs::ArcsParams {
         centre: ab.point_a,
         r_inner: cfg.job.arc_radius_m,
         width: cfg.job.line_width_m,
@@ -61,6 +58,7 @@ pub fn arcs_plan(cfg: &Config) -> Result<JobPlan, crate::plan::PlanError> {
         point_spacing: cfg.guidance.point_spacing_m,
         turn: ab.turn,
     })?;
+    let job = crate::plan::job::SegmentJob::from_plan_segments(segments)?;
     Ok(JobPlan::Segments(job))
 }
 
@@ -71,7 +69,7 @@ pub fn ab_job_plan(cfg: &Config) -> Result<JobPlan, ControlError> {
     Ok(match cfg.job.line_order {
         LineOrder::Blocks => AbPlan::new(params)?.into(),
         LineOrder::Sequential => {
-            JobPlan::Segments(crate::guidance::segments::SegmentJob::from_plan_segments(
+            JobPlan::Segments(crate::plan::job::SegmentJob::from_plan_segments(
                 crate::plan::abline::sequential_segments(&params)?,
             )?)
         }
@@ -146,6 +144,8 @@ pub fn observer_params(cfg: &Config) -> ObserverParams {
         slip_tau: t.observer_slip_tau_s,
         slip_limit: t.observer_slip_limit_mps_per_deg.to_degrees(),
         coast_max: t.observer_coast_max_s,
+        robust: t.observer_robust,
+        position_process: t.position_process_m,
     }
 }
 
@@ -187,7 +187,7 @@ pub enum ControlError {
     #[error(transparent)]
     Guidance(#[from] GuidanceError),
     #[error("cannot plan the job: {0}")]
-    Plan(#[from] crate::plan::PlanError),
+    Plan(#[from] crate::plan::types::PlanError),
     #[error("job.kind = \"field\" or \"maneuver\" needs its plan: load it first (the daemon and `agsteer demo` read job.field_path or job.maneuver_map_path)")]
     NoPlan,
 }
@@ -369,7 +369,7 @@ impl Controller {
         )
         .map(|(_, parts)| {
             let n = parts.len();
-            let segments = crate::guidance::segments::JobSegment::from_driven_parts(
+            let segments = crate::plan::job::JobSegment::from_driven_parts(
                 parts,
                 crate::plan::coverage::SegmentKind::Transit,
             );

@@ -55,6 +55,8 @@ pub struct ControllerNode {
     packer: Packer,
     /// Frames → inputs.
     can: CanAdapter,
+    /// GNSS comes from a byte stream (`gnss.source`): GNSS inputs from the bus are ignored.
+    gnss_from_stream: bool,
     output: OutputKind,
     heading: Option<(f64, f64)>,
     /// Latest IMU roll: (time s, rad, positive right side down).
@@ -134,6 +136,7 @@ impl ControllerNode {
             }),
             packer: Packer::new(cfg.bus.source_address),
             can: CanAdapter::default(),
+            gnss_from_stream: cfg.gnss.is_stream(),
             output: cfg.bus.output,
             heading: None,
             roll: None,
@@ -202,6 +205,13 @@ impl ControllerNode {
     /// One received frame: the CAN adapter's inputs, in order.
     pub fn on_frame(&mut self, tf: &TimedFrame) {
         for input in self.can.on_frame(tf) {
+            let gnss = matches!(
+                input,
+                Input::Position(_) | Input::Quality(_) | Input::CourseSpeed(_) | Input::Heading(_)
+            );
+            if gnss && self.gnss_from_stream {
+                continue;
+            }
             self.on_input(&input);
         }
     }

@@ -20,9 +20,12 @@ pub fn read_text(cfg: &Config) -> Result<(PathBuf, String), FieldJobError> {
         return Err(FieldJobError::NotAFieldJob);
     }
     let path = field_path(cfg);
-    match std::fs::read_to_string(&path) {
+    match crate::envelope::read_text(&path, crate::envelope::FileKind::Field) {
         Ok(text) => Ok((path, text)),
-        Err(source) => Err(FieldJobError::Read { path, source }),
+        Err(e) => Err(FieldJobError::Read {
+            path,
+            source: e.into_io(),
+        }),
     }
 }
 

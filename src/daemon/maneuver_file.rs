@@ -34,9 +34,11 @@ pub fn load_map(cfg: &Config) -> Result<Option<Field>, ManeuverFileError> {
         return Ok(None);
     }
     let path = PathBuf::from(name);
-    let text = std::fs::read_to_string(&path).map_err(|source| ManeuverFileError::Read {
-        path: path.clone(),
-        source,
+    let text = crate::envelope::read_text(&path, crate::envelope::FileKind::Map).map_err(|e| {
+        ManeuverFileError::Read {
+            path: path.clone(),
+            source: e.into_io(),
+        }
     })?;
     crate::field::load_local_map(&text)
         .map(Some)

@@ -2,6 +2,7 @@
 //! notifications.
 
 pub mod field_file;
+pub mod gnss;
 pub mod maneuver_file;
 pub mod notify;
 pub mod progress_file;

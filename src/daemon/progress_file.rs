@@ -59,10 +59,10 @@ pub fn save(path: &Path, progress: &Progress) -> Result<(), ProgressFileError> {
 /// Load a progress file. `Ok(None)` when there is none. A corrupt file is renamed aside and
 /// reported as [`ProgressFileError::Corrupt`].
 pub fn load(path: &Path) -> Result<Option<Progress>, ProgressFileError> {
-    let bytes = match fs::read(path) {
+    let bytes = match crate::envelope::read_bytes(path, crate::envelope::FileKind::Progress) {
         Ok(b) => b,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(io(path)(e)),
+        Err(e) if e.is_not_found() => return Ok(None),
+        Err(e) => return Err(io(path)(e.into_io())),
     };
     match Progress::decode(&bytes) {
         Ok(p) => Ok(Some(p)),

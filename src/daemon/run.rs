@@ -41,6 +41,8 @@ pub enum DaemonError {
     Maneuver(#[source] super::maneuver_file::ManeuverFileError),
     #[error("runtime: {0}")]
     Runtime(std::io::Error),
+    #[error(transparent)]
+    Gnss(#[from] crate::config::PasswordFileError),
 }
 
 /// Control-loop timing, for the status socket.
@@ -67,6 +69,9 @@ struct StatusReply<'a> {
     timing: &'a LoopStats,
     interface: &'a str,
     dt_s: f64,
+    /// The GNSS byte stream and NTRIP client, when `gnss.source` is one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gnss: Option<super::gnss::GnssStatusReply>,
 }
 
 enum BusEvent {
@@ -333,7 +338,7 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
         if let Some(dir) = path.parent() {
             let _ = std::fs::create_dir_all(dir);
         }
-        let _ = std::fs::remove_file(&path);
+        remove_stale_socket(&path);
         let l = tokio::net::UnixListener::bind(&path).map_err(|source| DaemonError::Status {
             path: cfg.bus.status_socket.clone(),
             source,
@@ -361,6 +366,9 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
             }
         }
     });
+
+    // GNSS over a serial port, USB, UDP or TCP, and the NTRIP client ([gnss]).
+    let mut gnss = super::gnss::spawn(&cfg, &local)?;
 
     let dt = cfg.dt();
     let mut interval = tokio::time::interval(Duration::from_secs_f64(dt));
@@ -467,6 +475,16 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                         }
                         None => break,
                     },
+                    input = async {
+                        match gnss.as_mut() {
+                            Some(g) => g.inputs.recv().await,
+                            None => std::future::pending().await,
+                        }
+                    } => {
+                        if let Some(i) = input {
+                            node.on_input(&i);
+                        }
+                    }
                     conn = async {
                         match &listener {
                             Some(l) => l.accept().await,
@@ -479,6 +497,7 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                                 timing: &stats,
                                 interface: &iface,
                                 dt_s: dt,
+                                gnss: gnss.as_ref().map(|g| g.status(monotonic_s())),
                             };
                             let mut text = serde_json::to_string(&reply).unwrap_or_default();
                             text.push('\n');
@@ -509,9 +528,19 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
         tracing::error!("saving progress: {e}");
     }
     if !cfg.bus.status_socket.is_empty() {
-        let _ = std::fs::remove_file(&cfg.bus.status_socket);
+        remove_stale_socket(std::path::Path::new(&cfg.bus.status_socket));
     }
     Ok(())
+}
+
+/// Remove the status socket left by an earlier run: only a socket, never another file that
+/// `bus.status_socket` might name by mistake (the configuration itself, say); binding then
+/// fails with the path named.
+fn remove_stale_socket(path: &std::path::Path) {
+    use std::os::unix::fs::FileTypeExt;
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_socket()) {
+        let _ = std::fs::remove_file(path);
+    }
 }
 
 #[cfg(test)]

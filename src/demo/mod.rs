@@ -5,6 +5,7 @@
 //! the SVG is recorded only on request.
 
 pub mod accuracy;
+pub mod envelope;
 pub mod svg;
 
 use crate::can::bus::{CanBus, MemBus};
@@ -18,7 +19,7 @@ use crate::guidance::progress::{Phase, Progress};
 use crate::guidance::{Event, JobPlan};
 use crate::safety::SafetyState;
 use crate::sim::can_node::{Scenario, SimAddresses, SimNode, SpeedProfile};
-use crate::sim::{Disturbances, SimParams, Simulator};
+use crate::sim::{Disturbances, LateralDynamics, SimParams, Simulator};
 use serde::Serialize;
 
 /// Work-line samples closer than this to the line start are excluded from the XTE figures, m.
@@ -32,11 +33,25 @@ const TRACE_SPACING_M: f64 = 0.5;
 pub fn sim_params(cfg: &Config) -> SimParams {
     let s = &cfg.sim;
     SimParams {
-        wheelbase: cfg.vehicle.wheelbase_m,
+        // The true vehicle: the controller's model plus the plant's own errors.
+        wheelbase: cfg.vehicle.wheelbase_m + s.wheelbase_error_m,
         max_wheel_angle: cfg.max_wheel_angle(),
-        antenna_forward: cfg.vehicle.antenna_forward_m,
-        antenna_left: cfg.vehicle.antenna_left_m,
-        antenna_up: cfg.vehicle.antenna_up_m,
+        antenna_forward: cfg.vehicle.antenna_forward_m + s.antenna_error_forward_m,
+        antenna_left: cfg.vehicle.antenna_left_m + s.antenna_error_left_m,
+        antenna_up: cfg.vehicle.antenna_up_m + s.antenna_error_up_m,
+        was_gain: s.was_gain,
+        lateral: s.tyre_slip.then(|| LateralDynamics {
+            mass: s.mass_kg,
+            yaw_inertia: s.yaw_inertia_kg_m2,
+            cg_ahead_of_rear: s.cg_ahead_of_rear_m,
+            // Per degree → per radian.
+            cornering_stiffness_front: s.cornering_stiffness_front_n_per_deg.to_degrees(),
+            cornering_stiffness_rear: s.cornering_stiffness_rear_n_per_deg.to_degrees(),
+            relaxation_length: s.relaxation_length_m,
+            friction: s.tyre_friction,
+            side_force: s.implement_side_force_n,
+            hitch_behind_rear: s.implement_hitch_m,
+        }),
         dead_time: s.actuator_dead_time_s,
         tau: s.actuator_tau_s,
         max_rate: s.actuator_rate_deg_s.to_radians(),

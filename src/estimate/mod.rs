@@ -106,6 +106,17 @@ pub struct ObserverParams {
     /// measured heading, the measured wheel angles less the offset, and the drift) instead of
     /// taking the float positions, for at most this long, s; 0 = off.
     pub coast_max: f64,
+    /// Robust to the receiver: estimate the fixes' noise from the innovations and widen the
+    /// gates with it (3.5 σ of the innovation, never below the fixed ones), and coast through a
+    /// jump only while it is a step (a lateral offset from the dead reckoning that stays put):
+    /// an offset that keeps growing is the dead reckoning going wrong (a model error), and the
+    /// fixes are taken again. Off: the fixed gates and a jump coasts until the fixes agree.
+    pub robust: bool,
+    /// Smooth the position: the pose handed out is the dead reckoning corrected by a Kalman
+    /// gain towards each fix, for a dead-reckoning error that grows by this much per 0.1 s
+    /// (m) against the estimated noise of the fixes (needs `robust`); 0 = each fix is taken
+    /// as it is. The observer learns from the raw fixes either way.
+    pub position_process: f64,
 }
 
 impl Default for ObserverParams {
@@ -119,6 +130,8 @@ impl Default for ObserverParams {
             slip_tau: 0.0,
             slip_limit: 3.0,
             coast_max: 0.0,
+            robust: false,
+            position_process: 0.0,
         }
     }
 }
@@ -130,6 +143,12 @@ impl Default for ObserverParams {
 /// [`ObserverParams::coast_max`].
 const GATE_LATERAL: f64 = 0.05;
 const GATE_HEADING: f64 = 0.02;
+/// With [`ObserverParams::robust`]: the lateral gate is this many standard deviations of the
+/// innovation (σ·√2 for two fixes of noise σ each).
+const GATE_SIGMAS: f64 = 3.5;
+/// The noise estimate's time constant, in fixes, and its starting value, m.
+const NOISE_FIXES: f64 = 50.0;
+const NOISE_START: f64 = 0.01;
 
 /// Why the estimator is dead-reckoning instead of taking the fix positions.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -283,6 +302,15 @@ pub struct Estimator {
     coast: bool,
     /// Dead reckoning through an RTK float or a position jump.
     coast_state: Coast,
+    /// Estimated variance of a fix's position noise per axis, m² ([`ObserverParams::robust`]).
+    noise_var: f64,
+    /// The previous fix's lateral innovation, m.
+    prev_lateral: Option<f64>,
+    /// The lateral offset of the fixes from the dead reckoning when the current jump began, m.
+    jump_onset: f64,
+    /// The smoothed pose's offset from the fix-based one (world, m;
+    /// [`ObserverParams::position_process`]).
+    smooth: Vec2,
 }
 
 impl Estimator {
@@ -307,7 +335,44 @@ impl Estimator {
             learn: true,
             coast: false,
             coast_state: Coast::Off,
+            noise_var: NOISE_START * NOISE_START,
+            prev_lateral: None,
+            jump_onset: 0.0,
+            smooth: Vec2::zeros(),
         }
+    }
+
+    /// The lateral gate for innovations, m: fixed, or widened with the estimated noise.
+    fn gate_lateral(&self) -> f64 {
+        if self.params.observer.robust {
+            GATE_LATERAL.max(GATE_SIGMAS * (2.0 * self.noise_var).sqrt())
+        } else {
+            GATE_LATERAL
+        }
+    }
+
+    /// The estimated noise of the fixes' position, σ per axis, m.
+    pub fn position_noise(&self) -> f64 {
+        self.noise_var.sqrt()
+    }
+
+    /// Learn the fixes' noise from a lateral innovation `lateral` (m). Against a pose taken
+    /// from the previous fix the innovation is the difference of two fixes' noise (variance
+    /// 2σ²); while coasting it is measured against the dead reckoning, so a jump is in all of
+    /// them and the difference of two consecutive ones is used instead (variance 2σ² again).
+    /// Each sample is clipped at 4 σ, so a jump's onset barely moves it.
+    fn learn_noise(&mut self, lateral: f64, coasting: bool) {
+        let sample = if coasting {
+            match self.prev_lateral {
+                Some(p) => lateral - p,
+                None => return,
+            }
+        } else {
+            lateral
+        };
+        let cap = 16.0 * 2.0 * self.noise_var;
+        let s = (sample * sample).min(cap) / 2.0;
+        self.noise_var += (s - self.noise_var) / NOISE_FIXES;
     }
 
     /// Whether the next fixes are RTK float (coast through them, see
@@ -400,7 +465,7 @@ impl Estimator {
             || v.abs() < o.min_speed
             || v_new.abs() < o.min_speed
             || i.heading.abs() > GATE_HEADING
-            || i.lateral.abs() > GATE_LATERAL
+            || i.lateral.abs() > self.gate_lateral()
         {
             return;
         }
@@ -506,9 +571,24 @@ impl Estimator {
         // A jump is a lateral step of the position while moving: a heading that jumps (course
         // from successive fixes at low speed) is not a reason to distrust the position.
         let moving = self.fix_speed.abs() >= o.min_speed && fix.speed.abs() >= o.min_speed;
-        let jump = moving && innovation.is_some_and(|i| i.lateral.abs() > GATE_LATERAL);
+        let gate = self.gate_lateral();
+        let jump = moving && innovation.is_some_and(|i| i.lateral.abs() > gate);
+        // Robust: a jump is a step; an offset from the dead reckoning that moves on by more
+        // than the gate since the jump began is the dead reckoning drifting, not the fixes.
+        let ramp = o.robust
+            && matches!(self.coast_state, Coast::Jump(_))
+            && innovation.is_some_and(|i| (i.lateral - self.jump_onset).abs() > gate);
+        let jump = jump && !ramp;
+        if let (true, Some(i)) = (o.robust && moving, innovation) {
+            if !self.coast {
+                let coasting = matches!(self.coast_state, Coast::Jump(_));
+                self.learn_noise(i.lateral, coasting);
+            }
+            self.prev_lateral = Some(i.lateral);
+        }
         let t = fix.t_received;
         let expired = |since: f64| t - since > o.coast_max;
+        let was_off = !matches!(self.coast_state, Coast::Jump(_));
         self.coast_state = match (innovation.is_some() && o.coast_max > 0.0, self.coast_state) {
             (false, _) => Coast::Off,
             (true, Coast::Off) if self.coast => Coast::Float(t),
@@ -524,18 +604,49 @@ impl Estimator {
             (true, Coast::Expired) if !self.coast && !jump => Coast::Off,
             (true, Coast::Expired) => Coast::Expired,
         };
+        if let (Coast::Jump(_), true, Some(i)) = (self.coast_state, was_off, innovation) {
+            self.jump_onset = i.lateral;
+        }
         match (self.coast_state, innovation) {
             (Coast::Float(_) | Coast::Jump(_), Some(i)) => {
                 // Dead reckoning from the previous (coasted or fixed) position; the heading is
                 // measured.
                 pose = Pose::new(i.predicted.pos.x, i.predicted.pos.y, heading);
             }
-            (_, Some(i)) => self.observe(&i, fix.speed),
-            _ => {}
+            (_, Some(i)) => {
+                self.observe(&i, fix.speed);
+                self.smooth_towards(&i, &pose);
+            }
+            _ => self.smooth = Vec2::zeros(),
         }
         self.fix_pose = Some(pose);
         self.fix_time = fix.t_received;
         self.fix_speed = fix.speed;
+    }
+
+    /// The smoothed pose's correction after the fix `pose` with innovation `i`
+    /// ([`ObserverParams::position_process`]): the smoothed pose is the dead reckoning of the
+    /// previous smoothed one moved by a steady-state Kalman gain K towards the fix, so its
+    /// offset from the fix-based pose becomes (1 − K)·(offset − innovation).
+    fn smooth_towards(&mut self, i: &Innovation, pose: &Pose) {
+        let o = &self.params.observer;
+        if !(o.robust && o.position_process > 0.0) {
+            self.smooth = Vec2::zeros();
+            return;
+        }
+        // Random walk of q per step against a noise of r: P⁻ = (q + √(q² + 4qr)) / 2,
+        // K = P⁻ / (P⁻ + r).
+        let q = o.position_process * o.position_process * (i.dt / 0.1);
+        let r = self.noise_var;
+        let p = 0.5 * (q + (q * q + 4.0 * q * r).sqrt());
+        let k = if p + r > 0.0 { p / (p + r) } else { 1.0 };
+        let innovation = pose.pos - i.predicted.pos;
+        self.smooth = (self.smooth - innovation) * (1.0 - k);
+        // Never further than the gate from the fixes.
+        let cap = self.gate_lateral();
+        if self.smooth.norm() > cap {
+            self.smooth *= cap / self.smooth.norm();
+        }
     }
 
     /// A measured front-wheel angle (rad) at `t` (s).
@@ -610,7 +721,12 @@ impl Estimator {
         let t1 = t_now + self.params.lead_time;
         let span = (t1 - t0).clamp(0.0, 2.0);
         let v = self.fix_speed;
-        let pose = self.propagate(pose, v, t0, span);
+        let start = Pose::new(
+            pose.pos.x + self.smooth.x,
+            pose.pos.y + self.smooth.y,
+            pose.heading,
+        );
+        let pose = self.propagate(start, v, t0, span);
         Some(VehicleEstimate {
             pose,
             speed: v,
@@ -620,347 +736,4 @@ impl Estimator {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
-    use std::f64::consts::FRAC_PI_2;
-
-    fn params(predict: bool) -> EstimatorParams {
-        EstimatorParams {
-            wheelbase: 3.0,
-            antenna: AntennaOffset {
-                forward: 1.5,
-                left: 0.2,
-                up: 3.0,
-            },
-            gnss_latency: 0.05,
-            predict,
-            lead_time: 0.0,
-            roll_compensation: true,
-            observer: ObserverParams::default(),
-        }
-    }
-
-    /// True rear-axle pose on a circle of radius r at time t (speed v, start at origin east).
-    fn circle(r: f64, v: f64, t: f64) -> Pose {
-        let a = v * t / r;
-        Pose::new(r * a.sin(), r - r * a.cos(), a)
-    }
-
-    fn antenna_of(e: &Estimator, p: &Pose) -> Vec2 {
-        let a = e.params().antenna;
-        let h = heading_vec(p.heading);
-        p.pos + h * a.forward + left_normal(&h) * a.left
-    }
-
-    #[test]
-    fn antenna_offset_round_trip_and_roll() {
-        let e = Estimator::new(params(false));
-        let p = Pose::new(3.0, 4.0, 0.7);
-        let ant = antenna_of(&e, &p);
-        assert!((e.antenna_to_rear_axle(&ant, p.heading, None) - p.pos).norm() < 1e-12);
-        // 2° of roll, right side down: the antenna is 3·sin 2° ≈ 10.5 cm right of where it
-        // would be; the rear axle comes out right where it is.
-        let roll = 2f64.to_radians();
-        let shifted = ant - left_normal(&heading_vec(p.heading)) * (3.0 * roll.sin());
-        let back = e.antenna_to_rear_axle(&shifted, p.heading, Some(roll));
-        assert!((back - p.pos).norm() < 1e-12);
-    }
-
-    #[test]
-    fn prediction_beats_the_raw_fix_under_latency() {
-        let (r, v, lat) = (10.0, 3.0, 0.05);
-        let delta = (3.0f64 / r).atan();
-        let mut pred = Estimator::new(params(true));
-        let mut raw = Estimator::new(params(false));
-        for k in 0..=100 {
-            let t = k as f64 * 0.01;
-            pred.on_wheel_angle(t, delta);
-        }
-        // Fix measured at 0.9 s, received at 0.95 s; estimate at 1.0 s.
-        let truth_then = circle(r, v, 0.9);
-        let fix = GnssFix {
-            t_received: 0.9 + lat,
-            antenna: antenna_of(&pred, &truth_then),
-            heading: Some(truth_then.heading),
-            speed: v,
-            roll: None,
-        };
-        pred.on_fix(&fix);
-        raw.on_fix(&fix);
-        let truth_now = circle(r, v, 1.0);
-        let e_pred = (pred.estimate(1.0).unwrap().pose.pos - truth_now.pos).norm();
-        let e_raw = (raw.estimate(1.0).unwrap().pose.pos - truth_now.pos).norm();
-        assert!(e_raw > 0.25, "raw error {e_raw}");
-        assert!(e_pred < 1e-3, "predicted error {e_pred}");
-        let h = pred.estimate(1.0).unwrap().pose.heading;
-        assert!((h - truth_now.heading).abs() < 1e-4);
-    }
-
-    #[test]
-    fn wheel_history_interpolates() {
-        let mut e = Estimator::new(params(true));
-        assert_eq!(e.wheel_angle_at(1.0), 0.0);
-        e.on_wheel_angle(1.0, 0.1);
-        e.on_wheel_angle(2.0, 0.3);
-        assert!((e.wheel_angle_at(1.5) - 0.2).abs() < 1e-12);
-        assert_eq!(e.wheel_angle_at(0.0), 0.1);
-        assert_eq!(e.wheel_angle_at(5.0), 0.3);
-        for i in 0..1000 {
-            e.on_wheel_angle(3.0 + i as f64, i as f64);
-        }
-        assert_eq!(e.wheel_angle_at(1e9), 999.0, "ring keeps the newest");
-        // The prediction's cursor search gives what a search from the start gives, for
-        // non-decreasing times before, within (on and between samples) and after the ring.
-        let mut cursor = 1;
-        for k in 0..=1600 {
-            // The ring holds t = 875..=1002 s.
-            let t = 800.0 + 0.25 * k as f64;
-            let a = e.wheel_angle_from(t, &mut cursor);
-            assert_eq!(a, e.wheel_angle_at(t), "t = {t}");
-        }
-        assert_eq!(cursor, RING, "ran past the newest sample");
-    }
-
-    #[test]
-    fn no_fix_and_bad_input_give_none_not_panics() {
-        let mut e = Estimator::new(params(true));
-        assert!(e.estimate(1.0).is_none());
-        e.on_fix(&GnssFix {
-            t_received: f64::NAN,
-            antenna: v2(0.0, 0.0),
-            heading: Some(0.0),
-            speed: 1.0,
-            roll: None,
-        });
-        e.on_wheel_angle(f64::INFINITY, 0.2);
-        assert!(e.estimate(1.0).is_none());
-    }
-
-    #[test]
-    fn heading_from_course_without_dual_antenna() {
-        let mut e = Estimator::new(EstimatorParams {
-            antenna: AntennaOffset::default(),
-            ..params(false)
-        });
-        for k in 0..5 {
-            e.on_fix(&GnssFix {
-                t_received: k as f64 * 0.1,
-                antenna: v2(k as f64 * 0.3, k as f64 * 0.3),
-                heading: None,
-                speed: 3.0,
-                roll: None,
-            });
-        }
-        let est = e.estimate(0.5).unwrap();
-        assert!((est.pose.heading - std::f64::consts::FRAC_PI_4).abs() < 1e-9);
-    }
-
-    /// A vehicle on a straight line with a wheel-angle sensor bias and a world drift, fed to
-    /// an estimator with the observer on: fixes at 10 Hz, wheel angles at 50 Hz, heading and
-    /// position exact. Returns the estimator after `seconds` s driven at 3 m/s along `heading`.
-    fn drive(
-        e: &mut Estimator,
-        t0: f64,
-        seconds: f64,
-        start: Pose,
-        bias: f64,
-        drift: Vec2,
-        float: Option<(f64, f64, Vec2)>,
-    ) -> Pose {
-        let v = 3.0;
-        let (mut x, mut y, th) = (start.pos.x, start.pos.y, start.heading);
-        let steps = (seconds / 0.02).round() as usize;
-        for k in 1..=steps {
-            let t = t0 + k as f64 * 0.02;
-            x += (v * th.cos() + drift.x) * 0.02;
-            y += (v * th.sin() + drift.y) * 0.02;
-            // Straight: true wheel angle 0, the sensor reads the bias.
-            e.on_wheel_angle(t, bias);
-            if k % 5 == 0 {
-                let truth = Pose::new(x, y, th);
-                let mut antenna = antenna_of(e, &truth);
-                let mut in_float = false;
-                if let Some((a, b, err)) = float {
-                    if t >= a && t <= b {
-                        antenna += err;
-                        in_float = true;
-                    }
-                }
-                e.set_learning(!in_float);
-                e.set_coasting(in_float);
-                e.on_fix(&GnssFix {
-                    t_received: t + e.params().gnss_latency,
-                    antenna,
-                    heading: Some(th),
-                    speed: v,
-                    roll: None,
-                });
-            }
-        }
-        Pose::new(x, y, th)
-    }
-
-    fn observer_params() -> EstimatorParams {
-        EstimatorParams {
-            observer: ObserverParams {
-                bias_tau: 5.0,
-                drift_tau: 5.0,
-                coast_max: 30.0,
-                ..ObserverParams::default()
-            },
-            ..params(true)
-        }
-    }
-
-    /// Passes north and south across a slope falling to the East, rolling `roll(along)` (right
-    /// side down driving north), the vehicle slipping downhill at `slip`·sin(roll) m/s, with an
-    /// IMU roll noise of ±0.05° (seeded, uniform) and the antenna 3 m up: the estimator's slip
-    /// coefficient and world drift afterwards.
-    fn slope_passes(roll: impl Fn(f64) -> f64, slip: f64, passes: usize) -> (f64, Vec2) {
-        let mut e = Estimator::new(EstimatorParams {
-            observer: ObserverParams {
-                drift_tau: 60.0,
-                slip_tau: 30.0,
-                ..ObserverParams::default()
-            },
-            ..params(true)
-        });
-        let v = 4.0;
-        let mut t = 0.0;
-        let mut rng = ChaCha8Rng::seed_from_u64(5);
-        for pass in 0..passes {
-            let north = pass % 2 == 0;
-            let th = if north { FRAC_PI_2 } else { -FRAC_PI_2 };
-            let x0 = pass as f64 * 3.0;
-            let (mut x, mut y) = (x0, if north { 0.0 } else { 150.0 });
-            // Re-anchor at the start of each pass (a turn, not simulated, comes between).
-            e.fix_pose = None;
-            for k in 1..=(150.0 / v / 0.02) as usize {
-                t += 0.02;
-                let along = if north { y } else { 150.0 - y };
-                // Positive roll when driving north (East side down); flips driving south.
-                let r = if north { roll(along) } else { -roll(along) };
-                let right = -left_normal(&heading_vec(th));
-                x += (v * th.cos() + right.x * slip * r.sin()) * 0.02;
-                y += (v * th.sin() + right.y * slip * r.sin()) * 0.02;
-                e.on_wheel_angle(t, 0.0);
-                if k % 5 == 0 {
-                    let measured = r + rng.gen_range(-0.05f64..0.05).to_radians();
-                    let truth = Pose::new(x, y, th);
-                    let antenna = antenna_of(&e, &truth)
-                        - left_normal(&heading_vec(th)) * (e.params().antenna.up * r.sin());
-                    e.on_fix(&GnssFix {
-                        t_received: t + e.params().gnss_latency,
-                        antenna,
-                        heading: Some(th),
-                        speed: v,
-                        roll: Some(measured),
-                    });
-                }
-            }
-        }
-        (e.slip, e.drift())
-    }
-
-    #[test]
-    fn the_observer_tells_slope_slip_from_a_world_drift() {
-        // 0.015 m/s per degree of roll, the roll 2° ± 1° over 60 m: the downhill drift and the
-        // slip push the same way on every pass; only the variation tells them apart.
-        let c = 0.015f64.to_degrees();
-        let varying =
-            |along: f64| (2.0 + (along / 60.0 * std::f64::consts::TAU).sin()).to_radians();
-        let (slip, drift) = slope_passes(varying, c, 12);
-        assert!((slip - c).abs() < 0.1 * c, "slip {slip} vs {c}");
-        assert!(drift.norm() < 0.004, "drift {drift:?}");
-        // On an even slope they cannot be told apart; the sum must be right, and roll noise
-        // (3 m up, it moves the antenna) must not drive them apart to their limits.
-        let even = |_: f64| 2f64.to_radians();
-        let (slip, drift) = slope_passes(even, c, 12);
-        let total = drift.x + slip * 2f64.to_radians().sin();
-        let truth = c * 2f64.to_radians().sin();
-        assert!((total - truth).abs() < 0.003, "total {total} vs {truth}");
-        assert!(
-            slip.abs() < 2.0 * c && drift.norm() < 0.05,
-            "slip {slip}, drift {drift:?}"
-        );
-    }
-
-    #[test]
-    fn the_observer_learns_a_sensor_bias_and_a_world_drift_that_keeps_its_sign() {
-        let mut e = Estimator::new(observer_params());
-        let bias = 0.5f64.to_radians();
-        // East drift of 3 cm/s while driving north, then south.
-        let drift = v2(0.03, 0.0);
-        let north = Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2);
-        let end = drive(&mut e, 0.0, 60.0, north, bias, drift, None);
-        assert!(
-            (e.wheel_offset() - bias).abs() < 0.05 * bias,
-            "offset {} vs {bias}",
-            e.wheel_offset()
-        );
-        assert!((e.drift() - drift).norm() < 0.003, "drift {:?}", e.drift());
-        // Turned about (the drift is on the other side of the vehicle now): the estimate is
-        // still right from the first fix, and the prediction carries it.
-        let south = Pose::new(end.pos.x + 3.0, end.pos.y, -std::f64::consts::FRAC_PI_2);
-        let t = 61.0;
-        drive(&mut e, t, 1.0, south, bias, drift, None);
-        assert!((e.drift() - drift).norm() < 0.003, "drift {:?}", e.drift());
-        // Without the observer the same drive leaves both at zero.
-        let mut off = Estimator::new(params(true));
-        drive(&mut off, 0.0, 20.0, north, bias, drift, None);
-        assert_eq!((off.wheel_offset(), off.drift()), (0.0, Vec2::zeros()));
-    }
-
-    #[test]
-    fn the_estimator_coasts_through_rtk_float_and_a_position_jump() {
-        let mut e = Estimator::new(observer_params());
-        let north = Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2);
-        // A 20 cm float error from 30 s to 40 s: the estimate dead-reckons and stays on the
-        // true track instead.
-        let err = v2(0.2, 0.0);
-        let truth = drive(
-            &mut e,
-            0.0,
-            35.0,
-            north,
-            0.0,
-            Vec2::zeros(),
-            Some((30.0, 40.0, err)),
-        );
-        assert!(e.is_coasting());
-        let est = e.estimate(35.0).expect("an estimate").pose;
-        assert!(
-            (est.pos.x - truth.pos.x).abs() < 0.01,
-            "{est:?} vs {truth:?}"
-        );
-        // Fixed again: the fixes are taken at once.
-        let truth = drive(
-            &mut e,
-            35.0,
-            10.0,
-            truth,
-            0.0,
-            Vec2::zeros(),
-            Some((30.0, 40.0, err)),
-        );
-        assert!(!e.is_coasting());
-        let est = e.estimate(45.0).expect("an estimate").pose;
-        assert!((est.pos.x - truth.pos.x).abs() < 0.01);
-        // A 10 cm jump of a fixed solution (multipath) is not followed either, nor learnt.
-        let truth = drive(&mut e, 45.0, 5.0, truth, 0.0, Vec2::zeros(), None);
-        let before = e.drift();
-        let jump = v2(0.1, 0.0);
-        let ant = antenna_of(&e, &truth) + jump;
-        e.on_fix(&GnssFix {
-            t_received: 50.1,
-            antenna: ant,
-            heading: Some(truth.heading),
-            speed: 3.0,
-            roll: None,
-        });
-        assert!(e.is_coasting());
-        assert_eq!(e.drift(), before);
-    }
-}
+mod tests;

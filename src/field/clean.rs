@@ -1,6 +1,7 @@
 //! Boundary ring clean-up: duplicates, collinear points, arcs of short edges replaced by
 //! regression-fitted straight segments (seed 001), orientation.
 
+use crate::envelope;
 use crate::geo::polygon::{make_ccw, point_segment_distance, self_intersection, signed_area};
 use crate::geo::{cross, Vec2};
 
@@ -201,6 +202,24 @@ pub fn clean_ring(ring: &[Vec2], tolerance: f64) -> RingCleanup {
         return out;
     }
     out.area_before_m2 = signed_area(&work).abs();
+    if work.len() > envelope::SIMPLIFY_ABOVE_POINTS {
+        // The checks below are quadratic: a large ring is simplified first, within the
+        // tolerance (a map's rings, cleaned without fitting, within 1 cm).
+        let tol = if tolerance > 0.0 {
+            tolerance
+        } else {
+            envelope::MAP_SIMPLIFY_TOLERANCE_M
+        };
+        let keep = douglas_peucker(&work, tol);
+        let before = work.len();
+        work = (0..before).filter(|&i| keep[i]).map(|i| work[i]).collect();
+        out.fitted_removed = before - work.len();
+        if work.len() > envelope::MAX_RING_POINTS {
+            // Refused by the caller (too many points); not checked here.
+            out.ring = work;
+            return out;
+        }
+    }
     out.self_intersection = self_intersection(&work);
     if out.self_intersection.is_some() {
         out.ring = work;
@@ -220,7 +239,7 @@ pub fn clean_ring(ring: &[Vec2], tolerance: f64) -> RingCleanup {
             simplified
         };
         if chosen.len() >= 3 && self_intersection(&chosen).is_none() {
-            out.fitted_removed = work.len() - chosen.len();
+            out.fitted_removed += work.len() - chosen.len();
             work = chosen;
         }
     }

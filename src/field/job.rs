@@ -10,11 +10,11 @@ use crate::config::Config;
 use crate::geo::wgs84::LatLon;
 use crate::geo::Vec2;
 use crate::guidance::progress::JobDefinition;
-use crate::guidance::segments::SegmentJob;
 use crate::guidance::JobPlan;
 use crate::plan::coverage::metrics::{plan_metrics, PlanMetrics};
 use crate::plan::coverage::{plan_field, CoverageParams, FieldPlan};
-use crate::plan::PlanError;
+use crate::plan::job::SegmentJob;
+use crate::plan::types::PlanError;
 use std::path::{Path, PathBuf};
 
 /// Why the field job could not be prepared. Every variant names the field file; the detail is
@@ -55,10 +55,15 @@ pub fn load_configured(
     path: &Path,
     text: &str,
 ) -> Result<LoadedField, FieldJobError> {
-    load_field(text, &cfg.field_load_options()).map_err(|source| FieldJobError::Field {
-        path: path.to_path_buf(),
-        source,
-    })
+    load_field(text, &cfg.field_load_options())
+        .and_then(|loaded| {
+            crate::field::check_plan_size(&loaded, &cfg.coverage_params())?;
+            Ok(loaded)
+        })
+        .map_err(|source| FieldJobError::Field {
+            path: path.to_path_buf(),
+            source,
+        })
 }
 
 /// A planned field job.
@@ -99,10 +104,13 @@ impl FieldJob {
         params: CoverageParams,
         plan: FieldPlan,
     ) -> Result<FieldJob, FieldJobError> {
-        let job = SegmentJob::from_field_plan(&plan).map_err(|source| FieldJobError::Job {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let job =
+            SegmentJob::from_plan_segments(plan.segments.iter().cloned()).map_err(|source| {
+                FieldJobError::Job {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
         Ok(FieldJob {
             path: path.to_path_buf(),
             loaded,

@@ -26,6 +26,7 @@ pub use clean::{clean_ring, RingCleanup};
 pub use job::{FieldJob, FieldJobError};
 pub use taskdata::{GuidanceKind, PartfieldInfo};
 
+use crate::envelope;
 use crate::geo::polygon::{contains_point, segments_intersect, signed_area};
 use crate::geo::wgs84::{EnuFrame, LatLon};
 use crate::geo::Vec2;
@@ -146,6 +147,12 @@ pub enum FieldError {
     },
     #[error("{feature}: obstacle is not inside the field boundary")]
     ObstacleOutside { feature: String },
+    #[error("{what}: {value}, over the limit of {limit} (input envelope)")]
+    Envelope {
+        what: String,
+        value: String,
+        limit: String,
+    },
     #[error("no field boundary polygon found")]
     NoBoundary,
     #[error("{count} boundary polygons found ({features}); exactly one field boundary is supported (mark the others \"obstacle\": true or split the file)")]
@@ -204,11 +211,24 @@ pub fn decode_text(bytes: &[u8]) -> Result<String, FieldError> {
 /// no fitting of short edges.
 pub fn load_local_map(text: &str) -> Result<Field, FieldError> {
     let parsed = geojson::parse_local(text)?;
+    check_counts(&parsed)?;
+    for p in parsed.boundaries.iter().chain(&parsed.obstacles) {
+        for q in p.exterior.iter().chain(p.holes.iter().flatten()) {
+            if q.x.abs() > envelope::MAX_LOCAL_COORD_M || q.y.abs() > envelope::MAX_LOCAL_COORD_M {
+                return Err(FieldError::Envelope {
+                    what: format!("{}: position ({}, {}) m", p.label, q.x, q.y),
+                    value: "outside the local frame".into(),
+                    limit: format!("±{} m", envelope::MAX_LOCAL_COORD_M),
+                });
+            }
+        }
+    }
     let boundary = single_boundary(parsed.boundaries)?;
     let clean = |ring: &[Vec2], feature: &str| -> Result<Vec<Vec2>, FieldError> {
         checked_ring(clean_ring(ring, 0.0), feature, "exterior ring").map(|c| c.ring)
     };
     let outer = clean(&boundary.exterior, &boundary.label)?;
+    check_extent(&boundary.label, &outer)?;
     let mut obstacles = Vec::new();
     for (k, hole) in boundary.holes.iter().enumerate() {
         obstacles.push(clean(hole, &format!("{} (hole {k})", boundary.label))?);
@@ -216,6 +236,7 @@ pub fn load_local_map(text: &str) -> Result<Field, FieldError> {
     for o in &parsed.obstacles {
         obstacles.push(clean(&o.exterior, &o.label)?);
     }
+    check_clean_points(outer.len() + obstacles.iter().map(Vec::len).sum::<usize>())?;
     Ok(Field {
         boundary: outer,
         obstacles,
@@ -260,6 +281,7 @@ pub fn load_field_with(
         Some('{') => load_geojson(text, options),
         Some('<') => {
             let parsed = taskdata::parse(text, externals, select)?;
+            check_counts(&parsed)?;
             assemble(parsed, options)
         }
         _ => Err(FieldError::UnknownFormat),
@@ -287,12 +309,119 @@ pub fn list_fields(
 
 /// Load a field from GeoJSON text (see the module docs).
 pub fn load_geojson(text: &str, options: &LoadOptions) -> Result<LoadedField, FieldError> {
-    assemble(geojson::parse(text)?, options)
+    let parsed = geojson::parse(text)?;
+    check_counts(&parsed)?;
+    assemble(parsed, options)
 }
 
 /// Load a field from ISO 11783-10 TASKDATA.XML text (see the module docs).
 pub fn load_taskdata(text: &str, options: &LoadOptions) -> Result<LoadedField, FieldError> {
-    assemble(taskdata::parse(text, &[], None)?, options)
+    let parsed = taskdata::parse(text, &[], None)?;
+    check_counts(&parsed)?;
+    assemble(parsed, options)
+}
+
+/// The input envelope's counts: positions as read, and obstacles (holes included).
+fn check_counts<C>(parsed: &Parsed<C>) -> Result<(), FieldError> {
+    let polys = || parsed.boundaries.iter().chain(&parsed.obstacles);
+    let points: usize = polys()
+        .map(|p| p.exterior.len() + p.holes.iter().map(Vec::len).sum::<usize>())
+        .sum();
+    if points > envelope::MAX_FIELD_POINTS {
+        return Err(FieldError::Envelope {
+            what: "positions in the file".into(),
+            value: points.to_string(),
+            limit: envelope::MAX_FIELD_POINTS.to_string(),
+        });
+    }
+    let obstacles = parsed.obstacles.len()
+        + parsed
+            .boundaries
+            .iter()
+            .map(|b| b.holes.len())
+            .sum::<usize>();
+    if obstacles > envelope::MAX_OBSTACLES {
+        return Err(FieldError::Envelope {
+            what: "obstacles (holes and obstacle features)".into(),
+            value: obstacles.to_string(),
+            limit: envelope::MAX_OBSTACLES.to_string(),
+        });
+    }
+    Ok(())
+}
+
+/// The boundary's extent (longer side of its bounding box) within the envelope.
+fn check_extent(feature: &str, outer: &[Vec2]) -> Result<(), FieldError> {
+    let (mut lo, mut hi) = (Vec2::repeat(f64::INFINITY), Vec2::repeat(f64::NEG_INFINITY));
+    for p in outer {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let extent = (hi - lo).max();
+    if extent > envelope::MAX_FIELD_EXTENT_M {
+        return Err(FieldError::Envelope {
+            what: format!("{feature}: extent"),
+            value: format!("{extent:.0} m"),
+            limit: format!("{} m", envelope::MAX_FIELD_EXTENT_M),
+        });
+    }
+    Ok(())
+}
+
+/// Whether planning `loaded` with `params` stays in the envelope: the work path's points
+/// (field area over working width and point spacing) at most [`envelope::MAX_PATH_POINTS`].
+/// The planner and its metrics hold every point of the plan; beyond this they would not fit
+/// the memory bound.
+pub fn check_plan_size(
+    loaded: &LoadedField,
+    params: &crate::plan::coverage::CoverageParams,
+) -> Result<(), FieldError> {
+    let (w, r) = (params.line_width, params.r_min);
+    let usable = |v: f64| v.is_finite() && v > 0.0;
+    if !(usable(w) && usable(r) && usable(params.point_spacing)) {
+        return Err(FieldError::Envelope {
+            what: "working width, r_min and point spacing".into(),
+            value: format!("{w} m, {r} m, {} m", params.point_spacing),
+            limit: "finite and positive".into(),
+        });
+    }
+    let block = 2.0 * (2.0 * r / w).ceil() + 1.0;
+    if block > envelope::MAX_BLOCK_LINES as f64 {
+        return Err(FieldError::Envelope {
+            what: format!("lines per block 2·ceil(2·r_min/w) + 1 at r_min {r} m and w {w} m"),
+            value: format!("{block}"),
+            limit: envelope::MAX_BLOCK_LINES.to_string(),
+        });
+    }
+    let area = loaded.cleanup.area_after_m2;
+    let points = area / (w * params.point_spacing);
+    if points.is_nan() || points > envelope::MAX_PATH_POINTS {
+        return Err(FieldError::Envelope {
+            what: format!(
+                "work path of {:.0} ha at job.line_width_m = {} and guidance.point_spacing_m = {}",
+                area / 1e4,
+                params.line_width,
+                params.point_spacing
+            ),
+            value: format!("{points:.2e} points"),
+            limit: format!(
+                "{:.0e} points (a wider working width or point spacing, or a smaller field)",
+                envelope::MAX_PATH_POINTS
+            ),
+        });
+    }
+    Ok(())
+}
+
+fn check_clean_points(points: usize) -> Result<(), FieldError> {
+    if points > envelope::MAX_CLEAN_POINTS {
+        return Err(FieldError::Envelope {
+            what: "points of all rings after clean-up".into(),
+            value: points.to_string(),
+            limit: envelope::MAX_CLEAN_POINTS.to_string(),
+        });
+    }
+    Ok(())
 }
 
 pub(crate) struct Parsed<C = LatLon> {
@@ -379,6 +508,13 @@ fn checked_ring(
     feature: &str,
     ring_name: &str,
 ) -> Result<RingCleanup, FieldError> {
+    if cleaned.ring.len() > envelope::MAX_RING_POINTS {
+        return Err(FieldError::Envelope {
+            what: format!("{feature}: {ring_name} points after simplification"),
+            value: cleaned.ring.len().to_string(),
+            limit: envelope::MAX_RING_POINTS.to_string(),
+        });
+    }
     if cleaned.ring.len() < 3 || cleaned.area_before_m2 < 1e-9 {
         return Err(FieldError::TooFewPoints {
             feature: feature.to_string(),
@@ -446,6 +582,7 @@ fn assemble(parsed: Parsed, options: &LoadOptions) -> Result<LoadedField, FieldE
         "exterior ring",
         tol,
     )?;
+    check_extent(&boundary.label, &outer)?;
     let (mut area_before, mut area_after) = (a_before, a_after);
     // Holes of the boundary become obstacles, labelled after the boundary feature.
     for (k, hole) in boundary.holes.iter().enumerate() {
@@ -489,6 +626,14 @@ fn assemble(parsed: Parsed, options: &LoadOptions) -> Result<LoadedField, FieldE
         area_before -= before;
         area_after -= after;
         field_obstacles.push(ring);
+    }
+    check_clean_points(outer.len() + field_obstacles.iter().map(Vec::len).sum::<usize>())?;
+    if area_after > envelope::MAX_FIELD_AREA_M2 {
+        return Err(FieldError::Envelope {
+            what: format!("{}: area", boundary.label),
+            value: format!("{:.0} ha", area_after / 1e4),
+            limit: format!("{} ha", envelope::MAX_FIELD_AREA_M2 / 1e4),
+        });
     }
     // A boundary cut after some obstacles were kept may now cross them: keep those inside.
     field_obstacles.retain(|o| ring_inside(o, &outer));

@@ -2,7 +2,7 @@
 //! summary of `metrics.json` and of the demo report.
 
 use super::{CleanupReport, LoadedField};
-use crate::demo::svg::SvgCanvas;
+use crate::geo::svg::SvgCanvas;
 use crate::geo::wgs84::{EnuFrame, LatLon};
 use crate::geo::{Direction, Vec2};
 use crate::plan::coverage::metrics::PlanMetrics;

@@ -5,6 +5,7 @@
 //! positive front-wheel angle turn left.
 
 pub mod polygon;
+pub mod svg;
 pub mod wgs84;
 
 use serde::{Deserialize, Serialize};

@@ -6,23 +6,11 @@
 //! and events are pushed only when something changes.
 
 use super::progress::{JobDefinition, Phase, Progress, PROGRESS_VERSION};
-use super::segments::{JobSegment, SegmentJob};
 use crate::geo::{signed_offset, wrap_angle, Direction, PathPoint, Pose, Tag, Vec2};
 use crate::plan::abline::AbPlan;
-use crate::plan::PlanError;
+use crate::plan::job::{JobPlan, JobSegment};
+use crate::plan::types::PlanError;
 use crate::track::local_path::{nearest_global, LocalPath, LocalPathParams};
-
-impl From<AbPlan> for JobPlan {
-    fn from(plan: AbPlan) -> Self {
-        JobPlan::Ab(Box::new(plan))
-    }
-}
-
-impl From<SegmentJob> for JobPlan {
-    fn from(job: SegmentJob) -> Self {
-        JobPlan::Segments(job)
-    }
-}
 
 /// Something the binaries log.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,16 +61,6 @@ pub enum GuidanceError {
     OutOfRange { block: u64, rank: u64 },
     #[error(transparent)]
     Plan(#[from] PlanError),
-}
-
-/// What the state machine drives.
-#[derive(Debug, Clone)]
-pub enum JobPlan {
-    /// An AB job: work lines generated lazily by block and rank, turns between them.
-    Ab(Box<AbPlan>),
-    /// A fixed list of segments (a field plan) driven in order. Its positions are
-    /// (block 0, rank = segment index); turns are segments of their own.
-    Segments(SegmentJob),
 }
 
 /// The job state machine.
@@ -580,6 +558,7 @@ mod tests {
     use super::*;
     use crate::config::Config;
     use crate::control::{ab_params, guidance_params};
+    use crate::plan::job::SegmentJob;
 
     /// Drive an ideal vehicle along whatever path the machine hands out and return the lines
     /// in the order they were finished.
@@ -656,8 +635,8 @@ mod tests {
     /// A segment job: two swaths joined by a semicircle, driven by an ideal vehicle.
     fn segment_job() -> SegmentJob {
         use crate::geo::{v2, Direction};
-        use crate::guidance::segments::JobSegment;
         use crate::plan::coverage::SegmentKind;
+        use crate::plan::job::JobSegment;
         let line = |x: f64, up: bool| -> Vec<Vec2> {
             let ys: Vec<f64> = (0..=30).map(|i| i as f64).collect();
             let pts = ys.iter().map(|&y| v2(x, y));

@@ -2,6 +2,6 @@
 
 pub mod machine;
 pub mod progress;
-pub mod segments;
 
-pub use machine::{Event, Guidance, GuidanceError, GuidanceParams, JobPlan};
+pub use crate::plan::job::JobPlan;
+pub use machine::{Event, Guidance, GuidanceError, GuidanceParams};

@@ -22,11 +22,11 @@ pub struct JobDefinition {
     pub line_width_m: f64,
     pub line_num: u64,
     pub r_min_m: f64,
-    pub side: crate::config::LineSide,
+    pub side: crate::plan::types::Side,
     pub a: i64,
     pub point_spacing_m: f64,
     /// For a segment job (a field plan): the CRC-32C of its segments
-    /// ([`SegmentJob::checksum`](crate::guidance::segments::SegmentJob::checksum)).
+    /// ([`SegmentJob::checksum`](crate::plan::job::SegmentJob::checksum)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plan_checksum: Option<u32>,
 }

@@ -21,6 +21,9 @@ pub mod can;
 
 use serde::Serialize;
 
+pub mod nmea0183;
+pub mod ubx;
+
 /// Where an input came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]

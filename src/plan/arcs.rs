@@ -1,14 +1,16 @@
 //! Concentric circular work lines (`job.kind = "arcs"`): the curved-line job of the accuracy
 //! suite. Line i is an arc of radius `r_inner + i·width` about `centre`, sweeping `sweep` rad;
 //! even lines run counter-clockwise from angle `start_angle`, odd lines clockwise back, and a
-//! headland turn ([`pi_turn`] or, for lines closer than 2·r_min, [`bulb_turn`]) joins the end
-//! of each line to the start of the next, as between AB lines. Pure: no I/O.
+//! forward headland turn ([`forward_turn`]: a pi turn or, for lines closer than 2·r_min, a bulb
+//! turn) joins the end of each line to the start of the next, as between AB lines.
+//!
+//! Contract: pure; returns planned segments ([`PlanSegment`]s), which the job layer turns into
+//! the segment job the guidance drives.
 
-use super::turns::{bulb_turn, pi_turn, TurnParams};
-use super::PlanError;
+use super::turns::{forward_turn, TurnParams};
+use super::types::PlanError;
 use crate::geo::{v2, Direction, PathPoint, Vec2};
-use crate::guidance::segments::{JobSegment, SegmentJob};
-use crate::plan::coverage::SegmentKind;
+use crate::plan::types::{PlanSegment, SegmentKind};
 
 /// The shape of an arcs job.
 #[derive(Debug, Clone, PartialEq)]
@@ -45,7 +47,7 @@ fn line_points(p: &ArcsParams, i: u64) -> Vec<Vec2> {
 }
 
 /// The arcs job: lines and the turns between them, in driving order.
-pub fn arcs_job(p: &ArcsParams) -> Result<SegmentJob, PlanError> {
+pub fn arcs_segments(p: &ArcsParams) -> Result<Vec<PlanSegment>, PlanError> {
     PlanError::check(
         "r_inner",
         p.r_inner,
@@ -80,38 +82,42 @@ pub fn arcs_job(p: &ArcsParams) -> Result<SegmentJob, PlanError> {
         let points = line_points(p, i);
         if i > 0 {
             // The previous line's end and direction there (a line has at least 3 points).
-            let Some(&[.., before, p1]) = segments.last().map(|s: &JobSegment| &s.points[..])
+            let Some(&[.., before, p1]) = segments.last().map(|s: &PlanSegment| &s.points[..])
             else {
                 break;
             };
             let dir1 = (p1 - before).normalize();
             let p2 = points[0];
             turn.clear();
-            if (p2 - p1).norm() + 1e-3 >= 2.0 * p.turn.r_min {
-                pi_turn(p1, dir1, p2, &p.turn, &mut turn)?;
-            } else {
-                bulb_turn(p1, dir1, p2, &p.turn, &mut turn)?;
-            }
-            segments.push(JobSegment {
+            forward_turn(p1, dir1, p2, (p2 - p1).norm(), &p.turn, &mut turn)?;
+            segments.push(PlanSegment {
                 kind: SegmentKind::Turn,
                 direction: Direction::Forward,
+                index: segments.len(),
                 cell: 0,
                 points: turn.iter().map(|q: &PathPoint| q.pos).collect(),
             });
         }
-        segments.push(JobSegment {
+        segments.push(PlanSegment {
             kind: SegmentKind::Work,
             direction: Direction::Forward,
+            index: segments.len(),
             cell: 0,
             points,
         });
     }
-    SegmentJob::new(segments)
+    Ok(segments)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::plan::job::{JobSegment, SegmentJob};
+
+    /// The segments as the job the guidance drives.
+    fn arcs_job(p: &ArcsParams) -> Result<SegmentJob, PlanError> {
+        SegmentJob::from_plan_segments(arcs_segments(p)?)
+    }
 
     fn params() -> ArcsParams {
         ArcsParams {

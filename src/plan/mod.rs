@@ -1,36 +1,26 @@
 //! Global path planning. Every planner here is a pure function of its inputs: no I/O, no
-//! clocks, no globals.
+//! clocks, no globals, no configuration (planners take their own parameter structs, filled by
+//! the configuration layer).
+//!
+//! Inner layers (lowest first, as `docs/layers.txt` lists them; each imports only earlier
+//! ones):
+//! * [`types`]: the shared types ([`PlanError`], [`types::Field`], [`types::PlanSegment`],
+//!   [`types::SegmentKind`], [`types::Side`]);
+//! * [`maneuver`]: continuous-curvature paths, Reeds-Shepp, collision checks, the manoeuvre
+//!   search, approach paths;
+//! * [`turns`]: turns between parallel lines and the one turn selector, with the
+//!   canonical-frame turn cache;
+//! * [`skip_order`]: the seed-000 block skip order;
+//! * the planners [`abline`], [`arcs`] and [`coverage`] (peers: none imports another);
+//! * [`job`]: what the guidance drives ([`job::JobPlan`], [`job::SegmentJob`]).
 
 pub mod abline;
 pub mod arcs;
 pub mod coverage;
+pub mod job;
 pub mod maneuver;
+pub mod skip_order;
 pub mod turns;
+pub mod types;
 
-/// Why a plan cannot be made.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum PlanError {
-    #[error("{name} = {value}: {rule}")]
-    Invalid {
-        name: &'static str,
-        value: f64,
-        rule: &'static str,
-    },
-    #[error("turn impossible ({reason}); lateral distance {distance:.3} m")]
-    Turn { reason: &'static str, distance: f64 },
-}
-
-impl PlanError {
-    /// `Ok` when `ok` and `value` is finite, else an `Invalid` error for `name`.
-    pub(crate) fn check(name: &'static str, value: f64, ok: bool) -> Result<(), PlanError> {
-        if ok && value.is_finite() {
-            Ok(())
-        } else {
-            Err(PlanError::Invalid {
-                name,
-                value,
-                rule: "must be finite and in range",
-            })
-        }
-    }
-}
+pub use types::PlanError;

@@ -75,6 +75,10 @@ pub struct LateralDynamics {
     pub cornering_stiffness_rear: f64,
     /// Tyre relaxation length: the distance rolled for the lateral force to build up, m.
     pub relaxation_length: f64,
+    /// Tyre-soil friction coefficient μ: an axle's lateral force saturates at μ times its
+    /// load (linear up to 70 % of it, then smoothly to the limit), so at large slip angles the
+    /// tyres slide instead of pulling ever harder.
+    pub friction: f64,
     /// Implement side draft: a lateral force at the hitch, N, positive pulling to the right.
     pub side_force: f64,
     /// The hitch point behind the rear axle, m.
@@ -90,6 +94,7 @@ impl Default for LateralDynamics {
             cornering_stiffness_front: 120_000.0,
             cornering_stiffness_rear: 240_000.0,
             relaxation_length: 0.6,
+            friction: 0.6,
             side_force: 0.0,
             hitch_behind_rear: 1.0,
         }
@@ -369,6 +374,12 @@ impl LateralDynamics {
             self.relaxation_length,
             self.relaxation_length >= 0.01,
             "must be >= 0.01 m",
+        )?;
+        check(
+            "friction",
+            self.friction,
+            self.friction > 0.0,
+            "must be > 0",
         )?;
         check("side_force", self.side_force, true, "must be finite")?;
         check(

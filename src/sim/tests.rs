@@ -403,3 +403,19 @@ fn bad_plant_parameters_are_errors() {
     };
     assert!(Simulator::try_new(p, Pose::new(0.0, 0.0, 0.0), 1.0).is_err());
 }
+
+#[test]
+fn the_tyres_slide_at_the_friction_limit() {
+    // Full lock at 6 m/s asks for v²·tanδ/L ≈ 8.4 m/s² on the kinematic model; the tyres can
+    // give μ·g = 5.9 m/s² at most: the tractor ploughs on a wider circle.
+    let lat = LateralDynamics::default();
+    let p = ideal(Some(lat));
+    let st = steady(&p, 6.0, 0.6, 30.0);
+    let a_y = st.speed * st.yaw_rate;
+    let limit = lat.friction * 9.80665;
+    assert!(
+        a_y < 1.02 * limit && a_y > 0.8 * limit,
+        "a_y {a_y} vs μg {limit}"
+    );
+    assert!(st.pose.pos.x.is_finite());
+}

@@ -16,6 +16,17 @@ const GRAVITY: f64 = 9.80665;
 /// the same way: a damping term switched off as speed rises).
 const LOW_SPEED: f64 = 1.0;
 
+/// A lateral force `f` (N) limited to `max` (N): unchanged up to 70 % of it, then bending
+/// smoothly (continuous slope) towards the limit.
+fn saturate(f: f64, max: f64) -> f64 {
+    let knee = 0.7 * max;
+    if f.abs() <= knee {
+        return f;
+    }
+    let span = max - knee;
+    f.signum() * (knee + span * ((f.abs() - knee) / span).tanh())
+}
+
 /// The body's state.
 #[derive(Debug, Clone)]
 pub(super) struct Body {
@@ -172,8 +183,25 @@ impl Body {
             let fade = (1.0 - rolling.abs() / LOW_SPEED).max(0.0);
             -c / LOW_SPEED * fade * slide
         };
-        let front = self.f_front + damping(l.cornering_stiffness_front, slide_front, roll_front);
-        let rear = self.f_rear + damping(l.cornering_stiffness_rear, slide_rear, roll_rear);
+        // Each axle's force saturates at μ times its load.
+        let load_front = l.mass * GRAVITY * b / wb;
+        let load_rear = l.mass * GRAVITY * a / wb;
+        let front = saturate(
+            self.f_front + damping(l.cornering_stiffness_front, slide_front, roll_front),
+            l.friction * load_front,
+        );
+        let rear = saturate(
+            self.f_rear + damping(l.cornering_stiffness_rear, slide_rear, roll_rear),
+            l.friction * load_rear,
+        );
+        // The tyre's deflection (the relaxed force) cannot build far past sliding either.
+        self.f_front = self.f_front.clamp(
+            -2.0 * l.friction * load_front,
+            2.0 * l.friction * load_front,
+        );
+        self.f_rear = self
+            .f_rear
+            .clamp(-2.0 * l.friction * load_rear, 2.0 * l.friction * load_rear);
         let (roll, _) = self.attitude(&p.dist);
         // Positive roll is right side down: gravity pulls to the right (negative lateral).
         let gravity = -l.mass * GRAVITY * roll.sin();

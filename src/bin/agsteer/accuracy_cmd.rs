@@ -25,7 +25,7 @@ fn scenarios(dir: &Path, files: &[PathBuf]) -> Result<Vec<PathBuf>> {
     Ok(v)
 }
 
-fn trackers(name: &str) -> Result<Vec<TrackerChoice>> {
+pub(crate) fn trackers(name: &str) -> Result<Vec<TrackerChoice>> {
     if name == "all" {
         return Ok(TRACKERS.to_vec());
     }
@@ -138,6 +138,141 @@ pub fn run(
             }
         }
         eprintln!("SVGs and accuracy.json in {}", out.display());
+    }
+    Ok(0)
+}
+
+/// `agsteer accuracy --envelope` arguments.
+pub struct EnvelopeArgs<'a> {
+    pub dir: &'a Path,
+    pub files: &'a [PathBuf],
+    pub tracker: &'a str,
+    pub json: bool,
+    pub out: &'a Path,
+    pub set: &'a [String],
+    pub variations: &'a [String],
+    pub calibration: &'a str,
+    pub threads: Option<usize>,
+}
+
+/// The envelope: every scenario under every variation, for the trackers asked (the default
+/// first, so that the references are compared with it).
+pub fn run_envelope(a: &EnvelopeArgs) -> Result<u8> {
+    use agsteer::demo::envelope::{self, Calibration, MATRIX};
+    let kinds = trackers(a.tracker)?;
+    let calibration = match a.calibration {
+        "truth" => Calibration::Truth,
+        "nominal" => Calibration::Nominal,
+        other => bail!("unknown --calibration {other:?} (truth or nominal)"),
+    };
+    let vars: Vec<&envelope::Variation> = if a.variations.is_empty() {
+        MATRIX.iter().collect()
+    } else {
+        a.variations
+            .iter()
+            .map(|n| {
+                MATRIX.iter().find(|v| v.name == n).with_context(|| {
+                    let names: Vec<&str> = MATRIX.iter().map(|v| v.name).collect();
+                    format!("unknown variation {n:?} (one of {})", names.join(", "))
+                })
+            })
+            .collect::<Result<_>>()?
+    };
+    let paths = scenarios(a.dir, a.files)?;
+    let names: Vec<String> = paths
+        .iter()
+        .map(|p| {
+            p.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| p.display().to_string())
+        })
+        .collect();
+    let mut jobs = Vec::new();
+    for v in &vars {
+        for (p, n) in paths.iter().zip(&names) {
+            let cfg = envelope::cell_config(p, v, a.set, calibration)
+                .with_context(|| format!("variation {} on scenario {}", v.name, p.display()))?;
+            jobs.push((v.name, n.as_str(), cfg));
+        }
+    }
+    let threads = a.threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let start = std::time::Instant::now();
+    eprintln!(
+        "envelope: {} variations × {} scenarios × {} trackers on {threads} threads",
+        vars.len(),
+        names.len(),
+        kinds.len()
+    );
+    let cells = envelope::parallel_map(
+        &jobs,
+        threads,
+        &|(v, n, cfg)| envelope::run_cell(v, n, cfg, &kinds),
+        &|done, total| {
+            eprint!(
+                "\r{done}/{total} cells, {:.0} s",
+                start.elapsed().as_secs_f64()
+            );
+            if done == total {
+                eprintln!();
+            }
+        },
+    );
+    std::fs::create_dir_all(a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let var_names: Vec<&str> = vars.iter().map(|v| v.name).collect();
+    let sc_names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let table = envelope::markdown(&cells, &var_names, &sc_names);
+    let svg = envelope::heat_map_svg(&cells, &var_names, &sc_names);
+    let report = serde_json::json!({
+        "calibration": calibration,
+        "trackers": kinds.iter().map(|k| agsteer::demo::accuracy::tracker_name(*k)).collect::<Vec<_>>(),
+        "set": a.set,
+        "variations": vars,
+        "cells": cells.iter().map(|c| {
+            let mut j = serde_json::to_value(c).unwrap_or_default();
+            if let Some(o) = j.as_object_mut() {
+                o.insert("verdict".into(), serde_json::to_value(c.verdict()).unwrap_or_default());
+                o.insert("meets_targets".into(), c.meets_targets().into());
+            }
+            j
+        }).collect::<Vec<_>>(),
+    });
+    let text = serde_json::to_string_pretty(&report)?;
+    for (file, body) in [
+        ("envelope.md", table.as_str()),
+        ("envelope.svg", svg.as_str()),
+        ("envelope.json", text.as_str()),
+    ] {
+        let p = a.out.join(file);
+        std::fs::write(&p, body).with_context(|| format!("writing {}", p.display()))?;
+    }
+    let failed: Vec<String> = cells
+        .iter()
+        .filter(|c| !c.meets_targets())
+        .map(|c| format!("{}/{}", c.variation, c.scenario))
+        .collect();
+    if a.json {
+        println!("{text}");
+    } else {
+        print!("{table}");
+        println!(
+            "\n{} of {} cells meet the targets ({} s); missed: {}",
+            cells.len() - failed.len(),
+            cells.len(),
+            start.elapsed().as_secs(),
+            if failed.is_empty() {
+                "none".to_string()
+            } else {
+                failed.join(", ")
+            }
+        );
+        eprintln!(
+            "envelope.md, envelope.svg and envelope.json in {}",
+            a.out.display()
+        );
     }
     Ok(0)
 }

@@ -3,6 +3,7 @@
 use agsteer::can::codec::{self, find_name, CounterCheck, Role, MAX_SIGNALS};
 use agsteer::can::fastpacket::Reassembler;
 use agsteer::can::gnss::GnssPosition;
+use agsteer::envelope;
 use anyhow::{bail, Context, Result};
 use clap::Subcommand;
 use serde_json::{json, Map, Value};
@@ -56,9 +57,9 @@ pub fn run(cmd: DbcCommand) -> Result<u8> {
             let mut dec = LogDecoder::default();
             match file {
                 Some(p) => {
-                    let f = std::fs::File::open(&p)
-                        .with_context(|| format!("opening {}", p.display()))?;
-                    dec.run(std::io::BufReader::new(f), &mut out)?;
+                    let f = envelope::open_stream(&p, envelope::FileKind::Log)?;
+                    dec.run(std::io::BufReader::new(f), &mut out)
+                        .with_context(|| format!("reading {}", p.display()))?;
                 }
                 None => dec.run(std::io::stdin().lock(), &mut out)?,
             }
@@ -124,13 +125,24 @@ pub fn parse_candump_line(line: &str) -> Option<(Option<f64>, u32, Vec<u8>)> {
     let _iface = first;
     let frame = words.next()?;
     let (id, hex) = frame.split_once('#')?;
-    let id = u32::from_str_radix(id, 16).ok()?;
-    if hex.len() % 2 != 0 || hex.len() > 16 {
+    // from_str_radix takes a leading sign; an ID or a byte is hex digits only (ASCII: slicing
+    // a line with other characters at odd byte offsets would split a character).
+    let hex_digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_hexdigit());
+    if !hex_digits(id) || id.len() > 8 {
         return None;
     }
-    let bytes = (0..hex.len())
-        .step_by(2)
-        .map(|i| u8::from_str_radix(&hex[i..i + 2], 16).ok())
+    let id = u32::from_str_radix(id, 16).ok()?;
+    if !(hex.is_empty() || hex_digits(hex)) || hex.len() % 2 != 0 || hex.len() > 16 {
+        return None;
+    }
+    let bytes = hex
+        .as_bytes()
+        .chunks(2)
+        .map(|pair| {
+            std::str::from_utf8(pair)
+                .ok()
+                .and_then(|p| u8::from_str_radix(p, 16).ok())
+        })
         .collect::<Option<Vec<u8>>>()?;
     Some((t, id, bytes))
 }
@@ -199,17 +211,25 @@ impl LogDecoder {
         v
     }
 
-    pub fn run(&mut self, input: impl BufRead, out: &mut impl Write) -> Result<()> {
-        for line in input.lines() {
-            let line = match line {
-                Ok(l) => l,
-                Err(e) => {
-                    writeln!(out, "{}", json!({"error": format!("unreadable line: {e}")}))?;
-                    continue;
+    /// Decode every line of `input`. A line longer than [`envelope::MAX_LINE_BYTES`] is
+    /// reported and skipped; a read error ends the run (it would repeat forever).
+    pub fn run(&mut self, mut input: impl BufRead, out: &mut impl Write) -> Result<()> {
+        let mut n = 0usize;
+        while let Some(line) = envelope::file::next_line(&mut input, envelope::MAX_LINE_BYTES)
+            .with_context(|| format!("after line {n}"))?
+        {
+            n += 1;
+            match line {
+                envelope::file::Line::Text(line) => {
+                    for v in self.line(&line) {
+                        writeln!(out, "{v}")?;
+                    }
                 }
-            };
-            for v in self.line(&line) {
-                writeln!(out, "{v}")?;
+                envelope::file::Line::TooLong(len) => writeln!(
+                    out,
+                    "{}",
+                    json!({"line": n, "error": format!("line of {len} bytes, over the limit of {} bytes", envelope::MAX_LINE_BYTES)})
+                )?,
             }
         }
         Ok(())

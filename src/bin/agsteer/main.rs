@@ -79,6 +79,21 @@ enum Command {
         /// Run these scenario files instead of the directory.
         #[arg(long)]
         config: Vec<PathBuf>,
+        /// Run the envelope: every scenario under every plant variation of the matrix
+        /// (src/demo/envelope.rs); writes OUT/envelope.md, OUT/envelope.svg (heat map) and
+        /// OUT/envelope.json, progress on stderr.
+        #[arg(long)]
+        envelope: bool,
+        /// Envelope: only these variations (comma-separated names; default all).
+        #[arg(long, value_delimiter = ',')]
+        variations: Vec<String>,
+        /// Envelope: what the controller knows of the steering that calibration measures:
+        /// "truth" (the plant's values) or "nominal" (its configuration as it is).
+        #[arg(long, default_value = "truth")]
+        calibration: String,
+        /// Worker threads (default: the available cores).
+        #[arg(long)]
+        threads: Option<usize>,
         #[command(flatten)]
         cfg: ConfigArgs,
     },
@@ -201,8 +216,28 @@ fn main() -> ExitCode {
             out,
             scenarios,
             config,
+            envelope,
+            variations,
+            calibration,
+            threads,
             cfg,
-        } => accuracy_cmd::run(&scenarios, &config, &tracker, json, &out, &cfg.set),
+        } => {
+            if envelope {
+                accuracy_cmd::run_envelope(&accuracy_cmd::EnvelopeArgs {
+                    dir: &scenarios,
+                    files: &config,
+                    tracker: &tracker,
+                    json,
+                    out: &out,
+                    set: &cfg.set,
+                    variations: &variations,
+                    calibration: &calibration,
+                    threads,
+                })
+            } else {
+                accuracy_cmd::run(&scenarios, &config, &tracker, json, &out, &cfg.set)
+            }
+        }
         Command::Demo {
             config,
             out,

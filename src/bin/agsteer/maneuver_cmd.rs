@@ -3,6 +3,7 @@
 //! of pose pairs from a JSON-lines file.
 
 use agsteer::config::{Config, CurveChoice};
+use agsteer::envelope;
 use agsteer::field::load_local_map;
 use agsteer::geo::{Direction, Pose, Vec2};
 use agsteer::plan::maneuver::collision::CollisionMap;
@@ -40,6 +41,32 @@ pub fn parse_pose(s: &str) -> Result<Pose> {
         bail!("pose `{s}`: every number must be finite");
     }
     Ok(pose_of([v[0], v[1], v[2]]))
+}
+
+/// A start and goal inside the input envelope: finite, within ±`MAX_LOCAL_COORD_M` and at most
+/// `MAX_MANEUVER_DISTANCE_M` apart; else the error names the value and the limit.
+pub fn check_request(from: [f64; 3], to: [f64; 3]) -> Result<()> {
+    for (name, p) in [("from", from), ("to", to)] {
+        if p.iter().any(|x| !x.is_finite()) {
+            bail!("{name} {p:?}: every number must be finite");
+        }
+        if p[0].abs() > envelope::MAX_LOCAL_COORD_M || p[1].abs() > envelope::MAX_LOCAL_COORD_M {
+            bail!(
+                "{name} ({}, {}) m: outside the local frame's ±{} m (envelope)",
+                p[0],
+                p[1],
+                envelope::MAX_LOCAL_COORD_M
+            );
+        }
+    }
+    let d = (to[0] - from[0]).hypot(to[1] - from[1]);
+    if d > envelope::MAX_MANEUVER_DISTANCE_M {
+        bail!(
+            "start and goal {d:.0} m apart: a manoeuvre is at most {} m long (envelope); drive it as a line or a field job",
+            envelope::MAX_MANEUVER_DISTANCE_M
+        );
+    }
+    Ok(())
 }
 
 #[derive(Serialize)]
@@ -151,8 +178,7 @@ struct BatchLine {
 pub fn run(cfg: &Config, a: &ManeuverArgs) -> Result<u8> {
     let (map, field) = match a.map {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("reading map {}", path.display()))?;
+            let text = envelope::read_text(path, envelope::FileKind::Map)?;
             let field = load_local_map(&text).with_context(|| format!("map {}", path.display()))?;
             let map = CollisionMap::new(
                 Some(field.boundary.clone()),
@@ -166,13 +192,14 @@ pub fn run(cfg: &Config, a: &ManeuverArgs) -> Result<u8> {
     };
     let curve = a.curve.unwrap_or(cfg.maneuver.curve);
     if let Some(batch) = a.batch {
-        let text = std::fs::read_to_string(batch)
-            .with_context(|| format!("reading batch {}", batch.display()))?;
+        let text = envelope::read_text(batch, envelope::FileKind::Batch)?;
         for (n, line) in text.lines().enumerate() {
             if line.trim().is_empty() {
                 continue;
             }
             let req: BatchLine = serde_json::from_str(line)
+                .with_context(|| format!("{} line {}", batch.display(), n + 1))?;
+            check_request(req.from, req.to)
                 .with_context(|| format!("{} line {}", batch.display(), n + 1))?;
             let (r, ms) = plan_one(&map, cfg, curve, &pose_of(req.from), &pose_of(req.to));
             if !say(&serde_json::to_string(&result_out(&r, ms))?)? {
@@ -183,6 +210,8 @@ pub fn run(cfg: &Config, a: &ManeuverArgs) -> Result<u8> {
     }
     let from = parse_pose(a.from.ok_or_else(|| anyhow!("--from is required"))?)?;
     let to = parse_pose(a.to.ok_or_else(|| anyhow!("--to is required"))?)?;
+    let xyh = |p: &Pose| [p.pos.x, p.pos.y, p.heading];
+    check_request(xyh(&from), xyh(&to))?;
     let (r, ms) = plan_one(&map, cfg, curve, &from, &to);
     let res = r.clone().context("planning the manoeuvre")?;
     let out = result_out(&r, ms);

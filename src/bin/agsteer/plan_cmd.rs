@@ -40,7 +40,7 @@ pub struct PlanOptions {
 
 /// Read a file's text (UTF-8 or UTF-16, with or without a byte-order mark).
 fn read_text(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let bytes = agsteer::envelope::read_bytes(path, agsteer::envelope::FileKind::Field)?;
     decode_text(&bytes).with_context(|| format!("reading {}", path.display()))
 }
 
@@ -198,6 +198,8 @@ where
     if let Some(note) = &guidance_note {
         eprintln!("{note}");
     }
+    agsteer::field::check_plan_size(&loaded, &params)
+        .with_context(|| format!("field {}", field_path.display()))?;
     let (plan, plan_time) = timed("planning", || planner(&loaded.field, &params));
     let plan = plan.with_context(|| format!("planning {}", field_path.display()))?;
     if plan.swaths == 0 {
@@ -388,6 +390,10 @@ where
                 let mut params = cfg.coverage_params();
                 params.line_width = w;
                 params.r_min = r;
+                if let Err(e) = agsteer::field::check_plan_size(&loaded, &params) {
+                    println!("{name:<28} w {w} m, r_min {r} m: {e}");
+                    continue;
+                }
                 let start = Instant::now();
                 let plan = planner(&loaded.field, &params);
                 let plan_time_ms = start.elapsed().as_secs_f64() * 1e3;

@@ -28,8 +28,7 @@ pub fn run(
     agsteer::daemon::run::set_realtime_priority(realtime_priority);
     let scenario: Scenario = match scenario {
         Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .with_context(|| format!("reading scenario {}", p.display()))?;
+            let text = agsteer::envelope::read_text(p, agsteer::envelope::FileKind::Config)?;
             toml::from_str(&text).with_context(|| format!("scenario {}", p.display()))?
         }
         None => Scenario::default(),

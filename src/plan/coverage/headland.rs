@@ -14,6 +14,7 @@
 
 use super::geometry::{offset, Area};
 use super::CoverageParams;
+pub use crate::geo::polygon::resample;
 use crate::geo::{cross, v2, Vec2};
 use geo::BooleanOps;
 
@@ -361,37 +362,6 @@ fn concave_kinks(areas: &[Area], spacing: f64, r_min: f64) -> Vec<(Vec2, Vec2)> 
                 }
             }
         }
-    }
-    out
-}
-
-/// Points evenly spaced by arc length along a polyline, about `spacing` m apart, from its
-/// first to its exact last point.
-pub fn resample(points: &[Vec2], spacing: f64) -> Vec<Vec2> {
-    let total = crate::geo::polygon::polyline_length(points);
-    let Some(&first) = points.first() else {
-        return Vec::new();
-    };
-    let n = (total / spacing).ceil().max(1.0) as usize;
-    let step = total / n as f64;
-    let mut out = Vec::with_capacity(n + 1);
-    out.push(first);
-    let (mut seg, mut at) = (0usize, 0.0);
-    for k in 1..n {
-        let target = k as f64 * step;
-        while seg + 1 < points.len() {
-            let len = (points[seg + 1] - points[seg]).norm();
-            if at + len >= target {
-                let f = if len > 0.0 { (target - at) / len } else { 0.0 };
-                out.push(points[seg] + (points[seg + 1] - points[seg]) * f);
-                break;
-            }
-            at += len;
-            seg += 1;
-        }
-    }
-    if let Some(&last) = points.last() {
-        out.push(last);
     }
     out
 }

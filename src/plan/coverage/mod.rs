@@ -12,51 +12,12 @@ pub mod metrics;
 pub mod swath_angle;
 pub mod swaths;
 pub mod transit;
-pub mod turns;
+
+pub use crate::plan::types::{Field, PlanSegment, SegmentKind};
 
 use crate::geo::{v2, vec_heading, wrap_angle, Direction, Vec2};
-use crate::plan::PlanError;
+use crate::plan::types::PlanError;
 use serde::{Deserialize, Serialize};
-
-/// A field in the local ENU frame, metres.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Field {
-    /// Outer boundary, counter-clockwise, not closed (the first vertex is not repeated).
-    pub boundary: Vec<Vec2>,
-    /// Obstacles (holes of the boundary and separate obstacle features), each
-    /// counter-clockwise, not closed, inside the boundary.
-    pub obstacles: Vec<Vec<Vec2>>,
-}
-
-/// What a plan segment is for. Serialised as the GeoJSON `kind` property.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SegmentKind {
-    /// A swath: the implement works.
-    Work,
-    /// A turn between two swaths of one cell.
-    Turn,
-    /// A headland pass around the field (the implement works).
-    Headland,
-    /// A detour around a small obstacle, replacing the blocked stretch of a swath.
-    Detour,
-    /// A move between cells or from the headland to the first swath (no work).
-    Transit,
-}
-
-/// One driveable piece of a field plan, in driving order.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PlanSegment {
-    pub kind: SegmentKind,
-    /// Driving direction along `points`.
-    pub direction: Direction,
-    /// Position of this segment in the plan (0-based, driving order).
-    pub index: usize,
-    /// The cell it belongs to (0-based; headland passes and transits use the cell they lead to).
-    pub cell: usize,
-    /// Points in driving order, local ENU metres, about `point_spacing` apart.
-    pub points: Vec<Vec2>,
-}
 
 /// How the swath direction is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -330,7 +291,7 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     }
 
     let tp = p.turn_params();
-    let mut cache = turns::TurnCache::default();
+    let mut cache = crate::plan::turns::TurnCache::default();
     let mut segments: Vec<PlanSegment> = Vec::new();
     let push = |segments: &mut Vec<PlanSegment>, kind, direction, cell, points: Vec<Vec2>| {
         if points.len() >= 2 {
@@ -721,27 +682,14 @@ fn split_for_detours(
 
 /// The driving order of a run's swaths (indices into the run): adjacent ones in turn when the
 /// spacing allows a U-turn (or the operator chose sequential lines, with fishtails); otherwise
-/// the seed-000 block skip order, so no turn is tighter than 2·r_min.
+/// the seed-000 block skip order ([`crate::plan::skip_order`], blocks of `2·min_gap + 1`), so no
+/// turn is tighter than 2·r_min.
 fn run_order(n: usize, spacing: f64, p: &CoverageParams) -> Vec<usize> {
-    let sequential = spacing + 1e-3 >= 2.0 * p.r_min || p.route == RouteOrder::Sequential;
-    if sequential || n < 2 {
+    use crate::plan::skip_order::{min_gap_lines, skip_order};
+    if p.route == RouteOrder::Sequential {
         return (0..n).collect();
     }
-    let min_gap = ((2.0 * p.r_min - 1e-3) / spacing).ceil() as usize;
-    let block = 2 * min_gap + 1;
-    let mut order = Vec::with_capacity(n);
-    let mut start = 0;
-    while start < n {
-        let len = if n - start < 2 * block {
-            n - start
-        } else {
-            block
-        };
-        let bo = crate::plan::abline::solve_block_order(len, min_gap, start + len < n);
-        order.extend(bo.lines().map(|l| start + l as usize));
-        start += len;
-    }
-    order
+    skip_order(n, min_gap_lines(p.r_min, spacing), 1)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -752,7 +700,7 @@ fn drive_run(
     cell: usize,
     p: &CoverageParams,
     tp: &crate::plan::turns::TurnParams,
-    cache: &mut turns::TurnCache,
+    cache: &mut crate::plan::turns::TurnCache,
     clear: &dyn Fn(&Vec2) -> bool,
     segments: &mut Vec<PlanSegment>,
     at: &mut Option<(Vec2, f64)>,

@@ -11,8 +11,8 @@ use super::search::{plan_maneuver, ManeuverError, ManeuverResult};
 use super::steering::{CcSteering, RsSteering};
 use crate::config::{Config, CurveChoice};
 use crate::geo::Pose;
-use crate::guidance::segments::SegmentJob;
 use crate::plan::coverage::{Field, SegmentKind};
+use crate::plan::job::SegmentJob;
 
 /// Why a manoeuvre job could not be prepared.
 #[derive(Debug, thiserror::Error)]
@@ -28,7 +28,7 @@ pub enum ManeuverJobError {
         why: String,
     },
     #[error("the manoeuvre cannot be driven as a segment job: {0}")]
-    Job(#[from] crate::plan::PlanError),
+    Job(#[from] crate::plan::types::PlanError),
 }
 
 /// The collision map of `field` (or free space) with the configured broad-phase cell.
@@ -101,7 +101,10 @@ pub fn pose_of(p: [f64; 3]) -> Pose {
 
 /// `path` as the guidance drives it: one transit segment per part between cusps, points every
 /// `spacing_m`.
-pub fn segment_job(path: &CurvePath, spacing_m: f64) -> Result<SegmentJob, crate::plan::PlanError> {
+pub fn segment_job(
+    path: &CurvePath,
+    spacing_m: f64,
+) -> Result<SegmentJob, crate::plan::types::PlanError> {
     SegmentJob::from_driven_parts(split_at_cusps(path, spacing_m), SegmentKind::Transit)
 }
 

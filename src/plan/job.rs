@@ -1,10 +1,39 @@
-//! A job given as a fixed list of segments (a field plan, later a manoeuvre), driven in order
-//! by the same state machine, local path and tracker as an AB job.
+//! What the guidance drives: a [`JobPlan`], either an AB plan (lines generated lazily) or a
+//! [`SegmentJob`], a fixed list of segments (a field plan, sequential AB lines, arcs, a
+//! manoeuvre) driven in order by the same state machine, local path and tracker.
+//!
+//! Contract: turns planned segments ([`PlanSegment`]s, a manoeuvre's parts between cusps) into
+//! driveable [`JobSegment`]s and identifies the list by a checksum saved with progress. Pure;
+//! uses only the planners' types (`plan::types`, `plan::abline`, `plan::maneuver`) and
+//! [`crate::geo`].
 
 use crate::geo::{Direction, PathPoint, Tag, Vec2};
-use crate::plan::coverage::{FieldPlan, PlanSegment, SegmentKind};
-use crate::plan::maneuver::drive::DrivenPart;
-use crate::plan::PlanError;
+use crate::plan::abline::AbPlan;
+use crate::plan::maneuver::drive::{split_at_cusps, DrivenPart};
+use crate::plan::maneuver::path::CurvePath;
+use crate::plan::types::{PlanError, PlanSegment, SegmentKind};
+
+/// What the state machine drives.
+#[derive(Debug, Clone)]
+pub enum JobPlan {
+    /// An AB job: work lines generated lazily by block and rank, turns between them.
+    Ab(Box<AbPlan>),
+    /// A fixed list of segments (a field plan) driven in order. Its positions are
+    /// (block 0, rank = segment index); turns are segments of their own.
+    Segments(SegmentJob),
+}
+
+impl From<AbPlan> for JobPlan {
+    fn from(plan: AbPlan) -> Self {
+        JobPlan::Ab(Box::new(plan))
+    }
+}
+
+impl From<SegmentJob> for JobPlan {
+    fn from(job: SegmentJob) -> Self {
+        JobPlan::Segments(job)
+    }
+}
 
 /// One driveable piece of a segment job.
 #[derive(Debug, Clone, PartialEq)]
@@ -112,11 +141,6 @@ impl SegmentJob {
         })
     }
 
-    /// The segments of a field plan, in its driving order.
-    pub fn from_field_plan(plan: &FieldPlan) -> Result<Self, PlanError> {
-        SegmentJob::from_plan_segments(plan.segments.iter().cloned())
-    }
-
     /// Planned segments (a field plan's, sequential AB lines) in driving order.
     pub fn from_plan_segments(
         segments: impl IntoIterator<Item = PlanSegment>,
@@ -140,6 +164,12 @@ impl SegmentJob {
         kind: SegmentKind,
     ) -> Result<Self, PlanError> {
         SegmentJob::new(JobSegment::from_driven_parts(parts, kind))
+    }
+
+    /// A manoeuvre's `path` as the guidance drives it: one transit segment per part between
+    /// cusps, points every `spacing_m`.
+    pub fn from_curve_path(path: &CurvePath, spacing_m: f64) -> Result<Self, PlanError> {
+        SegmentJob::from_driven_parts(split_at_cusps(path, spacing_m), SegmentKind::Transit)
     }
 
     pub fn segments(&self) -> &[JobSegment] {

@@ -1,14 +1,15 @@
-//! Turns between parallel swaths (seed 003), chosen by the lateral gap g against 2·r_min:
-//! a pi turn (two quarter arcs and a straight, g > 2r), a semicircle (g = 2r, the arcs merge),
-//! or a fishtail (g < 2r: forward arc, reverse along the transition line, forward arc).
+//! Turns between parallel swaths (seed 003) that may reverse, chosen by [`turn_shape`] from
+//! the lateral gap g against 2·r_min: a pi turn (two quarter arcs and a straight, g > 2r), a
+//! semicircle (g = 2r, the arcs merge), or a fishtail (g < 2r: forward arc, reverse along the
+//! transition line, forward arc).
 //!
 //! All turns between parallel swaths of a cell are alike up to a rigid motion, so each shape
 //! is solved once in a canonical frame — start at the origin heading +x, end at (0, ±g)
 //! heading −x — and then moved onto every pair of swath ends ([`TurnCache`]).
 
+use super::{arc_points, pi_turn, turn_shape, ShortTurn, TurnParams, TurnShape};
 use crate::geo::{v2, Direction, Vec2};
-use crate::plan::turns::{arc_points, pi_turn, TurnParams};
-use crate::plan::PlanError;
+use crate::plan::types::PlanError;
 
 /// One driven part of a turn.
 #[derive(Debug, Clone, PartialEq)]
@@ -20,7 +21,7 @@ pub struct TurnPart {
 /// The canonical turn for a gap `g` (m) to the left (`left`) or right.
 pub fn canonical_turn(g: f64, left: bool, p: &TurnParams) -> Result<Vec<TurnPart>, PlanError> {
     let r = p.r_min;
-    let parts = if g + 1e-3 >= 2.0 * r {
+    let parts = if turn_shape(g, r, ShortTurn::Fishtail) == TurnShape::Pi {
         let mut out = Vec::new();
         pi_turn(v2(0.0, 0.0), v2(1.0, 0.0), v2(0.0, g), p, &mut out)?;
         vec![TurnPart {
@@ -42,8 +43,7 @@ pub fn canonical_turn(g: f64, left: bool, p: &TurnParams) -> Result<Vec<TurnPart
             true,
             &mut a1,
         );
-        let back =
-            crate::plan::coverage::headland::resample(&[v2(r, r), v2(r, g - r)], p.point_spacing);
+        let back = crate::geo::polygon::resample(&[v2(r, r), v2(r, g - r)], p.point_spacing);
         let mut a2 = Vec::new();
         arc_points(
             v2(0.0, g - r),
@@ -91,7 +91,7 @@ fn cc_fishtail(g: f64, p: &TurnParams) -> Vec<TurnPart> {
     use crate::geo::Pose;
     use crate::plan::maneuver::drive::split_at_cusps;
     use crate::plan::maneuver::path::{CurvePath, CurveSegment};
-    let (quarter, d) = crate::plan::turns::cc_quarter_turn(p, true);
+    let (quarter, d) = super::cc_quarter_turn(p, true);
     let mut segments = quarter.clone();
     segments.push(CurveSegment::line(
         Direction::Reverse,

@@ -1,18 +1,87 @@
-//! Turn geometry between parallel lines, as pure functions writing into a caller's buffer.
+//! Turns between parallel lines, as pure functions, and the one turn selector.
 //!
-//! * [`pi_turn`]: the seed-000 turn for lines at least `2·r_min` apart: a quarter arc off the
-//!   current line, a straight across the headland (or nothing, when the arcs meet), a quarter
-//!   arc onto the next line.
-//! * [`bulb_turn`]: a forward-only turn for lines closer than `2·r_min`: an arc away from the
-//!   next line, a large arc the other way, and an arc back, all of radius `r_min` and tangent
-//!   to each other (an "omega" or bulb turn).
+//! [`turn_shape`] chooses the turn from the lateral gap between the lines and `r_min`:
+//! * a pi turn ([`pi_turn`], the seed-000 turn) when the lines are at least `2·r_min` apart
+//!   (within [`GAP_TOLERANCE`]): a quarter arc off the current line, a straight across the
+//!   headland (or nothing, when the arcs meet), a quarter arc onto the next line;
+//! * closer lines take a forward-only bulb (omega) turn ([`bulb_turn`]: an arc away from the
+//!   next line, a large arc the other way and an arc back, all of radius `r_min`) where the
+//!   job may not reverse ([`ShortTurn::Bulb`]: AB block jobs, arcs), else a fishtail with a
+//!   reversal ([`ShortTurn::Fishtail`]: fields, sequential AB lines).
+//!
+//! The curvature-rate limit (`TurnParams::max_curvature_rate` > 0) makes pi turns and
+//! fishtails continuous-curvature (clothoid + arc + clothoid; a pi turn falls back to arcs
+//! when its lines are not level or too close for the clothoids).
+//!
+//! [`forward_turn`] writes a pi or bulb turn straight into a caller's buffer (the AB plan's
+//! turns, generated while driving, and the arcs job). [`TurnCache`] solves each turn once in
+//! a canonical frame and moves it onto every alike pair of line ends (fields, sequential AB
+//! lines).
 //!
 //! Every point carries [`Tag::Turn`](crate::geo::Tag); the first point is exactly the end of the
 //! current line and the last exactly the start of the next one.
+//!
+//! Contract: pure; uses `plan::types`, `plan::maneuver` (clothoid turns, cusp splitting) and
+//! [`crate::geo`] only.
 
-use super::PlanError;
+pub mod cache;
+
+pub use cache::{canonical_turn, TurnCache, TurnPart};
+
+use super::types::PlanError;
 use crate::geo::{cross, left_normal, v2, PathPoint, Vec2};
 use std::f64::consts::TAU;
+
+/// Lines closer than `2·r_min` by less than this still take a pi turn (the rounding of gaps
+/// computed from coordinates), m. The skip order counts line gaps with the same tolerance.
+pub const GAP_TOLERANCE: f64 = 1e-3;
+
+/// How a job joins lines closer than `2·r_min`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShortTurn {
+    /// Forward only: a bulb (omega) turn (AB block jobs, arcs).
+    Bulb,
+    /// With a reversal: a fishtail (fields, sequential AB lines).
+    Fishtail,
+}
+
+/// The kind of a turn between two parallel lines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TurnShape {
+    Pi,
+    Bulb,
+    Fishtail,
+}
+
+/// The one turn selector: a pi turn for lines `gap` (m) apart when `gap + ε ≥ 2·r_min`
+/// (ε = [`GAP_TOLERANCE`]), else the job's turn for close lines.
+pub fn turn_shape(gap: f64, r_min: f64, short: ShortTurn) -> TurnShape {
+    if gap + GAP_TOLERANCE >= 2.0 * r_min {
+        TurnShape::Pi
+    } else {
+        match short {
+            ShortTurn::Bulb => TurnShape::Bulb,
+            ShortTurn::Fishtail => TurnShape::Fishtail,
+        }
+    }
+}
+
+/// Append the forward-only turn from the end `p1` (travel direction `dir1`, unit) of a line to
+/// the start `p2` of the next one, `gap` m to the side: a pi turn or a bulb turn, as
+/// [`turn_shape`] chooses.
+pub fn forward_turn(
+    p1: Vec2,
+    dir1: Vec2,
+    p2: Vec2,
+    gap: f64,
+    params: &TurnParams,
+    out: &mut Vec<PathPoint>,
+) -> Result<(), PlanError> {
+    match turn_shape(gap, params.r_min, ShortTurn::Bulb) {
+        TurnShape::Pi => pi_turn(p1, dir1, p2, params, out),
+        TurnShape::Bulb | TurnShape::Fishtail => bulb_turn(p1, dir1, p2, params, out),
+    }
+}
 
 /// Arc sweeps below this are treated as zero, rad.
 const ZERO_SWEEP: f64 = 1e-6;
@@ -31,8 +100,7 @@ pub struct TurnParams {
     /// Cap on the number of interior points of a straight.
     pub max_points: usize,
     /// Largest curvature rate per metre driven for continuous-curvature turns, 1/m²; 0 =
-    /// turns made of arcs only (curvature steps at their ends). Used by the fishtail turns
-    /// of sequential lines (see `plan::coverage::turns`).
+    /// turns made of arcs only (curvature steps at their ends).
     pub max_curvature_rate: f64,
 }
 
@@ -158,7 +226,7 @@ pub fn pi_turn(
     params.validate()?;
     let r = params.r_min;
     let (n, d) = toward_next(&p1, &dir1, &p2);
-    if d + 1e-3 < 2.0 * r {
+    if d + GAP_TOLERANCE < 2.0 * r {
         return Err(PlanError::Turn {
             reason: "lines closer than 2·r_min need a bulb or fishtail turn",
             distance: d,
@@ -284,7 +352,7 @@ pub fn bulb_turn(
     params.validate()?;
     let r = params.r_min;
     let (n, d) = toward_next(&p1, &dir1, &p2);
-    if d > 2.0 * r + 1e-3 {
+    if d > 2.0 * r + GAP_TOLERANCE {
         return Err(PlanError::Turn {
             reason: "lines 2·r_min or more apart take a pi turn",
             distance: d,

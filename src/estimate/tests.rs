@@ -1,0 +1,501 @@
+//! The estimator: prediction, the observer, coasting.
+
+use super::*;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::f64::consts::FRAC_PI_2;
+
+fn params(predict: bool) -> EstimatorParams {
+    EstimatorParams {
+        wheelbase: 3.0,
+        antenna: AntennaOffset {
+            forward: 1.5,
+            left: 0.2,
+            up: 3.0,
+        },
+        gnss_latency: 0.05,
+        predict,
+        lead_time: 0.0,
+        roll_compensation: true,
+        observer: ObserverParams::default(),
+    }
+}
+
+/// True rear-axle pose on a circle of radius r at time t (speed v, start at origin east).
+fn circle(r: f64, v: f64, t: f64) -> Pose {
+    let a = v * t / r;
+    Pose::new(r * a.sin(), r - r * a.cos(), a)
+}
+
+fn antenna_of(e: &Estimator, p: &Pose) -> Vec2 {
+    let a = e.params().antenna;
+    let h = heading_vec(p.heading);
+    p.pos + h * a.forward + left_normal(&h) * a.left
+}
+
+#[test]
+fn antenna_offset_round_trip_and_roll() {
+    let e = Estimator::new(params(false));
+    let p = Pose::new(3.0, 4.0, 0.7);
+    let ant = antenna_of(&e, &p);
+    assert!((e.antenna_to_rear_axle(&ant, p.heading, None) - p.pos).norm() < 1e-12);
+    // 2° of roll, right side down: the antenna is 3·sin 2° ≈ 10.5 cm right of where it
+    // would be; the rear axle comes out right where it is.
+    let roll = 2f64.to_radians();
+    let shifted = ant - left_normal(&heading_vec(p.heading)) * (3.0 * roll.sin());
+    let back = e.antenna_to_rear_axle(&shifted, p.heading, Some(roll));
+    assert!((back - p.pos).norm() < 1e-12);
+}
+
+#[test]
+fn prediction_beats_the_raw_fix_under_latency() {
+    let (r, v, lat) = (10.0, 3.0, 0.05);
+    let delta = (3.0f64 / r).atan();
+    let mut pred = Estimator::new(params(true));
+    let mut raw = Estimator::new(params(false));
+    for k in 0..=100 {
+        let t = k as f64 * 0.01;
+        pred.on_wheel_angle(t, delta);
+    }
+    // Fix measured at 0.9 s, received at 0.95 s; estimate at 1.0 s.
+    let truth_then = circle(r, v, 0.9);
+    let fix = GnssFix {
+        t_received: 0.9 + lat,
+        antenna: antenna_of(&pred, &truth_then),
+        heading: Some(truth_then.heading),
+        speed: v,
+        roll: None,
+    };
+    pred.on_fix(&fix);
+    raw.on_fix(&fix);
+    let truth_now = circle(r, v, 1.0);
+    let e_pred = (pred.estimate(1.0).unwrap().pose.pos - truth_now.pos).norm();
+    let e_raw = (raw.estimate(1.0).unwrap().pose.pos - truth_now.pos).norm();
+    assert!(e_raw > 0.25, "raw error {e_raw}");
+    assert!(e_pred < 1e-3, "predicted error {e_pred}");
+    let h = pred.estimate(1.0).unwrap().pose.heading;
+    assert!((h - truth_now.heading).abs() < 1e-4);
+}
+
+#[test]
+fn wheel_history_interpolates() {
+    let mut e = Estimator::new(params(true));
+    assert_eq!(e.wheel_angle_at(1.0), 0.0);
+    e.on_wheel_angle(1.0, 0.1);
+    e.on_wheel_angle(2.0, 0.3);
+    assert!((e.wheel_angle_at(1.5) - 0.2).abs() < 1e-12);
+    assert_eq!(e.wheel_angle_at(0.0), 0.1);
+    assert_eq!(e.wheel_angle_at(5.0), 0.3);
+    for i in 0..1000 {
+        e.on_wheel_angle(3.0 + i as f64, i as f64);
+    }
+    assert_eq!(e.wheel_angle_at(1e9), 999.0, "ring keeps the newest");
+    // The prediction's cursor search gives what a search from the start gives, for
+    // non-decreasing times before, within (on and between samples) and after the ring.
+    let mut cursor = 1;
+    for k in 0..=1600 {
+        // The ring holds t = 875..=1002 s.
+        let t = 800.0 + 0.25 * k as f64;
+        let a = e.wheel_angle_from(t, &mut cursor);
+        assert_eq!(a, e.wheel_angle_at(t), "t = {t}");
+    }
+    assert_eq!(cursor, RING, "ran past the newest sample");
+}
+
+#[test]
+fn no_fix_and_bad_input_give_none_not_panics() {
+    let mut e = Estimator::new(params(true));
+    assert!(e.estimate(1.0).is_none());
+    e.on_fix(&GnssFix {
+        t_received: f64::NAN,
+        antenna: v2(0.0, 0.0),
+        heading: Some(0.0),
+        speed: 1.0,
+        roll: None,
+    });
+    e.on_wheel_angle(f64::INFINITY, 0.2);
+    assert!(e.estimate(1.0).is_none());
+}
+
+#[test]
+fn heading_from_course_without_dual_antenna() {
+    let mut e = Estimator::new(EstimatorParams {
+        antenna: AntennaOffset::default(),
+        ..params(false)
+    });
+    for k in 0..5 {
+        e.on_fix(&GnssFix {
+            t_received: k as f64 * 0.1,
+            antenna: v2(k as f64 * 0.3, k as f64 * 0.3),
+            heading: None,
+            speed: 3.0,
+            roll: None,
+        });
+    }
+    let est = e.estimate(0.5).unwrap();
+    assert!((est.pose.heading - std::f64::consts::FRAC_PI_4).abs() < 1e-9);
+}
+
+/// A vehicle on a straight line with a wheel-angle sensor bias and a world drift, fed to
+/// an estimator with the observer on: fixes at 10 Hz, wheel angles at 50 Hz, heading and
+/// position exact. Returns the estimator after `seconds` s driven at 3 m/s along `heading`.
+fn drive(
+    e: &mut Estimator,
+    t0: f64,
+    seconds: f64,
+    start: Pose,
+    bias: f64,
+    drift: Vec2,
+    float: Option<(f64, f64, Vec2)>,
+) -> Pose {
+    let v = 3.0;
+    let (mut x, mut y, th) = (start.pos.x, start.pos.y, start.heading);
+    let steps = (seconds / 0.02).round() as usize;
+    for k in 1..=steps {
+        let t = t0 + k as f64 * 0.02;
+        x += (v * th.cos() + drift.x) * 0.02;
+        y += (v * th.sin() + drift.y) * 0.02;
+        // Straight: true wheel angle 0, the sensor reads the bias.
+        e.on_wheel_angle(t, bias);
+        if k % 5 == 0 {
+            let truth = Pose::new(x, y, th);
+            let mut antenna = antenna_of(e, &truth);
+            let mut in_float = false;
+            if let Some((a, b, err)) = float {
+                if t >= a && t <= b {
+                    antenna += err;
+                    in_float = true;
+                }
+            }
+            e.set_learning(!in_float);
+            e.set_coasting(in_float);
+            e.on_fix(&GnssFix {
+                t_received: t + e.params().gnss_latency,
+                antenna,
+                heading: Some(th),
+                speed: v,
+                roll: None,
+            });
+        }
+    }
+    Pose::new(x, y, th)
+}
+
+fn observer_params() -> EstimatorParams {
+    EstimatorParams {
+        observer: ObserverParams {
+            bias_tau: 5.0,
+            drift_tau: 5.0,
+            coast_max: 30.0,
+            ..ObserverParams::default()
+        },
+        ..params(true)
+    }
+}
+
+/// Passes north and south across a slope falling to the East, rolling `roll(along)` (right
+/// side down driving north), the vehicle slipping downhill at `slip`·sin(roll) m/s, with an
+/// IMU roll noise of ±0.05° (seeded, uniform) and the antenna 3 m up: the estimator's slip
+/// coefficient and world drift afterwards.
+fn slope_passes(roll: impl Fn(f64) -> f64, slip: f64, passes: usize) -> (f64, Vec2) {
+    let mut e = Estimator::new(EstimatorParams {
+        observer: ObserverParams {
+            drift_tau: 60.0,
+            slip_tau: 30.0,
+            ..ObserverParams::default()
+        },
+        ..params(true)
+    });
+    let v = 4.0;
+    let mut t = 0.0;
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    for pass in 0..passes {
+        let north = pass % 2 == 0;
+        let th = if north { FRAC_PI_2 } else { -FRAC_PI_2 };
+        let x0 = pass as f64 * 3.0;
+        let (mut x, mut y) = (x0, if north { 0.0 } else { 150.0 });
+        // Re-anchor at the start of each pass (a turn, not simulated, comes between).
+        e.fix_pose = None;
+        for k in 1..=(150.0 / v / 0.02) as usize {
+            t += 0.02;
+            let along = if north { y } else { 150.0 - y };
+            // Positive roll when driving north (East side down); flips driving south.
+            let r = if north { roll(along) } else { -roll(along) };
+            let right = -left_normal(&heading_vec(th));
+            x += (v * th.cos() + right.x * slip * r.sin()) * 0.02;
+            y += (v * th.sin() + right.y * slip * r.sin()) * 0.02;
+            e.on_wheel_angle(t, 0.0);
+            if k % 5 == 0 {
+                let measured = r + rng.gen_range(-0.05f64..0.05).to_radians();
+                let truth = Pose::new(x, y, th);
+                let antenna = antenna_of(&e, &truth)
+                    - left_normal(&heading_vec(th)) * (e.params().antenna.up * r.sin());
+                e.on_fix(&GnssFix {
+                    t_received: t + e.params().gnss_latency,
+                    antenna,
+                    heading: Some(th),
+                    speed: v,
+                    roll: Some(measured),
+                });
+            }
+        }
+    }
+    (e.slip, e.drift())
+}
+
+#[test]
+fn the_observer_tells_slope_slip_from_a_world_drift() {
+    // 0.015 m/s per degree of roll, the roll 2° ± 1° over 60 m: the downhill drift and the
+    // slip push the same way on every pass; only the variation tells them apart.
+    let c = 0.015f64.to_degrees();
+    let varying = |along: f64| (2.0 + (along / 60.0 * std::f64::consts::TAU).sin()).to_radians();
+    let (slip, drift) = slope_passes(varying, c, 12);
+    assert!((slip - c).abs() < 0.1 * c, "slip {slip} vs {c}");
+    assert!(drift.norm() < 0.004, "drift {drift:?}");
+    // On an even slope they cannot be told apart; the sum must be right, and roll noise
+    // (3 m up, it moves the antenna) must not drive them apart to their limits.
+    let even = |_: f64| 2f64.to_radians();
+    let (slip, drift) = slope_passes(even, c, 12);
+    let total = drift.x + slip * 2f64.to_radians().sin();
+    let truth = c * 2f64.to_radians().sin();
+    assert!((total - truth).abs() < 0.003, "total {total} vs {truth}");
+    assert!(
+        slip.abs() < 2.0 * c && drift.norm() < 0.05,
+        "slip {slip}, drift {drift:?}"
+    );
+}
+
+#[test]
+fn the_observer_learns_a_sensor_bias_and_a_world_drift_that_keeps_its_sign() {
+    let mut e = Estimator::new(observer_params());
+    let bias = 0.5f64.to_radians();
+    // East drift of 3 cm/s while driving north, then south.
+    let drift = v2(0.03, 0.0);
+    let north = Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+    let end = drive(&mut e, 0.0, 60.0, north, bias, drift, None);
+    assert!(
+        (e.wheel_offset() - bias).abs() < 0.05 * bias,
+        "offset {} vs {bias}",
+        e.wheel_offset()
+    );
+    assert!((e.drift() - drift).norm() < 0.003, "drift {:?}", e.drift());
+    // Turned about (the drift is on the other side of the vehicle now): the estimate is
+    // still right from the first fix, and the prediction carries it.
+    let south = Pose::new(end.pos.x + 3.0, end.pos.y, -std::f64::consts::FRAC_PI_2);
+    let t = 61.0;
+    drive(&mut e, t, 1.0, south, bias, drift, None);
+    assert!((e.drift() - drift).norm() < 0.003, "drift {:?}", e.drift());
+    // Without the observer the same drive leaves both at zero.
+    let mut off = Estimator::new(params(true));
+    drive(&mut off, 0.0, 20.0, north, bias, drift, None);
+    assert_eq!((off.wheel_offset(), off.drift()), (0.0, Vec2::zeros()));
+}
+
+#[test]
+fn the_estimator_coasts_through_rtk_float_and_a_position_jump() {
+    let mut e = Estimator::new(observer_params());
+    let north = Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+    // A 20 cm float error from 30 s to 40 s: the estimate dead-reckons and stays on the
+    // true track instead.
+    let err = v2(0.2, 0.0);
+    let truth = drive(
+        &mut e,
+        0.0,
+        35.0,
+        north,
+        0.0,
+        Vec2::zeros(),
+        Some((30.0, 40.0, err)),
+    );
+    assert!(e.is_coasting());
+    let est = e.estimate(35.0).expect("an estimate").pose;
+    assert!(
+        (est.pos.x - truth.pos.x).abs() < 0.01,
+        "{est:?} vs {truth:?}"
+    );
+    // Fixed again: the fixes are taken at once.
+    let truth = drive(
+        &mut e,
+        35.0,
+        10.0,
+        truth,
+        0.0,
+        Vec2::zeros(),
+        Some((30.0, 40.0, err)),
+    );
+    assert!(!e.is_coasting());
+    let est = e.estimate(45.0).expect("an estimate").pose;
+    assert!((est.pos.x - truth.pos.x).abs() < 0.01);
+    // A 10 cm jump of a fixed solution (multipath) is not followed either, nor learnt.
+    let truth = drive(&mut e, 45.0, 5.0, truth, 0.0, Vec2::zeros(), None);
+    let before = e.drift();
+    let jump = v2(0.1, 0.0);
+    let ant = antenna_of(&e, &truth) + jump;
+    e.on_fix(&GnssFix {
+        t_received: 50.1,
+        antenna: ant,
+        heading: Some(truth.heading),
+        speed: 3.0,
+        roll: None,
+    });
+    assert!(e.is_coasting());
+    assert_eq!(e.drift(), before);
+}
+
+/// Drive north at 3 m/s for `seconds` with white GNSS noise σ `sigma` per axis and a lateral
+/// error of `dr_error` m/s in the wheel angles' dead reckoning (the wheels read 0, the vehicle
+/// drifts East at that rate: an unmodelled slip). Returns (the largest |error| of the
+/// estimate's East position from the truth over the last half, fixes coasted through).
+fn noisy_drive(
+    e: &mut Estimator,
+    seconds: f64,
+    sigma: f64,
+    jump: Option<(f64, f64, Vec2)>,
+) -> (f64, usize) {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let normal = rand_distr::Normal::new(0.0, sigma.max(1e-12)).expect("σ");
+    use rand_distr::Distribution;
+    let v = 3.0;
+    let th = FRAC_PI_2;
+    let mut y = 0.0;
+    let mut worst: f64 = 0.0;
+    let mut coasted = 0;
+    let steps = (seconds / 0.02).round() as usize;
+    for k in 1..=steps {
+        let t = k as f64 * 0.02;
+        y += v * 0.02;
+        e.on_wheel_angle(t, 0.0);
+        if k % 5 == 0 {
+            let truth = Pose::new(0.0, y, th);
+            let mut antenna = antenna_of(e, &truth);
+            if sigma > 0.0 {
+                antenna += v2(normal.sample(&mut rng), normal.sample(&mut rng));
+            }
+            if let Some((a, b, j)) = jump {
+                if t >= a && t < b {
+                    antenna += j;
+                }
+            }
+            e.on_fix(&GnssFix {
+                t_received: t + e.params().gnss_latency,
+                antenna,
+                heading: Some(th),
+                speed: v,
+                roll: None,
+            });
+            coasted += usize::from(e.is_coasting());
+            if t > seconds / 2.0 {
+                let est = e.estimate(t).expect("an estimate").pose;
+                worst = worst.max(est.pos.x.abs());
+            }
+        }
+    }
+    (worst, coasted)
+}
+
+fn robust_params(position_process: f64) -> EstimatorParams {
+    EstimatorParams {
+        observer: ObserverParams {
+            bias_tau: 20.0,
+            drift_tau: 60.0,
+            coast_max: 30.0,
+            robust: true,
+            position_process,
+            ..ObserverParams::default()
+        },
+        lead_time: 0.0,
+        ..params(true)
+    }
+}
+
+#[test]
+fn the_robust_observer_learns_the_receiver_s_noise_and_does_not_coast_on_it() {
+    for sigma in [0.005, 0.03, 0.05] {
+        let mut e = Estimator::new(robust_params(0.0));
+        let (_, coasted) = noisy_drive(&mut e, 120.0, sigma, None);
+        let got = e.position_noise();
+        assert!(
+            (got - sigma).abs() < 0.2 * sigma.max(0.01),
+            "σ {sigma}: estimated {got}"
+        );
+        // White noise is not a jump: hardly ever coasted (3.5 σ gates).
+        assert!(coasted < 12, "σ {sigma}: coasted {coasted} of 1200 fixes");
+    }
+    // The fixed 5 cm gate coasts through most of a 5 cm receiver's fixes.
+    let mut fixed = Estimator::new(EstimatorParams {
+        observer: ObserverParams {
+            robust: false,
+            ..robust_params(0.0).observer
+        },
+        ..robust_params(0.0)
+    });
+    let (_, coasted) = noisy_drive(&mut fixed, 120.0, 0.05, None);
+    assert!(coasted > 200, "coasted {coasted}");
+}
+
+#[test]
+fn position_smoothing_takes_the_receiver_s_noise_out_of_the_pose() {
+    let mut raw = Estimator::new(robust_params(0.0));
+    let (raw_worst, _) = noisy_drive(&mut raw, 120.0, 0.05, None);
+    let mut smooth = Estimator::new(robust_params(0.015));
+    let (smooth_worst, _) = noisy_drive(&mut smooth, 120.0, 0.05, None);
+    assert!(raw_worst > 0.1, "raw {raw_worst}");
+    assert!(
+        smooth_worst < 0.5 * raw_worst,
+        "{smooth_worst} vs raw {raw_worst}"
+    );
+}
+
+#[test]
+fn the_robust_observer_coasts_through_a_step_but_not_a_ramp() {
+    // A 10 cm step for 5 s (multipath): coasted through, the estimate stays on the truth.
+    let mut e = Estimator::new(robust_params(0.0));
+    let (worst, coasted) = noisy_drive(&mut e, 40.0, 0.01, Some((30.0, 35.0, v2(0.1, 0.0))));
+    assert!(coasted >= 45, "coasted {coasted}");
+    assert!(worst < 0.06, "followed the jump: {worst}");
+    // The dead reckoning going wrong: the tractor starts sliding sideways at 0.6 m/s (an
+    // implement's side draft on a slope, say) with the drift estimate off. Each fix is 6 cm
+    // off the dead reckoning: a jump at first sight, but the offset grows: a ramp, not a
+    // step, and the fixes are taken again at once (without the check it coasts for 30 s).
+    for robust in [true, false] {
+        let mut e = Estimator::new(EstimatorParams {
+            observer: ObserverParams {
+                bias_tau: 0.0,
+                drift_tau: 0.0,
+                robust,
+                ..robust_params(0.0).observer
+            },
+            ..robust_params(0.0)
+        });
+        let v = 3.0;
+        let mut coasted = 0;
+        let mut worst: f64 = 0.0;
+        let mut x = 0.0;
+        for k in 1..=1500 {
+            let t = k as f64 * 0.02;
+            if t > 10.0 {
+                x += 0.6 * 0.02;
+            }
+            e.on_wheel_angle(t, 0.0);
+            if k % 5 == 0 {
+                let truth = Pose::new(x, v * t, FRAC_PI_2);
+                e.on_fix(&GnssFix {
+                    t_received: t + e.params().gnss_latency,
+                    antenna: antenna_of(&e, &truth),
+                    heading: Some(FRAC_PI_2),
+                    speed: v,
+                    roll: None,
+                });
+                coasted += usize::from(e.is_coasting());
+                let est = e.estimate(t).expect("an estimate").pose;
+                worst = worst.max((est.pos.x - x).abs());
+            }
+        }
+        if robust {
+            assert!(worst < 0.2, "off by {worst}");
+            assert!(coasted < 150, "coasted {coasted} of 300");
+        } else {
+            assert!(worst > 5.0, "off by {worst}");
+        }
+    }
+}
