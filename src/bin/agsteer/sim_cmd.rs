@@ -152,7 +152,7 @@ pub fn run(
 /// `agsteer status`: ask the daemon's status socket.
 pub fn status(socket: &Path) -> Result<u8> {
     use std::io::Read;
-    let mut s = std::os::unix::net::UnixStream::connect(socket)
+    let s = std::os::unix::net::UnixStream::connect(socket)
         .with_context(|| format!("connecting to {}", socket.display()))?;
     s.set_read_timeout(Some(Duration::from_secs(2)))?;
     let mut text = String::new();
