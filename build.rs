@@ -49,6 +49,49 @@ fn uint_for(bits: u64) -> &'static str {
     }
 }
 
+fn raw_max(size: u64) -> u64 {
+    if size >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << size) - 1
+    }
+}
+
+/// The first raw code, counting up to the top of a field of `size` bits, that is a sentinel
+/// (not available, error / out of range, reserved) rather than a value; for a signed field, the
+/// first such code among the positive values. `None` when every code is a value.
+///
+/// - NMEA 2000 (data page 1), as canboat reads it (analyzer/fieldtype.c `reservedCountForSize`,
+///   after Cassidy, "NMEA 2000 Explained": a uint16's valid range is 0..65532): the top 3 codes
+///   of a field of 8 bits or more (max = unknown / not available, max − 1 = out of range,
+///   max − 2 = reserved), the top 2 of a 4–7-bit field, the top code of a 2–3-bit field, none of
+///   a single bit. Signed fields count down from the largest positive value.
+/// - J1939 / ISO 11783 (data page 0), SAE J1939-71 §5.1.4 (parameter ranges): an 8-, 16- or
+///   32-bit unsigned parameter is valid up to 0xFA, 0xFAFF, 0xFAFFFFFF; above come the
+///   parameter-specific indicator (0xFB..), the reserved range (0xFC..–0xFD..), error (0xFE..)
+///   and not available (0xFF..). A field of another length: all ones = not available, all ones
+///   − 1 = error (as the 2-bit discrete parameters: 10 error, 11 not available). Signed fields,
+///   which J1939 does not define, follow canboat's convention above.
+fn sentinel_from(n2k: bool, size: u64, signed: bool) -> Option<u64> {
+    let bits = if signed { size - 1 } else { size };
+    let top = raw_max(bits);
+    let count = if n2k || signed {
+        match size {
+            8.. => 3,
+            4..=7 => 2,
+            2..=3 => 1,
+            _ => 0,
+        }
+    } else {
+        match size {
+            8 | 16 | 32 => return Some(0xFBu64 << (size - 8)),
+            2.. => 2,
+            _ => 0,
+        }
+    };
+    (count > 0).then(|| top - (count - 1))
+}
+
 fn attr_u64(v: &AttributeValue) -> u64 {
     match v {
         AttributeValue::Uint(u) => *u,
@@ -141,12 +184,32 @@ fn main() {
                     s.name
                 );
             }
-            let na = sig_attr(m.id, &s.name, "AgNotAvailable") == 1;
             let signed = s.value_type == ValueType::Signed;
             let descs: Vec<(i64, String)> = dbc
                 .value_descriptions_for_signal(m.id, &s.name)
                 .map(|v| v.iter().map(|d| (d.id, d.description.clone())).collect())
                 .unwrap_or_default();
+            // The first raw code that is a sentinel (see `sentinel_from`), unless the DBC's
+            // range or value table declares it a value.
+            let n2k = (id >> 24) & 1 == 1;
+            let declared = {
+                let max_raw = ((s.max - s.offset) / s.factor).round();
+                let named = descs.iter().map(|(id, _)| *id).max().unwrap_or(0) as f64;
+                max_raw.max(named).max(0.0) as u64
+            };
+            let top = if signed {
+                (1u64 << (s.size - 1)) - 1
+            } else {
+                raw_max(s.size)
+            };
+            let na_from = if role == "Role::Value" {
+                sentinel_from(n2k, s.size, signed)
+                    .map(|f| f.max(declared.saturating_add(1)))
+                    .filter(|&f| f <= top)
+            } else {
+                None
+            };
+            let na = na_from.is_some();
             let choices = descs
                 .iter()
                 .map(|(id, d)| format!("({id}, {d:?})"))
@@ -154,7 +217,7 @@ fn main() {
                 .join(", ");
             writeln!(
                 table,
-                "        SignalDef {{ name: {:?}, start_bit: {}, size: {}, signed: {signed}, factor: {}, offset: {}, min: {}, max: {}, unit: {:?}, role: {role}, not_available: {na}, choices: &[{choices}] }},",
+                "        SignalDef {{ name: {:?}, start_bit: {}, size: {}, signed: {signed}, factor: {}, offset: {}, min: {}, max: {}, unit: {:?}, role: {role}, na_from: {na_from:?}, choices: &[{choices}] }},",
                 s.name,
                 s.start_bit,
                 s.size,

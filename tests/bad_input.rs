@@ -329,6 +329,28 @@ fn a_boundary_of_many_vertices_is_simplified_and_planned() {
 }
 
 #[test]
+fn taskdata_of_too_many_points_is_refused_at_once() {
+    let pts: String = (0..200_000)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / 200_000.0;
+            format!(
+                "<PNT A=\"2\" C=\"{}\" D=\"{}\"/>",
+                52.0 + 500.0 * a.sin() / M_PER_DEG_LAT,
+                5.0 + 500.0 * a.cos() / M_PER_DEG_LON
+            )
+        })
+        .collect();
+    let xml = format!(
+        "<ISO11783_TaskData><PFD A=\"PFD1\" C=\"big\"><PLN A=\"1\"><LSG A=\"1\">{pts}</LSG></PLN></PFD></ISO11783_TaskData>"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let f = write(dir.path(), "TASKDATA.XML", &xml);
+    let out = dir.path().join("out").display().to_string();
+    run(&["plan", "--field", &f, "--out", &out])
+        .refused(1, &[&f, "positions in the file: 200000", "limit of 100000"]);
+}
+
+#[test]
 fn too_many_obstacles_are_refused() {
     let field = rect(2_000.0, 2_000.0);
     let parts: Vec<Vec<(f64, f64)>> = (0..2_000)

@@ -2,7 +2,7 @@
 //! lines), and the committed frame table.
 
 use agsteer::can::fastpacket::split;
-use agsteer::can::gnss::{GnssPosition, METHOD_RTK_FLOAT};
+use agsteer::can::gnss::{fix_message, GnssPosition, METHOD_RTK_FLOAT};
 use std::io::Write;
 use std::process::{Command, Stdio};
 
@@ -92,22 +92,13 @@ fn dbc_encode_then_decode() {
 #[test]
 fn dbc_decode_reassembles_129029_and_reports_bad_frames() {
     let g = GnssPosition {
-        sid: 1,
-        date_days: 20_000,
-        time_s: 1000.0,
-        latitude_deg: 52.000_000_123_4,
-        longitude_deg: 5.000_000_567_8,
-        altitude_m: 10.0,
-        gnss_type: 4,
-        method: METHOD_RTK_FLOAT,
-        integrity: 0,
-        satellites: 18,
+        time_s: Some(1000.0),
+        altitude_m: Some(10.0),
+        satellites: Some(18),
         hdop: Some(0.8),
         pdop: Some(1.2),
-        geoidal_separation_m: 45.0,
-        reference_stations: 1,
-        reference_station_id: 7,
-        correction_age_s: Some(0.6),
+        geoidal_separation_m: Some(45.0),
+        ..fix_message(1, 52.000_000_123_4, 5.000_000_567_8, METHOD_RTK_FLOAT)
     };
     let mut frames = Vec::new();
     split(&g.encode(), 2, &mut frames);

@@ -39,10 +39,13 @@ fn encode_and_decode_agree_with_cantools_bit_for_bit() {
                 values[i] = v["values"][s.name].as_f64();
             }
         }
-        let frame = encode_values(def, &values, counter, (id & 0xFF) as u8)
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(frame.id, id, "{name}");
-        assert_eq!(frame.payload(), &data[..], "{name} encode {v}");
+        // Decode-only vectors hold a sentinel code other than the one the encoder sends.
+        if v.get("decode_only").is_none() {
+            let frame = encode_values(def, &values, counter, (id & 0xFF) as u8)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(frame.id, id, "{name}");
+            assert_eq!(frame.payload(), &data[..], "{name} encode {v}");
+        }
         let d = decode(id, &data).unwrap_or_else(|e| panic!("{name}: {e}"));
         for (i, s) in def.signals.iter().enumerate() {
             match s.role {
@@ -79,8 +82,8 @@ fn packer_fills_counters_and_crcs_and_the_parser_checks_them() {
     let mut check = CounterCheck::default();
     for k in 0..40u32 {
         let msg = SteeringCommand {
-            angle: (k as f64) * 0.5 - 10.0,
-            mode: SteeringCommandMode::Engaged,
+            angle: Some((k as f64) * 0.5 - 10.0),
+            mode: Some(SteeringCommandMode::Engaged),
         };
         let f = packer.pack(&msg).unwrap();
         assert_eq!(f.id & 0xFF, 0x2A);
@@ -92,8 +95,8 @@ fn packer_fills_counters_and_crcs_and_the_parser_checks_them() {
     // A corrupted byte fails the CRC; a repeated frame fails the counter.
     let f = packer
         .pack(&SteeringCommand {
-            angle: 1.0,
-            mode: SteeringCommandMode::Engaged,
+            angle: Some(1.0),
+            mode: Some(SteeringCommandMode::Engaged),
         })
         .unwrap();
     let mut bad = f.data;
@@ -113,7 +116,7 @@ fn out_of_range_missing_and_not_available() {
         encode(
             &WheelAngle {
                 angle: Some(90.5),
-                status: WheelAngleStatus::Ok
+                status: Some(WheelAngleStatus::Ok)
             },
             0,
             0x13
@@ -123,8 +126,8 @@ fn out_of_range_missing_and_not_available() {
     assert!(matches!(
         encode(
             &SteeringCommand {
-                angle: f64::NAN,
-                mode: SteeringCommandMode::Disengaged
+                angle: Some(f64::NAN),
+                mode: Some(SteeringCommandMode::Disengaged)
             },
             0,
             0x2A
@@ -134,7 +137,7 @@ fn out_of_range_missing_and_not_available() {
     let f = encode(
         &WheelAngle {
             angle: None,
-            status: WheelAngleStatus::Ok,
+            status: Some(WheelAngleStatus::Ok),
         },
         3,
         0x13,
@@ -146,7 +149,7 @@ fn out_of_range_missing_and_not_available() {
     let f = encode(
         &WheelAngle {
             angle: Some(0.005),
-            status: WheelAngleStatus::Ok,
+            status: Some(WheelAngleStatus::Ok),
         },
         0,
         0x13,
@@ -156,7 +159,7 @@ fn out_of_range_missing_and_not_available() {
     let f = encode(
         &WheelAngle {
             angle: Some(0.015),
-            status: WheelAngleStatus::Ok,
+            status: Some(WheelAngleStatus::Ok),
         },
         0,
         0x13,
@@ -170,7 +173,7 @@ fn any_source_address_matches_by_pgn() {
     let f = encode(
         &WheelAngle {
             angle: Some(1.0),
-            status: WheelAngleStatus::Ok,
+            status: Some(WheelAngleStatus::Ok),
         },
         0,
         0x77,
@@ -207,4 +210,100 @@ fn random_bytes_of_every_length_never_panic() {
             }
         }
     }
+}
+
+/// The sentinel rule restated from its sources (see build.rs): the first raw code that means
+/// "no value" for a field of `size` bits, before the DBC's declarations are applied.
+fn convention_first(n2k: bool, size: u8, signed: bool) -> Option<u64> {
+    let top = if signed {
+        (1u64 << (size - 1)) - 1
+    } else {
+        (1u64 << size) - 1
+    };
+    let count = if n2k || signed {
+        match size {
+            8.. => 3,
+            4..=7 => 2,
+            2..=3 => 1,
+            _ => 0,
+        }
+    } else {
+        match size {
+            8 | 16 | 32 => return Some(0xFB << (size - 8)),
+            2.. => 2,
+            _ => 0,
+        }
+    };
+    (count > 0).then(|| top + 1 - count)
+}
+
+/// Every value signal of every message: the codes of its sentinel region decode as absent,
+/// the code below as a number; `None` encodes as the not-available code; a signal without a
+/// sentinel region is one whose DBC range or value table declares its top codes.
+#[test]
+fn every_signal_decodes_its_sentinel_codes_as_absent() {
+    let mut checked = 0;
+    for def in MESSAGES {
+        let n2k = (def.id >> 24) & 1 == 1;
+        let mut base = [None; MAX_SIGNALS];
+        for (i, s) in def.signals.iter().enumerate() {
+            base[i] = Some(s.min.max(0.0).min(s.max));
+        }
+        let frame = encode_values(def, &base, 0, 0x1C).unwrap_or_else(|e| panic!("{e}"));
+        for (i, s) in def.signals.iter().enumerate() {
+            if s.role != Role::Value {
+                continue;
+            }
+            let top = if s.signed {
+                (1u64 << (s.size - 1)) - 1
+            } else {
+                (1u64 << s.size) - 1
+            };
+            let declared = ((s.max - s.offset) / s.factor).round().max(0.0) as u64;
+            let named = s.choices.iter().map(|(k, _)| *k as u64).max().unwrap_or(0);
+            let expected = convention_first(n2k, s.size, s.signed)
+                .map(|f| f.max(declared.max(named) + 1))
+                .filter(|&f| f <= top);
+            assert_eq!(s.na_from, expected, "{}.{}", def.name, s.name);
+            let with_raw = |raw: u64| {
+                let mut word = u64::from_le_bytes(frame.data);
+                let m = (1u64 << s.size) - 1;
+                word = (word & !(m << s.start_bit)) | ((raw & m) << s.start_bit);
+                let mut data = word.to_le_bytes();
+                if let Some(c) = def.signals.iter().find(|c| c.role == Role::Crc) {
+                    let b = (c.start_bit / 8) as usize;
+                    data[b] = crc8_except(&data[..def.size as usize], b);
+                }
+                decode(frame.id, &data[..def.size as usize])
+                    .unwrap_or_else(|e| panic!("{}.{}: {e}", def.name, s.name))
+                    .values[i]
+            };
+            match expected {
+                Some(first) => {
+                    for raw in [first, first + 1, (first + top) / 2, top] {
+                        if raw <= top {
+                            assert_eq!(with_raw(raw), None, "{}.{} raw {raw}", def.name, s.name);
+                            checked += 1;
+                        }
+                    }
+                    assert!(with_raw(first - 1).is_some(), "{}.{}", def.name, s.name);
+                    let mut v = base;
+                    v[i] = None;
+                    let f = encode_values(def, &v, 0, 0x1C).unwrap();
+                    let word = u64::from_le_bytes(f.data);
+                    assert_eq!((word >> s.start_bit) & ((1u64 << s.size) - 1), top);
+                }
+                None => {
+                    assert!(with_raw(top).is_some(), "{}.{}", def.name, s.name);
+                    let mut v = base;
+                    v[i] = None;
+                    assert!(matches!(
+                        encode_values(def, &v, 0, 0x1C),
+                        Err(CodecError::Missing { .. })
+                    ));
+                }
+            }
+        }
+    }
+    assert!(checked > 100, "{checked}");
 }

@@ -250,9 +250,9 @@ impl Bench {
             let f = self
                 .terminal
                 .pack(&agsteer::can::codec::OperatorCommand {
-                    command: agsteer::can::codec::OperatorCommandCommand::Engage,
-                    nudge: 0.0,
-                    job: 0.0,
+                    command: Some(agsteer::can::codec::OperatorCommandCommand::Engage),
+                    nudge: Some(0.0),
+                    job: Some(0.0),
                 })
                 .unwrap();
             if self.period(dt, &[f]).engaged {

@@ -19,7 +19,7 @@ use agsteer::can::codec::{
     WheelSpeedDirection, WheelSpeedKeySwitch, MESSAGES,
 };
 use agsteer::can::fastpacket::split;
-use agsteer::can::gnss::GnssPosition;
+use agsteer::can::gnss::{fix_message, GnssPosition};
 use agsteer::can::{Frame, TimedFrame};
 use agsteer::config::Config;
 use agsteer::control::node::ControllerNode;
@@ -492,33 +492,19 @@ fn run_node_case(cfg: &Config, inputs: &[In]) -> Result<(), TestCaseError> {
             }
             In::Heading => {
                 if let Ok(f) = gnss.pack(&VesselHeading {
-                    sid: 0.0,
+                    sid: Some(0.0),
                     heading: Some(0.0),
                     deviation: None,
                     variation: None,
-                    reference: VesselHeadingReference::True,
+                    reference: Some(VesselHeadingReference::True),
                 }) {
                     feed(&mut node, t, f);
                 }
             }
             In::Quality { method, shuffle } => {
                 let g = GnssPosition {
-                    sid: 0,
-                    date_days: 0,
-                    time_s: 0.0,
-                    latitude_deg: 52.0,
-                    longitude_deg: 5.0,
-                    altitude_m: 0.0,
-                    gnss_type: 4,
-                    method: *method,
-                    integrity: 0,
-                    satellites: 12,
-                    hdop: Some(1.0),
-                    pdop: Some(1.0),
-                    geoidal_separation_m: 0.0,
-                    reference_stations: 1,
-                    reference_station_id: 1,
-                    correction_age_s: Some(1.0),
+                    time_s: Some(0.0),
+                    ..fix_message(0, 52.0, 5.0, *method)
                 };
                 let mut frames = Vec::new();
                 split(&g.encode(), seq, &mut frames);
@@ -539,12 +525,12 @@ fn run_node_case(cfg: &Config, inputs: &[In]) -> Result<(), TestCaseError> {
                 if *skip {
                     let _ = was.pack(&WheelAngle {
                         angle: Some(0.0),
-                        status: WheelAngleStatus::Ok,
+                        status: Some(WheelAngleStatus::Ok),
                     });
                 }
                 if let Ok(mut f) = was.pack(&WheelAngle {
                     angle: Some(*angle),
-                    status: WheelAngleStatus::from_raw(*status),
+                    status: Some(WheelAngleStatus::from_raw(*status)),
                 }) {
                     if *corrupt {
                         f.data[7] ^= 0xA5;
@@ -558,18 +544,18 @@ fn run_node_case(cfg: &Config, inputs: &[In]) -> Result<(), TestCaseError> {
                 if let Ok(f) = tractor.pack(&WheelSpeed {
                     speed: Some(*v),
                     distance: Some(0.0),
-                    max_time_tractor_power: 0.0,
-                    key_switch: WheelSpeedKeySwitch::NotOff,
-                    direction: WheelSpeedDirection::Forward,
+                    max_time_tractor_power: Some(0.0),
+                    key_switch: Some(WheelSpeedKeySwitch::NotOff),
+                    direction: Some(WheelSpeedDirection::Forward),
                 }) {
                     feed(&mut node, t, f);
                 }
             }
             In::Operator(c) => {
                 if let Ok(f) = terminal.pack(&OperatorCommand {
-                    command: OperatorCommandCommand::from_raw(*c),
-                    nudge: 0.0,
-                    job: 0.0,
+                    command: Some(OperatorCommandCommand::from_raw(*c)),
+                    nudge: Some(0.0),
+                    job: Some(0.0),
                 }) {
                     feed(&mut node, t, f);
                 }
@@ -601,11 +587,13 @@ fn run_node_case(cfg: &Config, inputs: &[In]) -> Result<(), TestCaseError> {
                 let steer =
                     steer.ok_or_else(|| TestCaseError::fail("no steering frame this period"))?;
                 prop_assert_eq!(
-                    steer.mode == codec::SteeringCommandMode::Engaged,
+                    steer.mode == Some(codec::SteeringCommandMode::Engaged),
                     cmd.engaged
                 );
                 if cmd.engaged {
-                    prop_assert!(steer.angle.to_radians().abs() <= p.max_wheel_angle + 1e-3);
+                    prop_assert!(steer
+                        .angle
+                        .is_some_and(|a| a.to_radians().abs() <= p.max_wheel_angle + 1e-3));
                     if let Some(prev) = last_cmd {
                         let dt = t - last_tick_t;
                         prop_assert!(

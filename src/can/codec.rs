@@ -32,9 +32,30 @@ pub struct SignalDef {
     pub max: f64,
     pub unit: &'static str,
     pub role: Role,
-    pub not_available: bool,
+    /// The first raw code that means "no value" (not available, error / out of range,
+    /// reserved; for a signed signal, among the positive codes): every code from it to the top
+    /// of the field decodes to `None`; `None` is encoded as the top code (not available).
+    /// Derived by `build.rs` from the field's length and signedness, the protocol (NMEA 2000
+    /// for data page 1, J1939 / ISO 11783 for data page 0) and the DBC's declared range and
+    /// value table; `None` when every code is a value.
+    pub na_from: Option<u64>,
     /// Named values (VAL_).
     pub choices: &'static [(i64, &'static str)],
+}
+
+impl SignalDef {
+    /// The signal has codes that mean "no value" (decoded as `None`).
+    pub fn not_available(&self) -> bool {
+        self.na_from.is_some()
+    }
+    /// The code sent for "not available": all ones, or the largest positive value if signed.
+    pub fn na_raw(&self) -> u64 {
+        if self.signed {
+            (1u64 << (self.size - 1)) - 1
+        } else {
+            mask(self.size)
+        }
+    }
 }
 
 /// One message of the DBC.
@@ -228,17 +249,14 @@ fn decode_as(
                 let m = mask(s.size);
                 let v = if s.signed {
                     let sign = 1u64 << (s.size - 1);
-                    if s.not_available && raw == sign - 1 {
+                    if raw & sign != 0 {
+                        Some((raw | !m) as i64 as f64 * s.factor + s.offset)
+                    } else if s.na_from.is_some_and(|f| raw >= f) {
                         None
                     } else {
-                        let sv = if raw & sign != 0 {
-                            (raw | !m) as i64
-                        } else {
-                            raw as i64
-                        };
-                        Some(sv as f64 * s.factor + s.offset)
+                        Some(raw as i64 as f64 * s.factor + s.offset)
                     }
-                } else if s.not_available && raw == m {
+                } else if s.na_from.is_some_and(|f| raw >= f) {
                     None
                 } else {
                     Some(raw as f64 * s.factor + s.offset)
@@ -279,13 +297,7 @@ pub fn encode_values(
             }
             Role::Counter => counter as u64 & m,
             Role::Value => match values.get(i).copied().flatten() {
-                None if s.not_available => {
-                    if s.signed {
-                        (1u64 << (s.size - 1)) - 1
-                    } else {
-                        m
-                    }
-                }
+                None if s.not_available() => s.na_raw(),
                 None => {
                     return Err(CodecError::Missing {
                         message: def.name,
@@ -402,7 +414,7 @@ pub fn frames_markdown() -> String {
                         } else {
                             format!(" {}", g.unit)
                         };
-                        let na = if g.not_available { ", n/a" } else { "" };
+                        let na = if g.not_available() { ", n/a" } else { "" };
                         format!(
                             " {}{} ×{} [{}, {}]{unit}{na}",
                             if g.signed { "i" } else { "u" },

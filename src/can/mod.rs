@@ -4,6 +4,7 @@
 //! generates the codec tables and typed messages from it.
 
 pub mod bus;
+pub mod candump;
 pub mod codec;
 pub mod fastpacket;
 pub mod gnss;

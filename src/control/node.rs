@@ -27,6 +27,8 @@ const HEADING_MAX_AGE: f64 = 0.5;
 const ROLL_MAX_AGE: f64 = 0.5;
 /// A 129029 quality older than this no longer vouches for positions, s.
 const QUALITY_MAX_AGE: f64 = 2.0;
+/// The largest fault code GuidanceStatus.Fault carries (its DBC range).
+const GUIDANCE_STATUS_FAULT_MAX: f64 = 13.0;
 
 /// What `agsteer status` and the guidance status frame report.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -415,7 +417,7 @@ impl ControllerNode {
             self.supervisor.set_direction_change(t, self.cusp);
             let due = self.last_request != Some(r) || self.ticks % self.status_every == 0;
             if due {
-                if let Ok(f) = self.packer.pack(&DirectionRequest { direction: r }) {
+                if let Ok(f) = self.packer.pack(&DirectionRequest { direction: Some(r) }) {
                     out.push(f);
                 }
                 self.last_request = Some(r);
@@ -429,12 +431,12 @@ impl ControllerNode {
 
         if matches!(self.output, OutputKind::Angle | OutputKind::Both) {
             if let Ok(f) = self.packer.pack(&SteeringCommand {
-                angle: angle_deg,
-                mode: if cmd.engaged {
+                angle: Some(angle_deg),
+                mode: Some(if cmd.engaged {
                     SteeringCommandMode::Engaged
                 } else {
                     SteeringCommandMode::Disengaged
-                },
+                }),
             }) {
                 out.push(f);
             }
@@ -443,12 +445,12 @@ impl ControllerNode {
             // ISO 11783-7: km⁻¹, positive = right turn; ours is 1/m, positive = left.
             let k = (-cmd.curvature * 1000.0).clamp(-8032.0, 8031.75);
             if let Ok(f) = self.packer.pack(&GuidanceSystemCommand {
-                curvature: k,
-                command_status: if cmd.engaged {
+                curvature: Some(k),
+                command_status: Some(if cmd.engaged {
                     GuidanceSystemCommandCommandStatus::IntendedToSteer
                 } else {
                     GuidanceSystemCommandCommandStatus::NotIntendedToSteer
-                },
+                }),
             }) {
                 out.push(f);
             }
@@ -471,14 +473,16 @@ impl ControllerNode {
         if self.ticks % self.status_every == 0 {
             let s = &self.status;
             let msg = GuidanceStatus {
-                state: GuidanceStatusState::from_raw(s.state.code()),
-                fault: (s.fault as u8).min(15) as f64,
+                state: Some(GuidanceStatusState::from_raw(s.state.code())),
+                // The DBC's range ends below the field's not-available codes (J1939-71): a
+                // value past it is sent as not available.
+                fault: Some(s.fault as u8 as f64).filter(|&f| f <= GUIDANCE_STATUS_FAULT_MAX),
                 xte: s
                     .xte_m
-                    .map(|x| (x * 1000.0).round().clamp(-32767.0, 32766.0)),
+                    .map(|x| (x * 1000.0).round().clamp(-32767.0, 32764.0)),
                 heading_error: s.heading_error_deg.map(|h| h.clamp(-180.0, 180.0)),
-                line: (s.line <= 65534).then_some(s.line as f64),
-                block: (s.block <= 254).then_some(s.block as f64),
+                line: (s.line <= 64255).then_some(s.line as f64),
+                block: (s.block <= 250).then_some(s.block as f64),
             };
             if let Ok(f) = self.packer.pack(&msg) {
                 out.push(f);

@@ -583,9 +583,9 @@ pub fn run(
         let st = node.status();
         if st.state == SafetyState::Ready && !(opts.no_reengage && engagements > 0) {
             if let Ok(f) = terminal.pack(&OperatorCommand {
-                command: crate::can::codec::OperatorCommandCommand::Engage,
-                nudge: 0.0,
-                job: 0.0,
+                command: Some(crate::can::codec::OperatorCommandCommand::Engage),
+                nudge: Some(0.0),
+                job: Some(0.0),
             }) {
                 terminal_bus.set_time(t);
                 let _ = terminal_bus.send(&f);

@@ -110,20 +110,30 @@ impl From<CogSogRapidCogReference> for HeadingReferenceRaw {
     }
 }
 
+/// An operator command; one whose command, nudge or job is not available is no command.
 fn operator_command(c: &codec::OperatorCommand) -> OperatorCommand {
-    match c.command {
+    let Some(command) = c.command else {
+        return OperatorCommand::None;
+    };
+    match command {
         OperatorCommandCommand::None => OperatorCommand::None,
         OperatorCommandCommand::Engage => OperatorCommand::Engage,
         OperatorCommandCommand::Disengage => OperatorCommand::Disengage,
         OperatorCommandCommand::Pause => OperatorCommand::Pause,
         OperatorCommandCommand::Resume => OperatorCommand::Resume,
-        OperatorCommandCommand::Nudge => OperatorCommand::Nudge {
-            offset_m: c.nudge * 0.01,
+        OperatorCommandCommand::Nudge => match c.nudge {
+            Some(cm) => OperatorCommand::Nudge {
+                offset_m: cm * 0.01,
+            },
+            None => OperatorCommand::None,
         },
         OperatorCommandCommand::SetA => OperatorCommand::SetA,
         OperatorCommandCommand::SetB => OperatorCommand::SetB,
-        OperatorCommandCommand::SelectJob => OperatorCommand::SelectJob {
-            job: c.job.clamp(0.0, 255.0) as u8,
+        OperatorCommandCommand::SelectJob => match c.job {
+            Some(job) => OperatorCommand::SelectJob {
+                job: job.clamp(0.0, 255.0) as u8,
+            },
+            None => OperatorCommand::None,
         },
         OperatorCommandCommand::Other(code) => OperatorCommand::Unknown { code },
     }
@@ -168,10 +178,10 @@ impl CanAdapter {
                 source,
                 angle: m.angle.map(f64::to_radians),
                 status: match m.status {
-                    WheelAngleStatus::Ok => SensorStatus::Ok,
-                    WheelAngleStatus::Fault => SensorStatus::Fault,
-                    WheelAngleStatus::OperatorOverride => SensorStatus::OperatorOverride,
-                    WheelAngleStatus::Other(_) => SensorStatus::Unknown,
+                    Some(WheelAngleStatus::Ok) => SensorStatus::Ok,
+                    Some(WheelAngleStatus::Fault) => SensorStatus::Fault,
+                    Some(WheelAngleStatus::OperatorOverride) => SensorStatus::OperatorOverride,
+                    Some(WheelAngleStatus::Other(_)) | None => SensorStatus::Unknown,
                 },
             })),
             Message::PositionRapid(m) => {
@@ -199,7 +209,9 @@ impl CanAdapter {
                         t,
                         source,
                         heading: yaw_from_north_cw(h),
-                        reference: reference(m.reference.into()),
+                        reference: m
+                            .reference
+                            .map_or(HeadingReference::Unknown, |r| reference(r.into())),
                         variation: m.variation,
                     }));
                 }
@@ -208,7 +220,9 @@ impl CanAdapter {
                 // A course over ground is given only when it is true (referred to the
                 // geographic North); a magnetic one would need the variation, which 129026
                 // does not carry.
-                let is_true = reference(m.cog_reference.into()) == HeadingReference::True;
+                let is_true = m
+                    .cog_reference
+                    .is_some_and(|r| reference(r.into()) == HeadingReference::True);
                 out.push(Input::CourseSpeed(CourseSpeedInput {
                     t,
                     source,
@@ -221,9 +235,9 @@ impl CanAdapter {
                 source,
                 speed_mps: m.speed,
                 direction: match m.direction {
-                    WheelSpeedDirection::Forward => Some(Direction::Forward),
-                    WheelSpeedDirection::Reverse => Some(Direction::Reverse),
-                    _ => None,
+                    Some(WheelSpeedDirection::Forward) => Some(Direction::Forward),
+                    Some(WheelSpeedDirection::Reverse) => Some(Direction::Reverse),
+                    Some(WheelSpeedDirection::Other(_)) | None => None,
                 },
             })),
             Message::GnssPositionData(_) => match self.fast.push(d.source, tf.frame.payload()) {
@@ -231,10 +245,10 @@ impl CanAdapter {
                     Ok(g) => out.push(Input::Quality(QualityInput {
                         t,
                         source,
-                        quality: quality_of_method(g.method),
-                        satellites: Some(g.satellites),
+                        quality: g.method.map_or(FixQuality::None, quality_of_method),
+                        satellites: g.satellites,
                         hdop: g.hdop,
-                        correction_age_s: g.correction_age_s,
+                        correction_age_s: g.correction_age_s(),
                         horizontal_sigma_m: None,
                     })),
                     Err(_) => out.check(t, source, None, false),
@@ -281,7 +295,7 @@ mod tests {
         let f = was
             .pack(&WheelAngle {
                 angle: Some(-12.5),
-                status: WheelAngleStatus::OperatorOverride,
+                status: Some(WheelAngleStatus::OperatorOverride),
             })
             .unwrap();
         let got = inputs(&mut a, f);
@@ -304,7 +318,7 @@ mod tests {
         let mut g = was
             .pack(&WheelAngle {
                 angle: Some(1.0),
-                status: WheelAngleStatus::Ok,
+                status: Some(WheelAngleStatus::Ok),
             })
             .unwrap();
         g.data[7] ^= 1;
@@ -320,11 +334,11 @@ mod tests {
         let mut gnss = Packer::new(0x1C);
         let f = gnss
             .pack(&VesselHeading {
-                sid: 1.0,
+                sid: Some(1.0),
                 heading: Some(std::f64::consts::FRAC_PI_2), // East, clockwise from North
                 deviation: None,
                 variation: Some(0.05),
-                reference: VesselHeadingReference::Magnetic,
+                reference: Some(VesselHeadingReference::Magnetic),
             })
             .unwrap();
         let [Input::Heading(h)] = inputs(&mut a, f)[..] else {
@@ -337,9 +351,9 @@ mod tests {
             .pack(&WheelSpeed {
                 speed: Some(2.5),
                 distance: Some(1.0),
-                max_time_tractor_power: 0.0,
-                key_switch: WheelSpeedKeySwitch::NotOff,
-                direction: WheelSpeedDirection::Reverse,
+                max_time_tractor_power: None,
+                key_switch: Some(WheelSpeedKeySwitch::NotOff),
+                direction: Some(WheelSpeedDirection::Reverse),
             })
             .unwrap();
         let [Input::WheelSpeed(s)] = inputs(&mut a, f)[..] else {
@@ -351,9 +365,9 @@ mod tests {
         );
         let f = Packer::new(0x26)
             .pack(&OpFrame {
-                command: OperatorCommandCommand::Nudge,
-                nudge: -15.0,
-                job: 0.0,
+                command: Some(OperatorCommandCommand::Nudge),
+                nudge: Some(-15.0),
+                job: None,
             })
             .unwrap();
         let got = inputs(&mut a, f);
@@ -367,22 +381,8 @@ mod tests {
     fn fast_packet_129029_gives_the_fix_quality_once_complete() {
         let mut a = CanAdapter::default();
         let g = GnssPosition {
-            sid: 0,
-            date_days: 0,
-            time_s: 0.0,
-            latitude_deg: 52.0,
-            longitude_deg: 5.0,
-            altitude_m: 0.0,
-            gnss_type: 4,
-            method: METHOD_RTK_FLOAT,
-            integrity: 0,
-            satellites: 14,
-            hdop: Some(0.9),
-            pdop: Some(1.5),
-            geoidal_separation_m: 0.0,
-            reference_stations: 1,
-            reference_station_id: 3,
-            correction_age_s: Some(2.0),
+            satellites: Some(14),
+            ..crate::can::gnss::fix_message(0, 52.0, 5.0, METHOD_RTK_FLOAT)
         };
         let mut frames = Vec::new();
         split(&g.encode(), 2, &mut frames);
@@ -398,7 +398,7 @@ mod tests {
         };
         assert_eq!(q.quality, FixQuality::RtkFloat);
         assert_eq!(q.satellites, Some(14));
-        assert_eq!(q.correction_age_s, Some(2.0));
+        assert_eq!(q.correction_age_s, Some(1.0));
         // A frame out of order drops the message: one failed check.
         let out = inputs(&mut a, Frame::new(0x0DF8051C, &frames[2]));
         assert!(matches!(out[..], [Input::FrameCheck(c)] if !c.ok && c.link.is_none()));

@@ -18,6 +18,7 @@
 //! angle turns left.
 
 pub mod can;
+pub mod source;
 
 use serde::Serialize;
 

@@ -16,7 +16,9 @@ use crate::can::codec::{
     WheelSpeed, WheelSpeedDirection, WheelSpeedKeySwitch,
 };
 use crate::can::fastpacket::split;
-use crate::can::gnss::{north_cw_from_yaw, GnssPosition, METHOD_RTK_FIXED, METHOD_RTK_FLOAT};
+use crate::can::gnss::{
+    fix_message, north_cw_from_yaw, GnssPosition, METHOD_RTK_FIXED, METHOD_RTK_FLOAT,
+};
 use crate::can::{Frame, TimedFrame};
 use crate::geo::wgs84::EnuFrame;
 use serde::Deserialize;
@@ -183,10 +185,10 @@ impl SimNode {
         if let Some(r) = d.to::<DirectionRequest>() {
             // The tractor obeys: brake to a stop, or head for the cruise speed either way.
             use DirectionRequestDirection::{Reverse, Stop};
-            self.forward = !matches!(r.direction, Stop | Reverse);
+            self.forward = !matches!(r.direction, Some(Stop | Reverse));
             let target = match r.direction {
-                Stop => 0.0,
-                Reverse => -self.cruise,
+                Some(Stop) => 0.0,
+                Some(Reverse) => -self.cruise,
                 _ => self.cruise,
             };
             self.sim.set_speed_target(target);
@@ -199,9 +201,13 @@ impl SimNode {
             self.rejected += 1;
             return;
         }
-        self.engaged = cmd.mode == SteeringCommandMode::Engaged;
-        if self.engaged {
-            self.sim.set_command(cmd.angle.to_radians());
+        // An engaged command without an angle is no command: the driver holds the wheels.
+        let angle = cmd
+            .angle
+            .filter(|_| cmd.mode == Some(SteeringCommandMode::Engaged));
+        self.engaged = angle.is_some();
+        if let Some(angle) = angle {
+            self.sim.set_command(angle.to_radians());
         } else {
             // The driver holds the wheels.
             self.sim.hold_wheels();
@@ -246,44 +252,38 @@ impl SimNode {
                     let ll = self.enu.to_latlon(m.antenna);
                     let heading = north_cw_from_yaw(m.heading);
                     if let Ok(f) = self.gnss.pack(&VesselHeading {
-                        sid: self.sid as f64,
+                        sid: Some(self.sid as f64),
                         heading: Some((heading / 1e-4).floor() * 1e-4),
                         deviation: None,
                         variation: None,
-                        reference: VesselHeadingReference::True,
+                        reference: Some(VesselHeadingReference::True),
                     }) {
                         out.push((ts, f));
                     }
                     let speed = m.speed.abs().min(655.32);
                     if let Ok(f) = self.gnss.pack(&CogSogRapid {
-                        sid: self.sid as f64,
-                        cog_reference: CogSogRapidCogReference::True,
+                        sid: Some(self.sid as f64),
+                        cog_reference: Some(CogSogRapidCogReference::True),
                         cog: Some((north_cw_from_yaw(m.course) / 1e-4).floor() * 1e-4),
                         sog: Some(speed),
                     }) {
                         out.push((ts, f));
                     }
                     let g = GnssPosition {
-                        sid: self.sid,
-                        date_days: 20_000,
-                        time_s: m.t_measured.rem_euclid(86_400.0),
-                        latitude_deg: ll.lat_deg,
-                        longitude_deg: ll.lon_deg,
-                        altitude_m: 0.0,
-                        gnss_type: 4,
-                        method: if m.fix == FixQuality::RtkFloat {
-                            METHOD_RTK_FLOAT
-                        } else {
-                            METHOD_RTK_FIXED
-                        },
-                        integrity: 0,
-                        satellites: 20,
+                        time_s: Some(m.t_measured.rem_euclid(86_400.0)),
+                        satellites: Some(20),
                         hdop: Some(0.7),
                         pdop: Some(1.2),
-                        geoidal_separation_m: 0.0,
-                        reference_stations: 1,
-                        reference_station_id: 1,
-                        correction_age_s: Some(1.0),
+                        ..fix_message(
+                            self.sid,
+                            ll.lat_deg,
+                            ll.lon_deg,
+                            if m.fix == FixQuality::RtkFloat {
+                                METHOD_RTK_FLOAT
+                            } else {
+                                METHOD_RTK_FIXED
+                            },
+                        )
                     };
                     self.fp.clear();
                     split(&g.encode(), self.seq, &mut self.fp);
@@ -304,13 +304,13 @@ impl SimNode {
                         if let Ok(f) = self.tractor.pack(&WheelSpeed {
                             speed: Some(v.abs().min(64.254)),
                             distance: Some(self.distance.rem_euclid(4_211_081.0)),
-                            max_time_tractor_power: 255.0,
-                            key_switch: WheelSpeedKeySwitch::NotOff,
-                            direction: if v < 0.0 {
+                            max_time_tractor_power: None,
+                            key_switch: Some(WheelSpeedKeySwitch::NotOff),
+                            direction: Some(if v < 0.0 {
                                 WheelSpeedDirection::Reverse
                             } else {
                                 WheelSpeedDirection::Forward
-                            },
+                            }),
                         }) {
                             out.push((ts, f));
                         }
@@ -332,7 +332,7 @@ impl SimNode {
         };
         let Ok(mut f) = self.was.pack(&WheelAngle {
             angle: Some(angle.to_degrees().clamp(-90.0, 90.0)),
-            status,
+            status: Some(status),
         }) else {
             return;
         };
@@ -385,7 +385,7 @@ mod tests {
             };
             if d.index == codec::GnssPositionData::INDEX {
                 if let Ok(Some(p)) = fast.push(d.source, f.payload()) {
-                    out.push((*t, GnssPosition::decode(p).unwrap().method));
+                    out.push((*t, GnssPosition::decode(p).unwrap().method.unwrap_or(0xFF)));
                 }
             }
         }

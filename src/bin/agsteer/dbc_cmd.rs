@@ -4,6 +4,24 @@ use agsteer::can::codec::{self, find_name, CounterCheck, Role, MAX_SIGNALS};
 use agsteer::can::fastpacket::Reassembler;
 use agsteer::can::gnss::GnssPosition;
 use agsteer::envelope;
+
+/// Every field of a 129029 message; absent (not available) ones are null.
+fn gnss_json(g: &GnssPosition) -> Value {
+    let stations: Vec<Value> = g
+        .stations
+        .iter()
+        .flatten()
+        .map(|s| json!({"type": s.station_type, "id": s.id, "age_s": s.age_s}))
+        .collect();
+    json!({
+        "sid": g.sid, "date_days": g.date_days, "time_s": g.time_s,
+        "latitude_deg": g.latitude_deg, "longitude_deg": g.longitude_deg,
+        "altitude_m": g.altitude_m, "gnss_type": g.gnss_type, "method": g.method,
+        "integrity": g.integrity, "satellites": g.satellites, "hdop": g.hdop, "pdop": g.pdop,
+        "geoidal_separation_m": g.geoidal_separation_m,
+        "reference_stations": g.reference_stations, "stations": stations,
+    })
+}
 use anyhow::{bail, Context, Result};
 use clap::Subcommand;
 use serde_json::{json, Map, Value};
@@ -113,51 +131,21 @@ pub struct LogDecoder {
     fast: Reassembler,
 }
 
-/// `(time, id, bytes)` of a candump line.
-pub fn parse_candump_line(line: &str) -> Option<(Option<f64>, u32, Vec<u8>)> {
-    let mut words = line.split_whitespace();
-    let mut first = words.next()?;
-    let mut t = None;
-    if let Some(ts) = first.strip_prefix('(').and_then(|s| s.strip_suffix(')')) {
-        t = ts.parse().ok();
-        first = words.next()?; // interface
-    }
-    let _iface = first;
-    let frame = words.next()?;
-    let (id, hex) = frame.split_once('#')?;
-    // from_str_radix takes a leading sign; an ID or a byte is hex digits only (ASCII: slicing
-    // a line with other characters at odd byte offsets would split a character).
-    let hex_digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_hexdigit());
-    if !hex_digits(id) || id.len() > 8 {
-        return None;
-    }
-    let id = u32::from_str_radix(id, 16).ok()?;
-    if !(hex.is_empty() || hex_digits(hex)) || hex.len() % 2 != 0 || hex.len() > 16 {
-        return None;
-    }
-    let bytes = hex
-        .as_bytes()
-        .chunks(2)
-        .map(|pair| {
-            std::str::from_utf8(pair)
-                .ok()
-                .and_then(|p| u8::from_str_radix(p, 16).ok())
-        })
-        .collect::<Option<Vec<u8>>>()?;
-    Some((t, id, bytes))
-}
-
 impl LogDecoder {
     /// Decode one line into the JSON objects it produces (one per frame, plus a reassembled
     /// 129029 message when a fast-packet completes).
     pub fn line(&mut self, line: &str) -> Vec<Value> {
         let line = line.trim();
-        if line.is_empty() {
+        if line.is_empty() || line.starts_with('#') {
             return Vec::new();
         }
-        let Some((t, id, bytes)) = parse_candump_line(line) else {
+        let Some(lf) = agsteer::can::candump::parse_line(line) else {
             return vec![json!({"line": line, "error": "not a candump line"})];
         };
+        let (t, id, bytes) = (lf.t, lf.frame.id, lf.frame.payload().to_vec());
+        if !lf.extended {
+            return vec![json!({"t": t, "id": format!("{id:03X}"), "error": "11-bit identifier"})];
+        }
         let mut obj = Map::new();
         obj.insert("t".into(), t.map(Value::from).unwrap_or(Value::Null));
         obj.insert("id".into(), Value::from(format!("{id:08X}")));
@@ -190,13 +178,7 @@ impl LogDecoder {
                         Ok(Some(payload)) => extra.push(match GnssPosition::decode(payload) {
                             Ok(g) => json!({
                                 "t": t, "id": format!("{id:08X}"), "name": "GnssPosition129029",
-                                "signals": {
-                                    "latitude_deg": g.latitude_deg, "longitude_deg": g.longitude_deg,
-                                    "altitude_m": g.altitude_m, "method": g.method,
-                                    "satellites": g.satellites, "hdop": g.hdop,
-                                    "correction_age_s": g.correction_age_s,
-                                    "time_s": g.time_s, "date_days": g.date_days,
-                                }
+                                "signals": gnss_json(&g),
                             }),
                             Err(e) => json!({"t": t, "id": format!("{id:08X}"),
                                 "name": "GnssPosition129029", "error": e.to_string()}),
