@@ -589,8 +589,9 @@ mod tests {
     fn progress_saved_with_another_plan_checksum_is_not_resumed() {
         let cfg = demo_field_config(&[]);
         let job = prepare_job(&cfg).unwrap();
-        // One headland pass instead of two: every job key is the same, only the plan differs.
-        let other_cfg = demo_field_config(&["field.headland_passes=1"]);
+        // Four headland passes instead of two (more than the turns need, so the plan changes):
+        // every job key is the same, only the plan differs.
+        let other_cfg = demo_field_config(&["field.headland_passes=4"]);
         let other = prepare_job(&other_cfg).unwrap();
         assert_ne!(other.definition.plan_checksum, job.definition.plan_checksum);
         let mut same_keys = other.definition.clone();
