@@ -15,6 +15,7 @@ use crate::geo::wgs84::{EnuFrame, LatLon};
 use crate::geo::Direction;
 use crate::guidance::progress::Progress;
 use crate::input::can::CanAdapter;
+use crate::input::source::{SourceChange, SourceParams, SourceSelector};
 use crate::input::{CheckedLink, Input, OperatorCommand, PositionInput, SensorStatus};
 use crate::safety::{
     CheckedInput, FaultCode, FixQuality, SafetyState, SteeringCommand as Cmd, Supervisor,
@@ -57,6 +58,8 @@ pub struct ControllerNode {
     packer: Packer,
     /// Frames → inputs.
     can: CanAdapter,
+    /// One source per input kind.
+    sources: SourceSelector,
     /// GNSS comes from a byte stream (`gnss.source`): GNSS inputs from the bus are ignored.
     gnss_from_stream: bool,
     output: OutputKind,
@@ -138,6 +141,7 @@ impl ControllerNode {
             }),
             packer: Packer::new(cfg.bus.source_address),
             can: CanAdapter::default(),
+            sources: SourceSelector::new(SourceParams::default()),
             gnss_from_stream: cfg.gnss.is_stream(),
             output: cfg.bus.output,
             heading: None,
@@ -218,9 +222,22 @@ impl ControllerNode {
         }
     }
 
-    /// One input, from any adapter (CAN, serial GNSS, the simulator).
+    /// The GNSS sources seen and selected.
+    pub fn sources(&self) -> &SourceSelector {
+        &self.sources
+    }
+
+    /// One input, from any adapter (CAN, serial GNSS, the simulator). Positions, courses,
+    /// headings and fix qualities pass the source selector first.
     pub fn on_input(&mut self, input: &Input) {
-        match *input {
+        let (input, change) = self.sources.select(input);
+        if let Some(c) = change {
+            self.on_source_change(&c);
+        }
+        let Some(input) = input else {
+            return;
+        };
+        match input {
             Input::FrameCheck(c) => {
                 if !c.ok {
                     self.status.bad_frames += 1;
@@ -302,6 +319,20 @@ impl ControllerNode {
         });
         self.status.fix = q;
         self.supervisor.on_gnss(t, q);
+    }
+
+    /// A kind's source changed: logged; a change (not the first choice) disengages unless
+    /// configured otherwise.
+    fn on_source_change(&mut self, c: &SourceChange) {
+        match c.from {
+            None => tracing::info!(kind = ?c.kind, source = ?c.to, "input source selected"),
+            Some(from) => {
+                tracing::warn!(kind = ?c.kind, ?from, to = ?c.to, "input source changed");
+                if self.sources.params().disengage_on_change {
+                    self.supervisor.request_disengage();
+                }
+            }
+        }
     }
 
     fn on_operator(&mut self, t: f64, command: OperatorCommand) {
