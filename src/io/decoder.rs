@@ -50,7 +50,9 @@ pub struct StreamCounters {
     pub unused: u64,
     #[serde(flatten)]
     pub convert: ConvertCounters,
-    /// RTK fixed solutions passed on as float because the corrections were too old.
+    /// Fixes (positions) whose RTK fixed quality was passed on as float because the corrections
+    /// were too old: the position's own quality, or, for a position without one, its epoch's
+    /// quality report. Counted once per fix, however many inputs carried the quality.
     pub degraded_fixes: u64,
     /// Inputs passed on.
     pub inputs: u64,
@@ -73,6 +75,8 @@ pub struct GnssDecoder {
     /// The receiver's age of corrections from the latest quality report, s.
     receiver_age_s: Option<f64>,
     link_age_s: Option<f64>,
+    /// The latest quality report was degraded (for a position that carries no quality).
+    quality_degraded: bool,
 }
 
 impl GnssDecoder {
@@ -85,6 +89,7 @@ impl GnssDecoder {
             counters: StreamCounters::default(),
             receiver_age_s: None,
             link_age_s: None,
+            quality_degraded: false,
         }
     }
 
@@ -128,15 +133,19 @@ impl GnssDecoder {
             counters,
             receiver_age_s,
             link_age_s,
+            quality_degraded,
         } = self;
         framer.push(chunk, &mut |frame| match frame {
             Frame::Nmea(line) => match nmea0183::parse(line) {
                 Ok(s) if params.protocol == Protocol::Nmea0183 => {
                     counters.decoded += 1;
-                    let age = params.max_correction_age_s;
-                    nmea.convert(&s, receipt, &mut |i| {
-                        emit(cap(i, age, receiver_age_s, *link_age_s, counters));
-                    });
+                    let mut ages = Ages {
+                        max: params.max_correction_age_s,
+                        receiver: &mut *receiver_age_s,
+                        link: *link_age_s,
+                        quality_degraded: &mut *quality_degraded,
+                    };
+                    nmea.convert(&s, receipt, &mut |i| emit(cap(i, &mut ages, counters)));
                 }
                 Ok(_) | Err(NmeaError::Unsupported) => counters.unused += 1,
                 Err(e) if e.is_checksum() => counters.nmea_checksum_errors += 1,
@@ -145,10 +154,13 @@ impl GnssDecoder {
             Frame::Ubx { class, id, payload } => match ubx::decode(class, id, payload) {
                 Ok(m) if params.protocol == Protocol::Ubx => {
                     counters.decoded += 1;
-                    let age = params.max_correction_age_s;
-                    ubx.convert(&m, receipt, &mut |i| {
-                        emit(cap(i, age, receiver_age_s, *link_age_s, counters));
-                    });
+                    let mut ages = Ages {
+                        max: params.max_correction_age_s,
+                        receiver: &mut *receiver_age_s,
+                        link: *link_age_s,
+                        quality_degraded: &mut *quality_degraded,
+                    };
+                    ubx.convert(&m, receipt, &mut |i| emit(cap(i, &mut ages, counters)));
                 }
                 Ok(_) | Err(UbxError::Unsupported) => counters.unused += 1,
                 Err(_) => counters.malformed += 1,
@@ -167,33 +179,44 @@ fn add(a: ConvertCounters, b: ConvertCounters) -> ConvertCounters {
     }
 }
 
-/// Apply the correction-age cap to one input (see the module doc) and count it.
-fn cap(
-    mut i: Input,
-    max_age: f64,
-    receiver_age_s: &mut Option<f64>,
-    link_age_s: Option<f64>,
-    counters: &mut StreamCounters,
-) -> Input {
+/// What the correction-age cap needs: the limit, the receiver's and the link's ages, and
+/// whether the latest quality report was degraded.
+struct Ages<'a> {
+    max: f64,
+    receiver: &'a mut Option<f64>,
+    link: Option<f64>,
+    quality_degraded: &'a mut bool,
+}
+
+/// Apply the correction-age cap to one input (see the module doc) and count it: one degraded
+/// fix per position, not one per input carrying the quality (a GGA gives a Quality and a
+/// Position of the same epoch).
+fn cap(mut i: Input, ages: &mut Ages<'_>, counters: &mut StreamCounters) -> Input {
     if let Input::Quality(q) = &i {
-        *receiver_age_s = q.correction_age_s;
+        *ages.receiver = q.correction_age_s;
     }
     counters.inputs += 1;
     let too_old =
-        receiver_age_s.is_some_and(|a| a > max_age) || link_age_s.is_some_and(|a| a > max_age);
-    if !too_old {
-        return i;
-    }
-    let q = match &mut i {
-        Input::Quality(q) => Some(&mut q.quality),
-        Input::Position(p) => p.quality.as_mut(),
-        _ => None,
-    };
-    if let Some(q) = q {
-        if *q == FixQuality::RtkFixed {
+        ages.receiver.is_some_and(|a| a > ages.max) || ages.link.is_some_and(|a| a > ages.max);
+    let degrade = |q: &mut FixQuality| {
+        let fixed = *q == FixQuality::RtkFixed;
+        if fixed && too_old {
             *q = FixQuality::RtkFloat;
-            counters.degraded_fixes += 1;
         }
+        fixed && too_old
+    };
+    match &mut i {
+        Input::Quality(q) => *ages.quality_degraded = degrade(&mut q.quality),
+        Input::Position(p) => {
+            let degraded = match p.quality.as_mut() {
+                Some(q) => degrade(q),
+                None => *ages.quality_degraded,
+            };
+            if degraded {
+                counters.degraded_fixes += 1;
+            }
+        }
+        _ => {}
     }
     i
 }

@@ -8,7 +8,7 @@
 //! With an IMU configured it sends the roll and pitch (0xFF30) at the IMU rate with counter
 //! and CRC; during the simulator's RTK-float windows 129029 reports method 5 (RTK float).
 
-use super::{FixQuality, SimOutput, Simulator};
+use super::{FixQuality, GnssMeasurement, SimOutput, Simulator};
 use crate::can::codec::{
     self, CogSogRapid, CogSogRapidCogReference, CounterCheck, DbcMessage, DirectionRequest,
     DirectionRequestDirection, ImuAttitude, Packer, PositionRapid, SteeringCommand,
@@ -126,6 +126,9 @@ pub struct SimNode {
     profile: Option<SpeedProfile>,
     /// The last direction request was forward (or there was none).
     forward: bool,
+    /// GNSS goes to a byte stream ([`SimNode::with_gnss_off_bus`]), not onto the bus.
+    gnss_off_bus: bool,
+    gnss_out: Vec<GnssMeasurement>,
 }
 
 impl SimNode {
@@ -150,7 +153,24 @@ impl SimNode {
             distance: 0.0,
             profile: None,
             forward: true,
+            gnss_off_bus: false,
+            gnss_out: Vec::new(),
         }
+    }
+
+    /// No GNSS frames on the bus: the measurements are handed out by
+    /// [`SimNode::drain_gnss`] instead, for a receiver's byte stream
+    /// ([`gnss_stream`](super::gnss_stream)). Scenario faults apply as on the bus (a GNSS
+    /// dropout hands out nothing, RTK float is the measurements' fix).
+    pub fn with_gnss_off_bus(mut self) -> Self {
+        self.gnss_off_bus = true;
+        self
+    }
+
+    /// Move the GNSS measurements delivered so far (with GNSS off the bus) into `out`, in
+    /// delivery order.
+    pub fn drain_gnss(&mut self, out: &mut Vec<GnssMeasurement>) {
+        out.append(&mut self.gnss_out);
     }
 
     /// Drive forward with a speed profile (see [`SpeedProfile`]).
@@ -248,56 +268,10 @@ impl SimNode {
                     if self.scenario.active(FaultKind::GnssDropout, ts) {
                         continue;
                     }
-                    self.sid = self.sid.wrapping_add(1) % 250;
-                    let ll = self.enu.to_latlon(m.antenna);
-                    let heading = north_cw_from_yaw(m.heading);
-                    if let Ok(f) = self.gnss.pack(&VesselHeading {
-                        sid: Some(self.sid as f64),
-                        heading: Some((heading / 1e-4).floor() * 1e-4),
-                        deviation: None,
-                        variation: None,
-                        reference: Some(VesselHeadingReference::True),
-                    }) {
-                        out.push((ts, f));
-                    }
-                    let speed = m.speed.abs().min(655.32);
-                    if let Ok(f) = self.gnss.pack(&CogSogRapid {
-                        sid: Some(self.sid as f64),
-                        cog_reference: Some(CogSogRapidCogReference::True),
-                        cog: Some((north_cw_from_yaw(m.course) / 1e-4).floor() * 1e-4),
-                        sog: Some(speed),
-                    }) {
-                        out.push((ts, f));
-                    }
-                    let g = GnssPosition {
-                        time_s: Some(m.t_measured.rem_euclid(86_400.0)),
-                        satellites: Some(20),
-                        hdop: Some(0.7),
-                        pdop: Some(1.2),
-                        ..fix_message(
-                            self.sid,
-                            ll.lat_deg,
-                            ll.lon_deg,
-                            if m.fix == FixQuality::RtkFloat {
-                                METHOD_RTK_FLOAT
-                            } else {
-                                METHOD_RTK_FIXED
-                            },
-                        )
-                    };
-                    self.fp.clear();
-                    split(&g.encode(), self.seq, &mut self.fp);
-                    self.seq = (self.seq + 1) & 7;
-                    let id =
-                        (codec::GnssPositionData::def().id & !0xFF) | self.gnss.source() as u32;
-                    for d in &self.fp {
-                        out.push((ts, Frame::new(id, d)));
-                    }
-                    if let Ok(f) = self.gnss.pack(&PositionRapid {
-                        latitude: Some(ll.lat_deg),
-                        longitude: Some(ll.lon_deg),
-                    }) {
-                        out.push((ts, f));
+                    if self.gnss_off_bus {
+                        self.gnss_out.push(m);
+                    } else {
+                        self.gnss_frames(&m, out);
                     }
                     if !self.scenario.active(FaultKind::SpeedSilence, ts) {
                         let v = self.sim.true_state().speed;
@@ -319,6 +293,61 @@ impl SimNode {
             }
         }
         self.outs = outs;
+    }
+
+    /// The NMEA 2000 GNSS frames of one measurement.
+    fn gnss_frames(&mut self, m: &GnssMeasurement, out: &mut Vec<(f64, Frame)>) {
+        let ts = m.t_delivered;
+        self.sid = self.sid.wrapping_add(1) % 250;
+        let ll = self.enu.to_latlon(m.antenna);
+        let heading = north_cw_from_yaw(m.heading);
+        if let Ok(f) = self.gnss.pack(&VesselHeading {
+            sid: Some(self.sid as f64),
+            heading: Some((heading / 1e-4).floor() * 1e-4),
+            deviation: None,
+            variation: None,
+            reference: Some(VesselHeadingReference::True),
+        }) {
+            out.push((ts, f));
+        }
+        let speed = m.speed.abs().min(655.32);
+        if let Ok(f) = self.gnss.pack(&CogSogRapid {
+            sid: Some(self.sid as f64),
+            cog_reference: Some(CogSogRapidCogReference::True),
+            cog: Some((north_cw_from_yaw(m.course) / 1e-4).floor() * 1e-4),
+            sog: Some(speed),
+        }) {
+            out.push((ts, f));
+        }
+        let g = GnssPosition {
+            time_s: Some(m.t_measured.rem_euclid(86_400.0)),
+            satellites: Some(20),
+            hdop: Some(0.7),
+            pdop: Some(1.2),
+            ..fix_message(
+                self.sid,
+                ll.lat_deg,
+                ll.lon_deg,
+                if m.fix == FixQuality::RtkFloat {
+                    METHOD_RTK_FLOAT
+                } else {
+                    METHOD_RTK_FIXED
+                },
+            )
+        };
+        self.fp.clear();
+        split(&g.encode(), self.seq, &mut self.fp);
+        self.seq = (self.seq + 1) & 7;
+        let id = (codec::GnssPositionData::def().id & !0xFF) | self.gnss.source() as u32;
+        for d in &self.fp {
+            out.push((ts, Frame::new(id, d)));
+        }
+        if let Ok(f) = self.gnss.pack(&PositionRapid {
+            latitude: Some(ll.lat_deg),
+            longitude: Some(ll.lon_deg),
+        }) {
+            out.push((ts, f));
+        }
     }
 
     fn wheel_frames(&mut self, ts: f64, angle: f64, out: &mut Vec<(f64, Frame)>) {

@@ -20,6 +20,7 @@
 mod actuator;
 pub mod can_node;
 mod gnss_error;
+pub mod gnss_stream;
 mod params;
 mod vehicle;
 
