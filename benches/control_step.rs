@@ -74,6 +74,7 @@ impl Rig {
                     heading: Some(m.heading),
                     speed: m.speed,
                     roll: self.roll,
+                    latency: None,
                 }),
                 SimOutput::WheelAngle { t, angle } => self.ctrl.on_wheel_angle(t, angle),
                 SimOutput::Attitude { roll, .. } => self.roll = Some(roll),

@@ -316,6 +316,8 @@ impl ControllerNode {
                 .roll
                 .filter(|(tr, _)| t - tr <= ROLL_MAX_AGE)
                 .map(|(_, r)| r),
+            // The sentence's own latency (NMEA 0183 / UBX); NMEA 2000 carries none.
+            latency: p.latency_s,
         });
         self.status.fix = q;
         self.supervisor.on_gnss(t, q);

@@ -1,7 +1,9 @@
 //! Pose estimation (SPEC §1): GNSS antenna → rear-axle reference point, latency compensation
 //! and dead reckoning between fixes.
 //!
-//! A fix describes the antenna `gnss_latency` before it arrived. With `predict` on, the
+//! A fix describes the antenna `gnss_latency` before it arrived, or the latency its own time
+//! stamp gives ([`GnssFix::latency`], NMEA 0183 and UBX with a disciplined host clock), when
+//! known. With `predict` on, the
 //! estimator moves the rear-axle pose from that moment to `now + lead_time` with the kinematic
 //! bicycle model (ẋ = v·cosθ, ẏ = v·sinθ, θ̇ = v·tanδ/L), using the measured wheel angles
 //! recorded in that interval. That is both the latency compensation and the dead reckoning
@@ -32,6 +34,11 @@ pub struct GnssFix {
     pub speed: f64,
     /// Roll, rad, positive when the right side is down, if a roll signal is present.
     pub roll: Option<f64>,
+    /// Time from the fix's time of validity to its arrival, s, when the sender's time stamp
+    /// gives it (see [`crate::input::PositionInput::latency_s`]); `None` (NMEA 2000, or an
+    /// undisciplined host clock): the configured [`EstimatorParams::gnss_latency`]. Used by
+    /// the predicting estimator only.
+    pub latency: Option<f64>,
 }
 
 /// Estimator parameters, SI units.
@@ -40,7 +47,8 @@ pub struct EstimatorParams {
     /// Wheelbase, m.
     pub wheelbase: f64,
     pub antenna: AntennaOffset,
-    /// The fix describes the vehicle this long before it arrived, s.
+    /// The fix describes the vehicle this long before it arrived, s (unless the fix carries
+    /// its own latency).
     pub gnss_latency: f64,
     /// Compensate latency and dead-reckon between fixes.
     pub predict: bool,
@@ -273,6 +281,8 @@ const COURSE_MIN_MOVE: f64 = 0.2;
 pub struct Estimator {
     params: EstimatorParams,
     fix_time: f64,
+    /// The current fix's own latency, s (`None`: the configured one).
+    fix_latency: Option<f64>,
     fix_pose: Option<Pose>,
     fix_speed: f64,
     last_course_pos: Option<Vec2>,
@@ -318,6 +328,7 @@ impl Estimator {
         Estimator {
             params,
             fix_time: 0.0,
+            fix_latency: None,
             fix_pose: None,
             fix_speed: 0.0,
             last_course_pos: None,
@@ -439,7 +450,7 @@ impl Estimator {
     /// The fix `new` (measured at `t_new`) against the pose predicted from the previous fix.
     fn innovation(&self, new: &Pose, t_new: f64) -> Option<Innovation> {
         let prev = self.fix_pose?;
-        let t_prev = self.fix_time - self.params.gnss_latency;
+        let t_prev = self.fix_time - self.latency(self.fix_latency);
         let dt = t_new - t_prev;
         if !(dt > 0.0 && dt <= 1.0) {
             return None;
@@ -508,6 +519,11 @@ impl Estimator {
         &self.params
     }
 
+    /// A fix's latency: its own, or the configured one, s.
+    fn latency(&self, own: Option<f64>) -> f64 {
+        own.unwrap_or(self.params.gnss_latency)
+    }
+
     /// New tuning; the fix and the wheel-angle history are kept.
     pub fn set_params(&mut self, params: EstimatorParams) {
         self.params = params;
@@ -559,7 +575,10 @@ impl Estimator {
         self.roll = roll.unwrap_or(0.0);
         let pos = self.antenna_to_rear_axle(&fix.antenna, heading, roll);
         let mut pose = Pose::new(pos.x, pos.y, heading);
-        let t_meas = fix.t_received - self.params.gnss_latency;
+        let fix_latency = fix
+            .latency
+            .filter(|l| self.params.predict && l.is_finite() && *l >= 0.0);
+        let t_meas = fix.t_received - self.latency(fix_latency);
         let o = self.params.observer;
         let innovation = if self.params.predict
             && (o.bias_tau > 0.0 || o.drift_tau > 0.0 || o.coast_max > 0.0)
@@ -621,6 +640,7 @@ impl Estimator {
         }
         self.fix_pose = Some(pose);
         self.fix_time = fix.t_received;
+        self.fix_latency = fix_latency;
         self.fix_speed = fix.speed;
     }
 
@@ -717,7 +737,7 @@ impl Estimator {
                 fix_age,
             });
         }
-        let t0 = self.fix_time - self.params.gnss_latency;
+        let t0 = self.fix_time - self.latency(self.fix_latency);
         let t1 = t_now + self.params.lead_time;
         let span = (t1 - t0).clamp(0.0, 2.0);
         let v = self.fix_speed;

@@ -65,6 +65,7 @@ fn prediction_beats_the_raw_fix_under_latency() {
         heading: Some(truth_then.heading),
         speed: v,
         roll: None,
+        latency: None,
     };
     pred.on_fix(&fix);
     raw.on_fix(&fix);
@@ -75,6 +76,41 @@ fn prediction_beats_the_raw_fix_under_latency() {
     assert!(e_pred < 1e-3, "predicted error {e_pred}");
     let h = pred.estimate(1.0).unwrap().pose.heading;
     assert!((h - truth_now.heading).abs() < 1e-4);
+}
+
+#[test]
+fn a_fix_with_its_own_latency_is_compensated_by_it() {
+    // Configured 0.05 s; the sentence's time stamp says 0.15 s (measured 0.8, received 0.95).
+    let (r, v) = (10.0, 3.0);
+    let delta = (3.0f64 / r).atan();
+    let truth_then = circle(r, v, 0.8);
+    let truth_now = circle(r, v, 1.0);
+    let error = |latency: Option<f64>, predict: bool| {
+        let mut e = Estimator::new(params(predict));
+        for k in 0..=100 {
+            e.on_wheel_angle(k as f64 * 0.01, delta);
+        }
+        e.on_fix(&GnssFix {
+            t_received: 0.95,
+            antenna: antenna_of(&e, &truth_then),
+            heading: Some(truth_then.heading),
+            speed: v,
+            roll: None,
+            latency,
+        });
+        (e.estimate(1.0).unwrap().pose.pos - truth_now.pos).norm()
+    };
+    assert!(
+        error(Some(0.15), true) < 1e-3,
+        "{}",
+        error(Some(0.15), true)
+    );
+    // Without it, the configured 0.05 s leaves the 0.1 s difference: about 0.3 m.
+    assert!(error(None, true) > 0.25, "{}", error(None, true));
+    // A latency that is not a number is the configured one.
+    assert_eq!(error(Some(f64::NAN), true), error(None, true));
+    // The plain reference (no prediction) takes the fix as it is, whatever its latency.
+    assert_eq!(error(Some(0.15), false), error(None, false));
 }
 
 #[test]
@@ -112,6 +148,7 @@ fn no_fix_and_bad_input_give_none_not_panics() {
         heading: Some(0.0),
         speed: 1.0,
         roll: None,
+        latency: None,
     });
     e.on_wheel_angle(f64::INFINITY, 0.2);
     assert!(e.estimate(1.0).is_none());
@@ -130,6 +167,7 @@ fn heading_from_course_without_dual_antenna() {
             heading: None,
             speed: 3.0,
             roll: None,
+            latency: None,
         });
     }
     let est = e.estimate(0.5).unwrap();
@@ -337,6 +375,7 @@ fn the_estimator_coasts_through_rtk_float_and_a_position_jump() {
         heading: Some(truth.heading),
         speed: 3.0,
         roll: None,
+        latency: None,
     });
     assert!(e.is_coasting());
     assert_eq!(e.drift(), before);
