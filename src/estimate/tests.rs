@@ -213,6 +213,7 @@ fn drive(
                 heading: Some(th),
                 speed: v,
                 roll: None,
+                latency: None,
             });
         }
     }
@@ -274,6 +275,7 @@ fn slope_passes(roll: impl Fn(f64) -> f64, slip: f64, passes: usize) -> (f64, Ve
                     heading: Some(th),
                     speed: v,
                     roll: Some(measured),
+                    latency: None,
                 });
             }
         }
@@ -421,6 +423,7 @@ fn noisy_drive(
                 heading: Some(th),
                 speed: v,
                 roll: None,
+                latency: None,
             });
             coasted += usize::from(e.is_coasting());
             if t > seconds / 2.0 {
@@ -524,6 +527,7 @@ fn the_robust_observer_coasts_through_a_step_but_not_a_ramp() {
                     heading: Some(FRAC_PI_2),
                     speed: v,
                     roll: None,
+                    latency: None,
                 });
                 coasted += usize::from(e.is_coasting());
                 let est = e.estimate(t).expect("an estimate").pose;
