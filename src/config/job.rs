@@ -160,7 +160,12 @@ impl JobConfig {
                 "must be in 1..=1000 when job.kind = \"arcs\"",
             );
         }
-        c.range("job.origin_lat_deg", j.origin_lat_deg, -89.0, 89.0);
+        c.range(
+            "job.origin_lat_deg",
+            j.origin_lat_deg,
+            -crate::geo::wgs84::MAX_ABS_LAT_DEG,
+            crate::geo::wgs84::MAX_ABS_LAT_DEG,
+        );
         c.range("job.origin_lon_deg", j.origin_lon_deg, -180.0, 180.0);
     }
 }

@@ -433,29 +433,33 @@ pub(crate) struct Parsed<C = LatLon> {
 }
 
 pub(crate) fn check_coordinate(feature: &str, lat: f64, lon: f64) -> Result<LatLon, FieldError> {
-    if !lat.is_finite() || !lon.is_finite() || lat.abs() > 90.0 || lon.abs() > 180.0 {
-        return Err(FieldError::BadCoordinates {
-            feature: feature.to_string(),
-            detail: format!("lat {lat}, lon {lon} out of range"),
-        });
-    }
-    Ok(LatLon {
+    crate::geo::wgs84::check_latitude(LatLon {
         lat_deg: lat,
         lon_deg: lon,
     })
+    .map_err(|e| FieldError::BadCoordinates {
+        feature: feature.to_string(),
+        detail: e.to_string(),
+    })
 }
 
-fn bbox_centre(ring: &[LatLon]) -> LatLon {
-    let (mut lat0, mut lat1, mut lon0, mut lon1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for p in ring {
-        lat0 = lat0.min(p.lat_deg);
-        lat1 = lat1.max(p.lat_deg);
-        lon0 = lon0.min(p.lon_deg);
-        lon1 = lon1.max(p.lon_deg);
-    }
-    LatLon {
-        lat_deg: 0.5 * (lat0 + lat1),
-        lon_deg: 0.5 * (lon0 + lon1),
+/// Every local position of a ring within [`envelope::MAX_LOCAL_COORD_M`] of the origin (a
+/// configured origin far from the field would plan it on a plane tangent elsewhere).
+fn check_near_origin(feature: &str, origin: LatLon, local: &[Vec2]) -> Result<(), FieldError> {
+    let limit = envelope::MAX_LOCAL_COORD_M;
+    match local
+        .iter()
+        .find(|p| !(p.x.abs() <= limit && p.y.abs() <= limit))
+    {
+        Some(p) => Err(FieldError::Envelope {
+            what: format!(
+                "{feature}: a point's distance from the ENU origin (lat {}, lon {})",
+                origin.lat_deg, origin.lon_deg
+            ),
+            value: format!("{:.0} m East, {:.0} m North", p.x, p.y),
+            limit: format!("±{limit} m (choose an origin at the field or field.origin = \"auto\")"),
+        }),
+        None => Ok(()),
     }
 }
 
@@ -473,6 +477,7 @@ impl Accum {
         tolerance: f64,
     ) -> Result<(Vec<Vec2>, f64, f64), FieldError> {
         let local: Vec<Vec2> = ring.iter().map(|p| frame.to_enu(*p)).collect();
+        check_near_origin(feature, frame.origin(), &local)?;
         let cleaned = clean_ring(&local, tolerance);
         let r = &mut self.report;
         r.vertices_before += local.len();
@@ -564,9 +569,14 @@ fn assemble(parsed: Parsed, options: &LoadOptions) -> Result<LoadedField, FieldE
         mut warnings,
     } = parsed;
     let boundary = single_boundary(boundaries)?;
-    let origin = options
-        .origin
-        .unwrap_or_else(|| bbox_centre(&boundary.exterior));
+    let origin = match options.origin {
+        Some(o) => o,
+        None => crate::geo::wgs84::centre(&boundary.exterior).ok_or(FieldError::NoBoundary)?,
+    };
+    crate::geo::wgs84::check_latitude(origin).map_err(|e| FieldError::BadCoordinates {
+        feature: "the ENU origin".into(),
+        detail: e.to_string(),
+    })?;
     let frame = EnuFrame::new(origin);
     let tol = options.boundary_tolerance_m.max(0.0);
     let mut acc = Accum {
@@ -685,3 +695,5 @@ fn cut_out(outer: &[Vec2], cut: &[Vec2]) -> Option<Vec<Vec2>> {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_geodesy;
