@@ -52,7 +52,9 @@ fn run(serial_quality: bool, seconds: f64) -> (usize, f64, ControllerNode) {
                         p.quality = serial_quality.then_some(FixQuality::RtkFixed);
                         node.on_input(&Input::Position(p));
                     }
-                    other => node.on_input(&other),
+                    other => {
+                        node.on_input(&other);
+                    }
                 }
             }
         }

@@ -115,6 +115,13 @@ fn bracketed<'a>(
     })
 }
 
+/// `t` rounded to the whole microsecond a `candump -L` line keeps: a time taken through it is
+/// written and read back exactly (`agsteerd` gives its node such times, so that a replay of its
+/// bus log feeds the node the same values).
+pub fn log_time(t: f64) -> f64 {
+    (t * 1e6).round() / 1e6
+}
+
 /// `(t) iface ID#HEX`, as `candump -L` writes it (an extended identifier, 8 hex digits).
 pub fn format_line(t: f64, iface: &str, frame: &Frame) -> String {
     format!("({t:.6}) {iface} {}", frame.to_candump())
@@ -171,5 +178,11 @@ mod tests {
         assert_eq!(line, "(12.500000) can0 0CFF2A2A#010203FF");
         let l = parse_line(&line).unwrap();
         assert_eq!((l.t, l.frame), (Some(12.5), f));
+        // A time rounded by log_time reads back bit for bit.
+        for t in [0.1, 12.345_678_9, 86_399.999_999_6, 1.234_567_5e5] {
+            let t = log_time(t);
+            let back = parse_line(&format_line(t, "can0", &f)).unwrap().t.unwrap();
+            assert_eq!(back.to_bits(), t.to_bits(), "{t}");
+        }
     }
 }

@@ -22,6 +22,7 @@ use crate::track::{
 };
 
 pub mod node;
+pub mod replay;
 
 /// The AB planner's parameters from the configuration.
 pub fn ab_params(cfg: &Config) -> AbParams {

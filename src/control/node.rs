@@ -208,8 +208,10 @@ impl ControllerNode {
         &self.enu
     }
 
-    /// One received frame: the CAN adapter's inputs, in order.
-    pub fn on_frame(&mut self, tf: &TimedFrame) {
+    /// One received frame: the CAN adapter's inputs, in order. True when a GNSS fix entered
+    /// the controller (the daemon then computes the command at once, issue 16 point 7).
+    pub fn on_frame(&mut self, tf: &TimedFrame) -> bool {
+        let mut fix = false;
         for input in self.can.on_frame(tf) {
             let gnss = matches!(
                 input,
@@ -218,8 +220,9 @@ impl ControllerNode {
             if gnss && self.gnss_from_stream {
                 continue;
             }
-            self.on_input(&input);
+            fix |= self.on_input(&input);
         }
+        fix
     }
 
     /// The GNSS sources seen and selected.
@@ -228,15 +231,20 @@ impl ControllerNode {
     }
 
     /// One input, from any adapter (CAN, serial GNSS, the simulator). Positions, courses,
-    /// headings and fix qualities pass the source selector first.
-    pub fn on_input(&mut self, input: &Input) {
+    /// headings and fix qualities pass the source selector first. True when it was a GNSS fix
+    /// the controller took.
+    pub fn on_input(&mut self, input: &Input) -> bool {
         let (input, change) = self.sources.select(input);
         if let Some(c) = change {
             self.on_source_change(&c);
         }
         let Some(input) = input else {
-            return;
+            return false;
         };
+        if let Input::Position(p) = &input {
+            self.on_position(p);
+            return true;
+        }
         match input {
             Input::FrameCheck(c) => {
                 if !c.ok {
@@ -257,7 +265,7 @@ impl ControllerNode {
                     self.ctrl.on_wheel_angle(w.t, a);
                 }
             }
-            Input::Position(p) => self.on_position(&p),
+            Input::Position(_) => {}
             Input::Quality(q) => self.quality = Some((q.t, q.quality)),
             Input::Attitude(a) => {
                 if let Some(roll) = a.roll {
@@ -286,6 +294,7 @@ impl ControllerNode {
             }
             Input::Operator(o) => self.on_operator(o.t, o.command),
         }
+        false
     }
 
     /// A GNSS antenna position: the one place a fix enters the controller, with the latest

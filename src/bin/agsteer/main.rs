@@ -4,6 +4,7 @@ mod accuracy_cmd;
 mod dbc_cmd;
 mod maneuver_cmd;
 mod plan_cmd;
+mod replay_cmd;
 mod sim_cmd;
 
 use agsteer::config::{Config, JobKind};
@@ -118,6 +119,38 @@ enum Command {
         /// the simulated sensors.
         #[arg(long, default_value_t = 0)]
         rt_priority: u8,
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    },
+    /// Run the controller offline on a recorded bus log (`agsteerd --bus-log`, or any candump
+    /// log), faster than real time: prints its status track (CSV) on stdout and, for a log of
+    /// agsteerd's, how many control periods send the same frames as the daemon did. Exit
+    /// status 4 with --strict when one differs.
+    Replay {
+        /// Log files in time order (rotated ones first: FILE.2 FILE.1 FILE).
+        #[arg(required = true)]
+        logs: Vec<PathBuf>,
+        /// The daemon's configuration.
+        #[arg(long, default_value = "/etc/agsteer/agsteer.toml")]
+        config: PathBuf,
+        /// Progress file the daemon resumed from, if it did.
+        #[arg(long)]
+        progress: Option<PathBuf>,
+        /// Write the frames the controller would send here (candump -L).
+        #[arg(long)]
+        frames: Option<PathBuf>,
+        /// Control periods every dt and at each fix, even when the log holds the daemon's.
+        #[arg(long)]
+        timer: bool,
+        /// Status track: one line every N control periods (0: none; differing ones always).
+        #[arg(long, default_value_t = 1)]
+        every: u64,
+        /// Print only a JSON summary.
+        #[arg(long)]
+        json: bool,
+        /// Exit status 4 when a control period differs from the log.
+        #[arg(long)]
+        strict: bool,
         #[command(flatten)]
         cfg: ConfigArgs,
     },
@@ -301,6 +334,30 @@ fn main() -> ExitCode {
                 rt_priority,
             )
         }),
+        Command::Replay {
+            logs,
+            config,
+            progress,
+            frames,
+            timer,
+            every,
+            json,
+            strict,
+            cfg,
+        } => load_config(&config, &cfg.set).and_then(|c| {
+            replay_cmd::run(
+                &c,
+                &replay_cmd::ReplayArgs {
+                    logs: &logs,
+                    progress: progress.as_deref(),
+                    frames_out: frames.as_deref(),
+                    timer,
+                    json,
+                    every,
+                    strict,
+                },
+            )
+        }),
         Command::Status { socket, config } => {
             let path = match socket {
                 Some(p) => Ok(p),
@@ -341,6 +398,21 @@ fn parse_curve(s: &str) -> Result<agsteer::config::CurveChoice, String> {
         "rs" => Ok(agsteer::config::CurveChoice::Rs),
         other => Err(format!("`{other}`: expected cc or rs")),
     }
+}
+
+/// The controller node exactly as agsteerd builds it at start: the configured job prepared
+/// (a field read and planned), resuming `progress` when it belongs to this job.
+fn daemon_node(
+    cfg: &Config,
+    progress: Option<&Path>,
+) -> Result<agsteer::control::node::ControllerNode> {
+    use agsteer::daemon::run::{build_node, load_progress, prepare_job};
+    let job = prepare_job(cfg).context("preparing the job")?;
+    let resume = progress.and_then(|p| load_progress(&job.definition, p));
+    if progress.is_some() && resume.is_none() {
+        anyhow::bail!("--progress: no progress of this job to resume");
+    }
+    build_node(cfg, &job, resume.as_ref()).context("building the controller")
 }
 
 fn load_config(path: &Path, set: &[String]) -> Result<Config> {
