@@ -7,7 +7,6 @@
 
 use agsteer::config::Config;
 use agsteer::control::Controller;
-use agsteer::demo::sim_params;
 use agsteer::estimate::GnssFix;
 use agsteer::geo::Pose;
 use agsteer::sim::{SimOutput, Simulator};
@@ -39,9 +38,11 @@ impl Rig {
             ],
         )
         .expect("config");
-        let ctrl = Controller::from_config(&cfg, None).expect("controller");
+        let job = agsteer::job::prepare_config(&cfg).expect("job");
+        let ctrl = Controller::new(&cfg.control_params(), job.plan, job.definition, None)
+            .expect("controller");
         let sim = Simulator::new(
-            sim_params(&cfg),
+            cfg.sim_params(),
             Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
             cfg.speed(),
         );

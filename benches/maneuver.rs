@@ -4,7 +4,7 @@
 
 use agsteer::config::Config;
 use agsteer::field::load_local_map;
-use agsteer::plan::maneuver::job::{collision_map, pose_of};
+use agsteer::job::maneuver::{collision_map, pose_of};
 use agsteer::plan::maneuver::search::plan_maneuver;
 use agsteer::plan::maneuver::steering::CcSteering;
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -40,7 +40,7 @@ fn bench(c: &mut Criterion) {
         let cfg = Config::parse_with("", &s.set).expect("overlay");
         let field = load_local_map(&std::fs::read_to_string(dir.join(&s.map)).expect("map"))
             .expect("map GeoJSON");
-        let map = collision_map(&cfg, Some(&field)).expect("map");
+        let map = collision_map(&cfg.planning().maneuver, Some(&field)).expect("map");
         let steer = CcSteering {
             params: cfg.maneuver_curve_params(),
         };

@@ -7,8 +7,11 @@
 //! `can`. [`control`] glues one cycle together; [`demo`] runs it closed-loop against the
 //! [`sim`]ulator.
 //!
-//! Planning modules are pure functions of their inputs (no I/O, clocks or globals). I/O lives
-//! only in `can`, [`daemon`] and the binaries.
+//! Planning modules are pure functions of their inputs (no I/O, clocks or globals). The
+//! configuration is read once and resolved into each consumer's parameters ([`config`]); the
+//! [`job`] layer sets the job up (and resumes it) the same way for the daemon, the demo and the
+//! tools. I/O lives only in the adapters (`can`, `io`), [`store`], [`daemon`] and the
+//! binaries. `docs/layers.txt` declares the layer order, which `tests/layering.rs` enforces.
 
 pub mod can;
 pub mod config;
@@ -22,7 +25,9 @@ pub mod geo;
 pub mod guidance;
 pub mod input;
 pub mod io;
+pub mod job;
 pub mod plan;
 pub mod safety;
 pub mod sim;
+pub mod store;
 pub mod track;

@@ -21,7 +21,7 @@ fn config() -> Config {
 fn sequential_lines_closer_than_two_radii_use_fishtails() {
     let cfg = config();
     assert!(cfg.job.line_width_m < 2.0 * cfg.vehicle.r_min_m);
-    let JobPlan::Segments(job) = agsteer::control::ab_job_plan(&cfg).unwrap() else {
+    let JobPlan::Segments(job) = agsteer::job::ab_plan(&cfg.planning()).unwrap() else {
         panic!("a sequential AB job is a segment job");
     };
     // 4 lines, 3 fishtails of (forward, reverse, forward).

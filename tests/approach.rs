@@ -66,14 +66,14 @@ fn near_the_line_no_approach_is_planned() {
 
 #[test]
 fn a_field_job_approaches_inside_the_field() {
-    use agsteer::daemon::field_file;
+    use agsteer::job::field as field_file;
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.toml");
     let mut cfg = Config::load(std::path::Path::new(path), &[]).unwrap();
     // 8 m to the left of the first headland pass (into the field), facing 100° off it.
     cfg.sim.start_offset_m = 8.0;
     cfg.sim.start_heading_deg = 80.0;
     cfg.sim.max_time_s = 120.0;
-    let fj = field_file::load(&cfg).unwrap();
+    let fj = field_file::load_config(&cfg).unwrap();
     let opts = DemoOptions {
         job: Some(fj.job_plan()),
         origin: Some(fj.origin()),

@@ -296,3 +296,37 @@ fn accuracy_runs_the_chosen_scenarios_and_writes_json_and_svgs() {
     assert!(err.contains("unknown tracker"), "{err}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+fn agsteerd(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_agsteerd"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("agsteerd runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// `agsteerd --check` sets the job up as the daemon would: a manoeuvre job's map is read and
+/// the manoeuvre planned, and a missing map fails the check naming the file and the key.
+#[test]
+fn agsteerd_check_sets_up_the_manoeuvre_and_names_a_missing_map() {
+    let (code, out, err) = agsteerd(&["--config", "config/demo-maneuver.toml", "--check"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("manoeuvre on its map plans into"), "{out}");
+    assert!(out.contains("valid"), "{out}");
+    let (code, out, err) = agsteerd(&[
+        "--config",
+        "config/demo-maneuver.toml",
+        "--check",
+        "--set",
+        "job.maneuver_map_path=\"/nonexistent/agsteer/map.geojson\"",
+    ]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains("/nonexistent/agsteer/map.geojson"), "{err}");
+    assert!(err.contains("job.maneuver_map_path"), "{err}");
+    assert!(!out.contains("valid"), "{out}");
+}

@@ -2,8 +2,8 @@
 //! simulated power loss through the real progress file.
 
 use agsteer::config::{Config, TrackerChoice};
-use agsteer::daemon::progress_file;
 use agsteer::demo::{run, DemoOptions};
+use agsteer::store::progress_file;
 
 fn demo_config() -> Config {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo.toml");

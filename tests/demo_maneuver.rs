@@ -4,17 +4,17 @@
 //! brackets).
 
 use agsteer::config::Config;
-use agsteer::daemon::maneuver_file;
 use agsteer::demo::{run, DemoOptions};
 use agsteer::geo::Direction;
 use agsteer::guidance::JobPlan;
+use agsteer::job::maneuver as maneuver_file;
 use agsteer::plan::maneuver::collision::CollisionMap;
 
 #[test]
 fn the_demo_manoeuvre_is_driven_to_its_goal() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-maneuver.toml");
     let cfg = Config::load(std::path::Path::new(path), &[]).expect("config/demo-maneuver.toml");
-    let (mj, map) = maneuver_file::load(&cfg).expect("the demo manoeuvre plans");
+    let (mj, map) = maneuver_file::load_config(&cfg).expect("the demo manoeuvre plans");
     let map = map.expect("the demo has a map");
     assert_eq!(mj.path.cusps(), 2, "two reversals");
     let directions: Vec<Direction> = mj.job.segments().iter().map(|s| s.direction).collect();

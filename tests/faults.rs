@@ -151,9 +151,8 @@ fn operator_override_disengages_at_once_and_nothing_reengages_by_itself() {
 fn garbage_on_every_known_id_is_counted_invalid_and_never_panics() {
     use agsteer::can::codec::{Role, MESSAGES};
     use agsteer::can::{Frame, TimedFrame};
-    use agsteer::control::node::ControllerNode;
     let cfg = config();
-    let mut node = ControllerNode::new(&cfg, None).unwrap();
+    let mut node = agsteer::job::node_for_config(&cfg, None).unwrap();
     let mut x: u64 = 0x1234_5678_9ABC_DEF1;
     let mut expected_bad = 0u64;
     for def in MESSAGES {
@@ -195,10 +194,10 @@ struct Bench {
 impl Bench {
     fn new(cfg: &Config) -> Bench {
         use agsteer::geo::Pose;
-        let node = agsteer::control::node::ControllerNode::new(cfg, None).unwrap();
+        let node = agsteer::job::node_for_config(cfg, None).unwrap();
         let sim = agsteer::sim::can_node::SimNode::new(
             agsteer::sim::Simulator::new(
-                agsteer::demo::sim_params(cfg),
+                cfg.sim_params(),
                 Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
                 cfg.speed(),
             ),

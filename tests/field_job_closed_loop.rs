@@ -6,18 +6,19 @@
 //! regression fails while noise does not.
 
 use agsteer::config::Config;
-use agsteer::daemon::{field_file, progress_file};
 use agsteer::demo::{run, DemoOptions, Report};
-use agsteer::field::job::FieldJob;
 use agsteer::guidance::progress::Progress;
+use agsteer::job::field as field_file;
+use agsteer::job::field::FieldJob;
 use agsteer::plan::coverage::SegmentKind;
+use agsteer::store::progress_file;
 
 /// The demo-field configuration. `job.field_path` is relative to the working directory, the
 /// package root under `cargo test`.
 fn field_job() -> (Config, FieldJob) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.toml");
     let cfg = Config::load(std::path::Path::new(path), &[]).expect("config/demo-field.toml");
-    let job = field_file::load(&cfg).expect("the demo field loads and plans");
+    let job = field_file::load_config(&cfg).expect("the demo field loads and plans");
     (cfg, job)
 }
 
@@ -124,7 +125,7 @@ fn demo_field_job_resumes_its_own_plan_and_refuses_another() {
         &overrides,
     )
     .unwrap();
-    let other = field_file::load(&other_cfg).unwrap();
+    let other = field_file::load_config(&other_cfg).unwrap();
     assert_ne!(other.job.checksum(), job.job.checksum());
     let refused = run(
         &other_cfg,

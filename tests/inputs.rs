@@ -24,10 +24,10 @@ fn config() -> Config {
 fn run(serial_quality: bool, seconds: f64) -> (usize, f64, ControllerNode) {
     let cfg = config();
     let dt = cfg.dt();
-    let mut node = ControllerNode::new(&cfg, None).unwrap();
+    let mut node = agsteer::job::node_for_config(&cfg, None).unwrap();
     let mut sim = SimNode::new(
         Simulator::new(
-            agsteer::demo::sim_params(&cfg),
+            cfg.sim_params(),
             agsteer::geo::Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
             cfg.speed(),
         ),

@@ -8,8 +8,8 @@
 use agsteer::config::{Config, CurveChoice};
 use agsteer::field::load_local_map;
 use agsteer::geo::Pose;
+use agsteer::job::maneuver::{collision_map, plan_configured, pose_of};
 use agsteer::plan::maneuver::collision::CollisionMap;
-use agsteer::plan::maneuver::job::{collision_map, plan_configured, pose_of};
 use agsteer::plan::maneuver::path::{CurvePath, PathSample};
 use agsteer::plan::maneuver::search::{plan_maneuver, ManeuverResult};
 use agsteer::plan::maneuver::steering::RsSteering;
@@ -119,8 +119,15 @@ fn plan(name: &str, curve: CurveChoice) -> (Scenario, String, Config, ManeuverRe
     assert!(cfg.validate().is_empty(), "{:?}", cfg.validate());
     cfg.maneuver.curve = curve;
     let field = load_local_map(&map_text).unwrap();
-    let map = collision_map(&cfg, Some(&field)).unwrap();
-    let r = plan_configured(&cfg, &map, curve, &pose_of(s.from), &pose_of(s.to)).unwrap();
+    let map = collision_map(&cfg.planning().maneuver, Some(&field)).unwrap();
+    let r = plan_configured(
+        &cfg.planning().maneuver,
+        &map,
+        curve,
+        &pose_of(s.from),
+        &pose_of(s.to),
+    )
+    .unwrap();
     (s, map_text, cfg, r)
 }
 

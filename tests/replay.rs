@@ -9,7 +9,6 @@ use agsteer::can::codec::{OperatorCommand, OperatorCommandCommand, Packer};
 use agsteer::can::Frame;
 use agsteer::config::Config;
 use agsteer::daemon::bus_log::{BusLog, BusLogParams};
-use agsteer::daemon::run::{build_node, prepare_job};
 use agsteer::geo::{left_normal, v2, Pose};
 use agsteer::safety::SafetyState;
 use agsteer::sim::can_node::{Scenario, SimAddresses, SimNode};
@@ -33,8 +32,7 @@ fn us(t: f64) -> f64 {
 /// Run `seconds` of a job closed-loop, logging to `log`; returns (control periods, fix
 /// periods, engaged periods).
 fn closed_loop(cfg: &Config, seconds: f64, log: &BusLog) -> (u64, u64, u64) {
-    let job = prepare_job(cfg).unwrap();
-    let mut node = build_node(cfg, &job, None).unwrap();
+    let mut node = agsteer::job::node_for_config(cfg, None).unwrap();
     let a = v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]);
     let b = v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]);
     let dir = (b - a).normalize();

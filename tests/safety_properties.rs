@@ -432,7 +432,7 @@ fn node_case() -> impl Strategy<Value = Vec<In>> {
 
 fn run_node_case(cfg: &Config, inputs: &[In]) -> Result<(), TestCaseError> {
     let mut node =
-        ControllerNode::new(cfg, None).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        agsteer::job::node_for_config(cfg, None).map_err(|e| TestCaseError::fail(e.to_string()))?;
     let p = cfg.safety_params();
     let enu = EnuFrame::new(agsteer::geo::wgs84::LatLon {
         lat_deg: cfg.job.origin_lat_deg,

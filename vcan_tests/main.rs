@@ -353,10 +353,9 @@ fn e_sigterm_disengages_last() {
 /// excluded): (rms, p95, max, samples, samples expected at the 50 ms trajectory period).
 fn xte_from_trajectory(path: &str) -> (f64, f64, f64, usize, f64) {
     use agsteer::config::Config;
-    use agsteer::control::ab_params;
     use agsteer::plan::abline::AbPlan;
     let cfg = Config::load(std::path::Path::new(CONFIG), &[]).unwrap();
-    let plan = AbPlan::new(ab_params(&cfg)).unwrap();
+    let plan = AbPlan::new(cfg.ab_params()).unwrap();
     let text = std::fs::read_to_string(path).unwrap();
     let mut xs = Vec::new();
     for l in text.lines().skip(1) {
@@ -815,10 +814,9 @@ fn i_kill_9_resume() {
 /// within half a line width).
 fn line_crossings(path: &str, set: &str) -> Vec<u32> {
     use agsteer::config::Config;
-    use agsteer::control::ab_params;
     use agsteer::plan::abline::AbPlan;
     let cfg = Config::load(std::path::Path::new(CONFIG), &[set.to_string()]).unwrap();
-    let plan = AbPlan::new(ab_params(&cfg)).unwrap();
+    let plan = AbPlan::new(cfg.ab_params()).unwrap();
     let (a, b) = plan.line_endpoints(0, false);
     let dir = (b - a).normalize();
     let half = plan.line_length() / 2.0;

@@ -5,18 +5,8 @@
 use super::check::Checker;
 use serde::{Deserialize, Serialize};
 
-/// What the steering output is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum OutputKind {
-    /// The proprietary steering-angle frame.
-    #[default]
-    Angle,
-    /// ISO 11783-7 Guidance System Command (curvature).
-    Curvature,
-    /// Both.
-    Both,
-}
+/// What the steering output is (the node's type).
+pub use crate::control::params::OutputKind;
 
 /// `[bus]`: the CAN side.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

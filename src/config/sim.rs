@@ -3,6 +3,8 @@
 //! Owns the section's keys, their defaults and their range checks.
 
 use super::check::{fmt_num, Checker};
+use crate::sim::can_node::SpeedProfile;
+use crate::sim::{Disturbances, LateralDynamics, SimParams};
 use serde::{Deserialize, Serialize};
 
 /// `[sim]`: the vehicle simulator.
@@ -333,5 +335,84 @@ impl SimConfig {
                 "must be less than the true wheelbase (vehicle.wheelbase_m + sim.wheelbase_error_m)",
             );
         }
+    }
+}
+
+impl super::Config {
+    /// The simulator's parameters: the true vehicle is the controller's model (`[vehicle]`) plus
+    /// the plant's own errors (`[sim]`).
+    pub fn sim_params(&self) -> SimParams {
+        let cfg = self;
+        let s = &cfg.sim;
+        SimParams {
+            // The true vehicle: the controller's model plus the plant's own errors.
+            wheelbase: cfg.vehicle.wheelbase_m + s.wheelbase_error_m,
+            max_wheel_angle: cfg.max_wheel_angle(),
+            antenna_forward: cfg.vehicle.antenna_forward_m + s.antenna_error_forward_m,
+            antenna_left: cfg.vehicle.antenna_left_m + s.antenna_error_left_m,
+            antenna_up: cfg.vehicle.antenna_up_m + s.antenna_error_up_m,
+            was_gain: s.was_gain,
+            lateral: s.tyre_slip.then(|| LateralDynamics {
+                mass: s.mass_kg,
+                yaw_inertia: s.yaw_inertia_kg_m2,
+                cg_ahead_of_rear: s.cg_ahead_of_rear_m,
+                // Per degree → per radian.
+                cornering_stiffness_front: s.cornering_stiffness_front_n_per_deg.to_degrees(),
+                cornering_stiffness_rear: s.cornering_stiffness_rear_n_per_deg.to_degrees(),
+                relaxation_length: s.relaxation_length_m,
+                friction: s.tyre_friction,
+                side_force: s.implement_side_force_n,
+                hitch_behind_rear: s.implement_hitch_m,
+            }),
+            dead_time: s.actuator_dead_time_s,
+            tau: s.actuator_tau_s,
+            max_rate: s.actuator_rate_deg_s.to_radians(),
+            gnss_rate_hz: s.gnss_rate_hz,
+            gnss_latency: s.gnss_latency_s,
+            gnss_sigma: s.gnss_sigma_m,
+            heading_sigma: s.heading_sigma_deg.to_radians(),
+            was_rate_hz: s.was_rate_hz,
+            was_noise: s.was_noise_deg.to_radians(),
+            step: s.step_s,
+            seed: s.seed,
+            accel: s.accel_mps2,
+            dist: Disturbances {
+                gnss_markov_sigma: s.gnss_markov_sigma_m,
+                gnss_markov_tau: s.gnss_markov_tau_s,
+                multipath_rate: s.gnss_multipath_rate_per_h / 3600.0,
+                multipath_magnitude: s.gnss_multipath_m,
+                multipath_duration: s.gnss_multipath_duration_s,
+                float_windows: s
+                    .gnss_float_windows_s
+                    .iter()
+                    .map(|w| (w[0], w[1]))
+                    .collect(),
+                float_sigma: s.gnss_float_sigma_m,
+                float_tau: s.gnss_float_tau_s,
+                terrain_slope: s.terrain_slope_deg.to_radians(),
+                terrain_downhill: s.terrain_downhill_deg.to_radians(),
+                terrain_slope_amp: s.terrain_slope_amp_deg.to_radians(),
+                terrain_wavelength: s.terrain_wavelength_m,
+                imu_rate_hz: s.imu_rate_hz,
+                imu_noise: s.imu_noise_deg.to_radians(),
+                // Per degree of roll → per radian.
+                slip_per_roll: s.slip_per_roll_mps_per_deg.to_degrees(),
+                slip: s.slip_mps,
+                was_bias: s.was_bias_deg.to_radians(),
+                deadband: s.actuator_deadband_deg.to_radians(),
+                backlash: s.actuator_backlash_deg.to_radians(),
+            },
+            ..SimParams::default()
+        }
+    }
+
+    /// The simulated driver's speed profile, if one is set.
+    pub fn speed_profile(&self) -> Option<SpeedProfile> {
+        let s = &self.sim;
+        (s.speed_max_kmh > 0.0).then(|| SpeedProfile {
+            min: s.speed_min_kmh / 3.6,
+            max: s.speed_max_kmh / 3.6,
+            turn_angle: s.speed_turn_angle_deg.to_radians(),
+        })
     }
 }

@@ -9,7 +9,7 @@ fn turns_are_planned_no_tighter_than_the_speed_allows() {
     let v: f64 = 15.0 / 3.6;
     assert!((cfg.turn_radius() - v * v / 2.0).abs() < 1e-12);
     assert!(cfg.coverage_params().r_min > 8.0);
-    assert!(crate::control::ab_params(&cfg).turn.r_min > 8.0);
+    assert!(cfg.ab_params().turn.r_min > 8.0);
 }
 
 #[test]

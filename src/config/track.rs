@@ -6,18 +6,8 @@
 use super::check::Checker;
 use serde::{Deserialize, Serialize};
 
-/// Which tracker steers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum TrackerChoice {
-    /// Pure pursuit on a latency-compensated, dead-reckoned pose (the default).
-    #[default]
-    Predictive,
-    /// Plain seed-000 pure pursuit on the latest fix: the reference.
-    PurePursuit,
-    /// Stanley steering on the same latency-compensated, dead-reckoned pose.
-    Stanley,
-}
+/// Which tracker steers (the tracker registry's type).
+pub use crate::track::registry::TrackerKind as TrackerChoice;
 
 /// `[track]`: local path and tracker.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

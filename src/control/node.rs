@@ -2,23 +2,23 @@
 //! → `track` → `safety` → `can`, without I/O: the daemon feeds it SocketCAN frames, the demo
 //! feeds it in-memory ones, so both run exactly the same code on exactly the same frames.
 
-use super::{ControlError, Controller};
+use super::params::{BusParams, OutputKind};
+use super::Controller;
 use crate::can::codec::{
     DirectionRequest, DirectionRequestDirection, GuidanceStatus, GuidanceStatusState,
     GuidanceSystemCommand, GuidanceSystemCommandCommandStatus, Packer, SteeringCommand,
     SteeringCommandMode,
 };
 use crate::can::{Frame, TimedFrame};
-use crate::config::{Config, OutputKind};
 use crate::estimate::GnssFix;
 use crate::geo::wgs84::{EnuFrame, LatLon};
 use crate::geo::Direction;
-use crate::guidance::progress::Progress;
 use crate::input::can::CanAdapter;
 use crate::input::source::{SourceChange, SourceParams, SourceSelector};
 use crate::input::{CheckedLink, Input, OperatorCommand, PositionInput, SensorStatus};
 use crate::safety::{
-    CheckedInput, FaultCode, FixQuality, SafetyState, SteeringCommand as Cmd, Supervisor,
+    CheckedInput, FaultCode, FixQuality, SafetyParams, SafetyState, SteeringCommand as Cmd,
+    Supervisor,
 };
 use serde::Serialize;
 
@@ -94,6 +94,11 @@ struct CuspParams {
     min_speed: f64,
 }
 
+/// Control periods between two status frames (at least 1).
+fn status_every(status_period: f64, dt: f64) -> u64 {
+    ((status_period / dt).round() as u64).max(1)
+}
+
 fn request_of(d: Direction) -> DirectionRequestDirection {
     match d {
         Direction::Forward => DirectionRequestDirection::Forward,
@@ -110,52 +115,33 @@ fn checked_input(link: CheckedLink) -> CheckedInput {
 }
 
 impl ControllerNode {
-    pub fn new(cfg: &Config, resume: Option<&Progress>) -> Result<Self, ControlError> {
-        Self::with_controller(cfg, Controller::from_config(cfg, resume)?)
-    }
-
-    /// A node driving `plan` (see [`Controller::with_job`]).
-    pub fn with_job(
-        cfg: &Config,
-        plan: crate::guidance::JobPlan,
-        resume: Option<&Progress>,
-    ) -> Result<Self, ControlError> {
-        Self::with_controller(cfg, Controller::with_job(cfg, plan, resume)?)
-    }
-
-    /// Convert GNSS positions about `origin` instead of `job.origin_*`: the origin of the job's
-    /// local coordinates (a field plan is in its field's frame, see
-    /// [`FieldJob::origin`](crate::field::job::FieldJob::origin)).
-    pub fn with_origin(mut self, origin: LatLon) -> Self {
-        self.enu = EnuFrame::new(origin);
-        self
-    }
-
-    fn with_controller(cfg: &Config, ctrl: Controller) -> Result<Self, ControlError> {
-        Ok(ControllerNode {
+    /// The node running `ctrl` under a supervisor with `safety`, on the bus as `bus` says,
+    /// converting GNSS positions about `origin` (the origin of the job's local coordinates:
+    /// `job.origin_*`, or the field's for a field plan).
+    pub fn new(ctrl: Controller, safety: &SafetyParams, bus: &BusParams, origin: LatLon) -> Self {
+        let c = ctrl.params().cusp;
+        let dt = ctrl.params().dt;
+        ControllerNode {
             ctrl,
-            supervisor: Supervisor::new(cfg.safety_params()),
-            enu: EnuFrame::new(LatLon {
-                lat_deg: cfg.job.origin_lat_deg,
-                lon_deg: cfg.job.origin_lon_deg,
-            }),
-            packer: Packer::new(cfg.bus.source_address),
+            supervisor: Supervisor::new(safety.clone()),
+            enu: EnuFrame::new(origin),
+            packer: Packer::new(bus.source_address),
             can: CanAdapter::default(),
             sources: SourceSelector::new(SourceParams::default()),
-            gnss_from_stream: cfg.gnss.is_stream(),
-            output: cfg.bus.output,
+            gnss_from_stream: bus.gnss_from_stream,
+            output: bus.output,
             heading: None,
             roll: None,
             speed: 0.0,
             quality: None,
-            status_every: ((cfg.bus.status_period_s / cfg.dt()).round() as u64).max(1),
+            status_every: status_every(bus.status_period, dt),
             ticks: 0,
             cusps: CuspParams {
-                decel: cfg.guidance.cusp_decel_mps2,
-                stopped_speed: cfg.guidance.stopped_speed_mps,
-                capture: cfg.guidance.cusp_capture_m,
-                dt: cfg.dt(),
-                min_speed: cfg.safety.min_speed_kmh / 3.6,
+                decel: c.decel,
+                stopped_speed: c.stopped_speed,
+                capture: c.capture,
+                dt,
+                min_speed: safety.min_speed,
             },
             cusp: false,
             approach_refused: false,
@@ -176,7 +162,7 @@ impl ControllerNode {
                 steering_lost_motion_deg: 0.0,
                 bad_frames: 0,
             },
-        })
+        }
     }
 
     pub fn controller(&self) -> &Controller {
@@ -191,13 +177,18 @@ impl ControllerNode {
     pub fn supervisor_mut(&mut self) -> &mut Supervisor {
         &mut self.supervisor
     }
-    /// Apply the tuning keys of `cfg` (tracker, estimator, safety limits, output) at once.
-    /// The caller has checked that nothing defining the job changed.
-    pub fn apply_tuning(&mut self, cfg: &Config) {
-        self.ctrl.set_tuning(cfg);
-        self.supervisor.set_params(cfg.safety_params());
-        self.output = cfg.bus.output;
-        self.status_every = ((cfg.bus.status_period_s / cfg.dt()).round() as u64).max(1);
+    /// Apply new tuning (tracker, estimator, safety limits, output) at once. The caller has
+    /// checked that nothing defining the job changed.
+    pub fn apply_tuning(
+        &mut self,
+        control: &super::ControlParams,
+        safety: &SafetyParams,
+        bus: &BusParams,
+    ) {
+        self.ctrl.set_tuning(control);
+        self.supervisor.set_params(safety.clone());
+        self.output = bus.output;
+        self.status_every = status_every(bus.status_period, self.ctrl.params().dt);
     }
 
     pub fn status(&self) -> NodeStatus {

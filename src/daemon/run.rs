@@ -7,17 +7,16 @@
 //! non-blocking write, and progress is handed to a writer thread through a bounded channel
 //! (a full channel skips a save rather than stall the loop; the next line change saves again).
 
-use super::{field_file, progress_file};
 use crate::can::bus::{monotonic_s, AsyncSocketCan, BusError, Filter};
 use crate::can::{Frame, TimedFrame};
-use crate::config::{Config, JobKind};
+use crate::config::{Config, ConfigError};
 use crate::control::node::{ControllerNode, NodeStatus};
 use crate::control::ControlError;
-use crate::geo::wgs84::LatLon;
-use crate::guidance::progress::{JobDefinition, Progress};
-use crate::guidance::JobPlan;
+use crate::guidance::progress::Progress;
+use crate::job::{JobDetail, JobError, PreparedJob};
+use crate::store::progress_file;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::mpsc;
 use std::time::Duration;
 use tokio::io::AsyncWriteExt;
@@ -34,11 +33,11 @@ pub enum DaemonError {
         source: std::io::Error,
     },
     #[error(transparent)]
+    Config(#[from] ConfigError),
+    #[error(transparent)]
+    Job(#[from] JobError),
+    #[error(transparent)]
     Control(#[from] ControlError),
-    #[error("job.kind = \"field\": cannot prepare the field job")]
-    Field(#[source] crate::field::job::FieldJobError),
-    #[error("job.kind = \"maneuver\": cannot prepare the manoeuvre")]
-    Maneuver(#[source] super::maneuver_file::ManeuverFileError),
     #[error("runtime: {0}")]
     Runtime(std::io::Error),
     #[error(transparent)]
@@ -106,125 +105,34 @@ fn spawn_progress_writer(path: PathBuf) -> mpsc::SyncSender<Progress> {
     tx
 }
 
-/// The job agsteerd drives, prepared before the control loop starts.
-#[derive(Debug, Clone)]
-pub struct DaemonJob {
-    /// What the guidance drives: the configuration's AB lines or the field's coverage plan.
-    pub plan: JobPlan,
-    /// Its definition, saved with progress; progress saved under another one is not resumed.
-    pub definition: JobDefinition,
-    /// ENU origin of the plan's coordinates when it is not `job.origin_*` (a field plan).
-    pub origin: Option<LatLon>,
-    /// The field (local ENU about `origin`), which approach paths must stay in.
-    pub field: Option<crate::plan::coverage::Field>,
-}
-
-/// Prepare the configured job. For `job.kind = "field"` this reads `job.field_path` and plans
-/// its coverage: blocking work, done once at start-up, never in the control loop.
-pub fn prepare_job(cfg: &Config) -> Result<DaemonJob, DaemonError> {
-    let mut field = None;
-    let (plan, origin) = match cfg.job.kind {
-        JobKind::Ab => (crate::control::ab_job_plan(cfg)?, None),
-        JobKind::Arcs => (
-            crate::control::arcs_plan(cfg).map_err(ControlError::from)?,
-            None,
+/// Prepare the configured job ([`crate::job::prepare`]) and log what was planned. For
+/// `job.kind = "field"` this reads `job.field_path` and plans its coverage, for `"maneuver"`
+/// it reads the map and plans the manoeuvre: blocking work, done once at start-up, never in
+/// the control loop.
+pub fn prepare_job(planning: &crate::config::Planning) -> Result<PreparedJob, JobError> {
+    let job = crate::job::prepare(planning)?;
+    match &job.detail {
+        JobDetail::Field(fj) => tracing::info!(
+            field = %fj.title(),
+            origin_lat_deg = fj.origin().lat_deg,
+            origin_lon_deg = fj.origin().lon_deg,
+            cells = fj.plan.cells,
+            swaths = fj.plan.swaths,
+            segments = fj.job.len(),
+            checksum = format_args!("{:08x}", fj.job.checksum()),
+            plan_ms = format_args!("{:.0}", fj.plan_time.as_secs_f64() * 1e3),
+            "field job planned from {}",
+            fj.path.display()
         ),
-        JobKind::Field => {
-            let start = std::time::Instant::now();
-            let fj = field_file::load(cfg).map_err(DaemonError::Field)?;
-            tracing::info!(
-                field = %fj.title(),
-                origin_lat_deg = fj.origin().lat_deg,
-                origin_lon_deg = fj.origin().lon_deg,
-                cells = fj.plan.cells,
-                swaths = fj.plan.swaths,
-                segments = fj.job.len(),
-                checksum = format_args!("{:08x}", fj.job.checksum()),
-                plan_ms = format_args!("{:.0}", start.elapsed().as_secs_f64() * 1e3),
-                "field job planned from {}",
-                fj.path.display()
-            );
-            field = Some(fj.loaded.field.clone());
-            (fj.job_plan(), Some(fj.origin()))
-        }
-        JobKind::Maneuver => {
-            let (mj, _) = super::maneuver_file::load(cfg).map_err(DaemonError::Maneuver)?;
-            tracing::info!(
-                length_m = format_args!("{:.1}", mj.path.length()),
-                cusps = mj.path.cusps(),
-                segments = mj.job.len(),
-                "manoeuvre planned"
-            );
-            (JobPlan::Segments(mj.job), None)
-        }
-    };
-    Ok(DaemonJob {
-        definition: JobDefinition::for_job(cfg, &plan),
-        plan,
-        origin,
-        field,
-    })
-}
-
-/// The controller node for `job`, continuing `resume` (which must belong to it).
-pub fn build_node(
-    cfg: &Config,
-    job: &DaemonJob,
-    resume: Option<&Progress>,
-) -> Result<ControllerNode, ControlError> {
-    let mut node = ControllerNode::with_job(cfg, job.plan.clone(), resume)?;
-    if let Some(field) = &job.field {
-        match crate::plan::maneuver::job::field_clearance(cfg, field) {
-            Ok(clear) => node.controller_mut().set_approach_clearance(clear),
-            Err(e) => tracing::warn!("approach paths are not checked against the field: {e}"),
-        }
+        JobDetail::Maneuver(mj, _) => tracing::info!(
+            length_m = format_args!("{:.1}", mj.path.length()),
+            cusps = mj.path.cusps(),
+            segments = mj.job.len(),
+            "manoeuvre planned"
+        ),
+        JobDetail::Lines => {}
     }
-    Ok(match job.origin {
-        Some(origin) => node.with_origin(origin),
-        None => node,
-    })
-}
-
-/// Load saved progress for the job `expected`: `None` when there is none, it is corrupt (moved
-/// aside) or it belongs to another job (other parameters, or another field plan).
-pub fn load_progress(expected: &JobDefinition, path: &Path) -> Option<Progress> {
-    match progress_file::load(path) {
-        Ok(Some(p)) => {
-            if p.job == *expected {
-                tracing::info!(
-                    lines_done = p.lines_done,
-                    block = p.index_block,
-                    rank = p.index_rank,
-                    "resuming the job from {}",
-                    path.display()
-                );
-                Some(p)
-            } else if p.job.plan_checksum != expected.plan_checksum {
-                tracing::warn!(
-                    "{} belongs to another field plan (checksum {}, this plan {}); starting this job from the beginning",
-                    path.display(),
-                    checksum_text(p.job.plan_checksum),
-                    checksum_text(expected.plan_checksum)
-                );
-                None
-            } else {
-                tracing::warn!(
-                    "{} belongs to another job (its parameters differ); starting this job from the beginning",
-                    path.display()
-                );
-                None
-            }
-        }
-        Ok(None) => None,
-        Err(e) => {
-            tracing::error!("{e}; starting the job from the beginning, disengaged");
-            None
-        }
-    }
-}
-
-fn checksum_text(c: Option<u32>) -> String {
-    c.map_or_else(|| "none (AB job)".into(), |c| format!("{c:08x}"))
+    Ok(job)
 }
 
 /// Run this thread under SCHED_FIFO at `priority` (0 = leave it alone).
@@ -274,9 +182,9 @@ fn apply_reload(
     cfg: &mut Config,
     source: &ConfigSource,
     node: &mut ControllerNode,
-    loaded: Result<Config, crate::config::ConfigError>,
+    loaded: Result<Config, ConfigError>,
 ) {
-    let new = match loaded {
+    let (new, resolved) = match loaded.and_then(|c| c.resolve().map(|r| (c, r))) {
         Ok(c) => c,
         Err(e) => {
             tracing::error!(
@@ -294,7 +202,7 @@ fn apply_reload(
         );
         return;
     }
-    node.apply_tuning(&new);
+    node.apply_tuning(&resolved.control, &resolved.safety, &resolved.bus);
     *cfg = new;
     tracing::info!(
         "SIGHUP: configuration reloaded from {}",
@@ -313,39 +221,40 @@ pub fn run(cfg: Config, source: ConfigSource) -> Result<(), DaemonError> {
 
 async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonError> {
     use tokio::signal::unix::{signal, SignalKind};
-    // The field is read and planned here, before the bus is opened and the loop starts.
-    let job = prepare_job(&cfg)?;
-    let iface = cfg.bus.interface.clone();
+    // The job is set up here (the field or map read and planned), before the bus is opened
+    // and the loop starts.
+    let resolved = cfg.resolve()?;
+    let job = prepare_job(&resolved.planning)?;
+    let iface = resolved.daemon.interface.clone();
     let bus = std::rc::Rc::new(AsyncSocketCan::open(&iface, &receive_filters()).map_err(
         |source| DaemonError::Open {
             iface: iface.clone(),
             source,
         },
     )?);
-    let state_dir = PathBuf::from(&cfg.progress.state_dir);
-    let progress_path = progress_file::progress_path(&state_dir);
-    let resume = load_progress(&job.definition, &progress_path);
+    let progress_path = progress_file::progress_path(&resolved.daemon.state_dir);
+    let resume = crate::job::resume::resume_or_start(&job.definition, &progress_path);
     // The node is built once; a SIGHUP only retunes it (apply_reload), so the plan is kept.
-    let mut node = build_node(&cfg, &job, resume.as_ref())?;
+    let mut node = crate::job::build_node(&resolved, &job, resume.as_ref())?;
     let progress_tx = spawn_progress_writer(progress_path.clone());
     // Helper threads exist now; only the control loop's thread gets real-time priority.
-    set_realtime_priority(cfg.daemon.realtime_priority);
+    set_realtime_priority(resolved.daemon.realtime_priority);
 
-    let listener = if cfg.bus.status_socket.is_empty() {
-        None
-    } else {
-        let path = PathBuf::from(&cfg.bus.status_socket);
+    let status_socket = resolved.daemon.status_socket.clone();
+    let listener = if let Some(path) = &status_socket {
         if let Some(dir) = path.parent() {
             let _ = std::fs::create_dir_all(dir);
         }
-        remove_stale_socket(&path);
-        let l = tokio::net::UnixListener::bind(&path).map_err(|source| DaemonError::Status {
-            path: cfg.bus.status_socket.clone(),
+        remove_stale_socket(path);
+        let l = tokio::net::UnixListener::bind(path).map_err(|source| DaemonError::Status {
+            path: path.display().to_string(),
             source,
         })?;
         use std::os::unix::fs::PermissionsExt;
-        let _ = std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o660));
+        let _ = std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o660));
         Some(l)
+    } else {
+        None
     };
 
     // Reader task: frames → channel; errors → Down, with a back-off, never ending.
@@ -370,7 +279,7 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
     // GNSS over a serial port, USB, UDP or TCP, and the NTRIP client ([gnss]).
     let mut gnss = super::gnss::spawn(&cfg, &local)?;
 
-    let dt = cfg.dt();
+    let dt = resolved.control.dt;
     let mut interval = tokio::time::interval(Duration::from_secs_f64(dt));
     interval.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     let mut sigterm = signal(SignalKind::terminate()).map_err(DaemonError::Runtime)?;
@@ -385,8 +294,7 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
     let mut bus_up = true;
     tracing::info!(interface = %iface, dt_s = dt, "agsteerd running");
     let mut watchdog = crate::daemon::notify::Watchdog::from_env();
-    let mut reloading: Option<tokio::task::JoinHandle<Result<Config, crate::config::ConfigError>>> =
-        None;
+    let mut reloading: Option<tokio::task::JoinHandle<Result<Config, ConfigError>>> = None;
     crate::daemon::notify::ready();
 
     local
@@ -527,8 +435,8 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
     if let Err(e) = progress_file::save(&progress_path, &p) {
         tracing::error!("saving progress: {e}");
     }
-    if !cfg.bus.status_socket.is_empty() {
-        remove_stale_socket(std::path::Path::new(&cfg.bus.status_socket));
+    if let Some(path) = &status_socket {
+        remove_stale_socket(path);
     }
     Ok(())
 }
@@ -540,95 +448,5 @@ fn remove_stale_socket(path: &std::path::Path) {
     use std::os::unix::fs::FileTypeExt;
     if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_socket()) {
         let _ = std::fs::remove_file(path);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::guidance::progress::{Phase, PROGRESS_VERSION};
-
-    /// config/demo-field.toml; `job.field_path` is relative to the working directory, which
-    /// is the package root under `cargo test`.
-    fn demo_field_config(overrides: &[&str]) -> Config {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.toml");
-        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-        Config::load(Path::new(path), &overrides).expect("config/demo-field.toml is valid")
-    }
-
-    fn progress(job: &JobDefinition) -> Progress {
-        Progress {
-            version: PROGRESS_VERSION,
-            job: job.clone(),
-            index_block: 0,
-            index_rank: 3,
-            phase: Phase::Work,
-            lines_done: 3,
-        }
-    }
-
-    #[test]
-    fn field_job_is_planned_and_its_progress_resumed() {
-        let cfg = demo_field_config(&[]);
-        let job = prepare_job(&cfg).expect("the demo field plans");
-        assert!(matches!(job.plan, JobPlan::Segments(_)));
-        assert!(job.definition.plan_checksum.is_some());
-        let dir = tempfile::tempdir().unwrap();
-        let path = progress_file::progress_path(dir.path());
-        progress_file::save(&path, &progress(&job.definition)).unwrap();
-        let resume = load_progress(&job.definition, &path).expect("same plan resumes");
-        let node = build_node(&cfg, &job, Some(&resume)).expect("node resumes");
-        assert_eq!(node.controller().guidance().lines_done(), 3);
-        // GNSS positions are converted about the field's origin, not job.origin_*.
-        let fj = field_file::load(&cfg).unwrap();
-        assert_eq!(*node.enu(), crate::geo::wgs84::EnuFrame::new(fj.origin()));
-        assert_ne!(fj.origin().lat_deg, cfg.job.origin_lat_deg);
-    }
-
-    #[test]
-    fn progress_saved_with_another_plan_checksum_is_not_resumed() {
-        let cfg = demo_field_config(&[]);
-        let job = prepare_job(&cfg).unwrap();
-        // Four headland passes instead of two (more than the turns need, so the plan changes):
-        // every job key is the same, only the plan differs.
-        let other_cfg = demo_field_config(&["field.headland_passes=4"]);
-        let other = prepare_job(&other_cfg).unwrap();
-        assert_ne!(other.definition.plan_checksum, job.definition.plan_checksum);
-        let mut same_keys = other.definition.clone();
-        same_keys.plan_checksum = job.definition.plan_checksum;
-        assert_eq!(same_keys, job.definition, "only the checksum differs");
-
-        let dir = tempfile::tempdir().unwrap();
-        let path = progress_file::progress_path(dir.path());
-        progress_file::save(&path, &progress(&other.definition)).unwrap();
-        assert_eq!(load_progress(&job.definition, &path), None);
-        // The file is left alone (not corrupt), and is still good for its own plan.
-        assert!(load_progress(&other.definition, &path).is_some());
-        // Progress of an AB job (no checksum) does not resume a field job either.
-        progress_file::save(&path, &progress(&JobDefinition::from_config(&cfg))).unwrap();
-        assert_eq!(load_progress(&job.definition, &path), None);
-        // And the controller itself refuses it too.
-        let saved = progress(&other.definition);
-        assert!(build_node(&cfg, &job, Some(&saved)).is_err());
-    }
-
-    #[test]
-    fn ab_job_definition_is_the_configured_one() {
-        let cfg = Config::default();
-        let job = prepare_job(&cfg).unwrap();
-        assert!(job.origin.is_none());
-        assert_eq!(job.definition, JobDefinition::from_config(&cfg));
-    }
-
-    #[test]
-    fn an_unreadable_field_stops_the_daemon_naming_the_file() {
-        let cfg = demo_field_config(&["job.field_path=\"/nonexistent/agsteer/field.geojson\""]);
-        let e = prepare_job(&cfg).unwrap_err();
-        let text = format!("{:#}", anyhow::Error::new(e));
-        assert!(
-            text.contains("/nonexistent/agsteer/field.geojson"),
-            "{text}"
-        );
-        assert!(text.contains("job.field_path"), "{text}");
     }
 }

@@ -25,7 +25,6 @@
 
 use super::{run, DemoOptions, WorkPass, XteStats, ACQUISITION_END_M, ACQUISITION_SKIP_M};
 use crate::config::{Config, TrackerChoice};
-use crate::control::ControlError;
 use crate::geo::Vec2;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -237,7 +236,7 @@ pub fn evaluate(
     name: &str,
     cfg: &Config,
     tracker: TrackerChoice,
-) -> Result<(ScenarioResult, XteSeries), ControlError> {
+) -> Result<(ScenarioResult, XteSeries), crate::job::JobError> {
     let mut cfg = cfg.clone();
     cfg.track.kind = tracker;
     let opts = DemoOptions {

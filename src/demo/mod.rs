@@ -11,15 +11,14 @@ pub mod svg;
 use crate::can::bus::{CanBus, MemBus};
 use crate::can::codec::{OperatorCommand, Packer};
 use crate::can::Frame;
-use crate::config::{Config, TrackerChoice};
-use crate::control::node::ControllerNode;
-use crate::control::ControlError;
+use crate::config::{Config, JobKind, TrackerChoice};
 use crate::geo::{left_normal, signed_offset, v2, Pose, Vec2};
 use crate::guidance::progress::{Phase, Progress};
 use crate::guidance::{Event, JobPlan};
+use crate::job::JobError;
 use crate::safety::SafetyState;
-use crate::sim::can_node::{Scenario, SimAddresses, SimNode, SpeedProfile};
-use crate::sim::{Disturbances, LateralDynamics, SimParams, Simulator};
+use crate::sim::can_node::{Scenario, SimAddresses, SimNode};
+use crate::sim::Simulator;
 use serde::Serialize;
 
 /// Work-line samples closer than this to the line start are excluded from the XTE figures, m.
@@ -29,79 +28,9 @@ pub const ACQUISITION_END_M: f64 = 20.0;
 /// Trace points for the SVG are recorded every this many metres driven.
 const TRACE_SPACING_M: f64 = 0.5;
 
-/// The simulator's parameters from the configuration.
-pub fn sim_params(cfg: &Config) -> SimParams {
-    let s = &cfg.sim;
-    SimParams {
-        // The true vehicle: the controller's model plus the plant's own errors.
-        wheelbase: cfg.vehicle.wheelbase_m + s.wheelbase_error_m,
-        max_wheel_angle: cfg.max_wheel_angle(),
-        antenna_forward: cfg.vehicle.antenna_forward_m + s.antenna_error_forward_m,
-        antenna_left: cfg.vehicle.antenna_left_m + s.antenna_error_left_m,
-        antenna_up: cfg.vehicle.antenna_up_m + s.antenna_error_up_m,
-        was_gain: s.was_gain,
-        lateral: s.tyre_slip.then(|| LateralDynamics {
-            mass: s.mass_kg,
-            yaw_inertia: s.yaw_inertia_kg_m2,
-            cg_ahead_of_rear: s.cg_ahead_of_rear_m,
-            // Per degree → per radian.
-            cornering_stiffness_front: s.cornering_stiffness_front_n_per_deg.to_degrees(),
-            cornering_stiffness_rear: s.cornering_stiffness_rear_n_per_deg.to_degrees(),
-            relaxation_length: s.relaxation_length_m,
-            friction: s.tyre_friction,
-            side_force: s.implement_side_force_n,
-            hitch_behind_rear: s.implement_hitch_m,
-        }),
-        dead_time: s.actuator_dead_time_s,
-        tau: s.actuator_tau_s,
-        max_rate: s.actuator_rate_deg_s.to_radians(),
-        gnss_rate_hz: s.gnss_rate_hz,
-        gnss_latency: s.gnss_latency_s,
-        gnss_sigma: s.gnss_sigma_m,
-        heading_sigma: s.heading_sigma_deg.to_radians(),
-        was_rate_hz: s.was_rate_hz,
-        was_noise: s.was_noise_deg.to_radians(),
-        step: s.step_s,
-        seed: s.seed,
-        accel: s.accel_mps2,
-        dist: Disturbances {
-            gnss_markov_sigma: s.gnss_markov_sigma_m,
-            gnss_markov_tau: s.gnss_markov_tau_s,
-            multipath_rate: s.gnss_multipath_rate_per_h / 3600.0,
-            multipath_magnitude: s.gnss_multipath_m,
-            multipath_duration: s.gnss_multipath_duration_s,
-            float_windows: s
-                .gnss_float_windows_s
-                .iter()
-                .map(|w| (w[0], w[1]))
-                .collect(),
-            float_sigma: s.gnss_float_sigma_m,
-            float_tau: s.gnss_float_tau_s,
-            terrain_slope: s.terrain_slope_deg.to_radians(),
-            terrain_downhill: s.terrain_downhill_deg.to_radians(),
-            terrain_slope_amp: s.terrain_slope_amp_deg.to_radians(),
-            terrain_wavelength: s.terrain_wavelength_m,
-            imu_rate_hz: s.imu_rate_hz,
-            imu_noise: s.imu_noise_deg.to_radians(),
-            // Per degree of roll → per radian.
-            slip_per_roll: s.slip_per_roll_mps_per_deg.to_degrees(),
-            slip: s.slip_mps,
-            was_bias: s.was_bias_deg.to_radians(),
-            deadband: s.actuator_deadband_deg.to_radians(),
-            backlash: s.actuator_backlash_deg.to_radians(),
-        },
-        ..SimParams::default()
-    }
-}
-
-/// The simulated driver's speed profile from the configuration, if one is set.
-pub fn speed_profile(cfg: &Config) -> Option<SpeedProfile> {
-    let s = &cfg.sim;
-    (s.speed_max_kmh > 0.0).then(|| SpeedProfile {
-        min: s.speed_min_kmh / 3.6,
-        max: s.speed_max_kmh / 3.6,
-        turn_angle: s.speed_turn_angle_deg.to_radians(),
-    })
+/// The simulator's parameters from the configuration ([`Config::sim_params`]).
+pub fn sim_params(cfg: &Config) -> crate::sim::SimParams {
+    cfg.sim_params()
 }
 
 /// |XTE| statistics in constant memory: a histogram of 0.1 mm bins up to 2 m.
@@ -253,7 +182,10 @@ pub struct DemoOptions {
     /// The simulated operator never presses engage again after the first engagement ends
     /// (fault scenarios); by default they re-engage whenever the system is ready.
     pub no_reengage: bool,
-    /// The job to drive (a field plan as a segment job); `None` = the configuration's AB job.
+    /// The job as set up by [`crate::job::prepare`]; `None` = set it up here (from `job`, or
+    /// the configuration's).
+    pub prepared: Option<crate::job::PreparedJob>,
+    /// The job to drive (a field plan as a segment job); `None` = the configuration's job.
     pub job: Option<JobPlan>,
     /// Outlines drawn under the trace in the SVG (field boundary, obstacles, headland).
     pub outlines: Vec<Vec<Vec2>>,
@@ -421,11 +353,7 @@ pub struct DemoRun {
 
 /// The configuration name of a tracker (`track.kind`).
 pub fn tracker_name(kind: TrackerChoice) -> &'static str {
-    match kind {
-        TrackerChoice::Predictive => "predictive",
-        TrackerChoice::PurePursuit => "pure_pursuit",
-        TrackerChoice::Stanley => "stanley",
-    }
+    kind.name()
 }
 
 /// A default time budget: three times the time to drive every line and turn.
@@ -451,82 +379,67 @@ pub fn run(
     opts: &DemoOptions,
     on_progress: &mut dyn FnMut(&Progress),
     on_event: &mut dyn FnMut(f64, &Event),
-) -> Result<DemoRun, ControlError> {
+) -> Result<DemoRun, JobError> {
     let wall = std::time::Instant::now();
-    // A sequential AB job is a segment job: plan it here so its segments are scored.
-    let sequential;
-    let opts = if opts.job.is_none()
-        && cfg.job.kind == crate::config::JobKind::Ab
-        && cfg.job.line_order == crate::config::LineOrder::Sequential
-    {
-        sequential = DemoOptions {
-            job: Some(crate::control::ab_job_plan(cfg)?),
-            ..opts.clone()
-        };
-        &sequential
-    } else {
-        opts
+    let resolved = cfg.resolve()?;
+    // The job given, or the configured one, set up as agsteerd sets it up.
+    let job = match (&opts.prepared, &opts.job) {
+        (Some(prepared), _) => prepared.clone(),
+        (None, Some(plan)) => crate::job::given(
+            &resolved.planning,
+            plan.clone(),
+            opts.origin,
+            opts.field.clone(),
+        ),
+        (None, None) => crate::job::prepare(&resolved.planning)?,
     };
-    let mut node = match &opts.job {
-        Some(job) => ControllerNode::with_job(cfg, job.clone(), opts.resume.as_ref())?,
-        None => ControllerNode::new(cfg, opts.resume.as_ref())?,
-    };
-    if let Some(origin) = opts.origin {
-        node = node.with_origin(origin);
-    }
-    if let Some(field) = &opts.field {
-        match crate::plan::maneuver::job::field_clearance(cfg, field) {
-            Ok(clear) => node.controller_mut().set_approach_clearance(clear),
-            Err(e) => tracing::warn!("approach paths are not checked against the field: {e}"),
+    // Segment jobs are scored segment by segment (arcs, driven as lines, by line).
+    let scored = match &job.plan {
+        JobPlan::Segments(s) if opts.job.is_some() || resolved.planning.kind != JobKind::Arcs => {
+            Some(s)
         }
-    }
-    let speed = cfg.speed();
+        _ => None,
+    };
+    let mut node = crate::job::build_node(&resolved, &job, opts.resume.as_ref())?;
+    let sim_setup = &resolved.sim;
+    let speed = sim_setup.speed;
     let segment_job = matches!(
         node.controller().guidance().job_plan(),
         JobPlan::Segments(_)
     );
-    let start = match (&opts.resume, &opts.job) {
-        (None, _) if segment_job => node.controller().path_start_pose().map(|p| {
+    let start = match &opts.resume {
+        None if segment_job => node.controller().path_start_pose().map(|p| {
             let normal = left_normal(&crate::geo::heading_vec(p.heading));
-            let pos = p.pos + normal * cfg.sim.start_offset_m;
-            Pose::new(
-                pos.x,
-                pos.y,
-                p.heading + cfg.sim.start_heading_deg.to_radians(),
-            )
+            let pos = p.pos + normal * sim_setup.start_offset;
+            Pose::new(pos.x, pos.y, p.heading + sim_setup.start_heading)
         }),
-        (Some(_), _) => node.controller().path_start_pose(),
-        (None, _) => None,
+        Some(_) => node.controller().path_start_pose(),
+        None => None,
     }
     .unwrap_or_else(|| {
-        let a = v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]);
-        let b = v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]);
-        let dir = (b - a).normalize();
-        let p = a + left_normal(&dir) * cfg.sim.start_offset_m;
-        Pose::new(
-            p.x,
-            p.y,
-            dir.y.atan2(dir.x) + cfg.sim.start_heading_deg.to_radians(),
-        )
+        let ab = &resolved.planning.ab;
+        let dir = (ab.point_b - ab.point_a).normalize();
+        let p = ab.point_a + left_normal(&dir) * sim_setup.start_offset;
+        Pose::new(p.x, p.y, dir.y.atan2(dir.x) + sim_setup.start_heading)
     });
     let mut sim = SimNode::new(
-        Simulator::new(sim_params(cfg), start, speed),
+        Simulator::new(sim_setup.params.clone(), start, speed),
         *node.enu(),
         SimAddresses::default(),
         opts.scenario.clone(),
     )
-    .with_speed_profile(speed_profile(cfg));
+    .with_speed_profile(sim_setup.speed_profile);
     // The controller and the simulator talk only through frames on an in-memory bus.
     let mut bus_ctrl = MemBus::new();
     let mut bus_sim = bus_ctrl.node();
     let mut terminal_bus = bus_ctrl.node();
     let mut terminal = Packer::new(0x26);
-    let dt = cfg.dt();
-    let max_time = if cfg.sim.max_time_s > 0.0 {
-        cfg.sim.max_time_s
+    let dt = resolved.control.dt;
+    let max_time = if sim_setup.max_time > 0.0 {
+        sim_setup.max_time
     } else if let JobPlan::Segments(job) = node.controller().guidance().job_plan() {
         let length: f64 = job.segments().iter().map(|s| s.length()).sum();
-        60.0 + 3.0 * length / cfg.speed().max(0.1)
+        60.0 + 3.0 * length / speed.max(0.1)
     } else {
         default_max_time(cfg)
     };
@@ -535,10 +448,7 @@ pub fn run(
     let mut scored_path = ScoredPath::default();
     // Segment jobs: every segment scored on its own, whatever its kind.
     let mut segment_path = ScoredPath::default();
-    let segment_count = match &opts.job {
-        Some(JobPlan::Segments(job)) => job.len(),
-        _ => 0,
-    };
+    let segment_count = scored.map_or(0, |job| job.len());
     let mut segment_scores = vec![SegmentScore::default(); segment_count];
     let mut finished_at: Option<f64> = None;
     let mut acquisition_max: f64 = 0.0;
@@ -733,8 +643,8 @@ pub fn run(
 
     let ctrl = node.controller();
     let finished = ctrl.guidance().is_finished() && !stopped;
-    let (segments, goal_position_error_m, goal_heading_error_deg) = match &opts.job {
-        Some(JobPlan::Segments(job)) => {
+    let (segments, goal_position_error_m, goal_heading_error_deg) = match scored {
+        Some(job) => {
             let segments = job
                 .segments()
                 .iter()
@@ -771,13 +681,13 @@ pub fn run(
             });
             (segments, goal.map(|g| g.0), goal.map(|g| g.1))
         }
-        _ => (Vec::new(), None, None),
+        None => (Vec::new(), None, None),
     };
     let report = Report {
         finished,
-        lines_planned: match &opts.job {
-            Some(JobPlan::Segments(job)) => Some(job.len() as u64),
-            _ => (cfg.job.line_num > 0).then_some(cfg.job.line_num),
+        lines_planned: match scored {
+            Some(job) => Some(job.len() as u64),
+            None => (cfg.job.line_num > 0).then_some(cfg.job.line_num),
         },
         lines_completed: ctrl.guidance().lines_done(),
         xte_rms_m: stats.rms(),

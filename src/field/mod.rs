@@ -18,12 +18,10 @@
 
 mod clean;
 mod geojson;
-pub mod job;
 pub mod output;
 mod taskdata;
 
 pub use clean::{clean_ring, RingCleanup};
-pub use job::{FieldJob, FieldJobError};
 pub use taskdata::{GuidanceKind, PartfieldInfo};
 
 use crate::envelope;

@@ -557,7 +557,14 @@ impl Guidance {
 mod tests {
     use super::*;
     use crate::config::Config;
-    use crate::control::{ab_params, guidance_params};
+
+    fn ab_params(cfg: &Config) -> crate::plan::abline::AbParams {
+        cfg.ab_params()
+    }
+
+    fn guidance_params(cfg: &Config) -> GuidanceParams {
+        cfg.control_params().guidance
+    }
     use crate::plan::job::SegmentJob;
 
     /// Drive an ideal vehicle along whatever path the machine hands out and return the lines
@@ -568,7 +575,7 @@ mod tests {
         stop_after: Option<usize>,
     ) -> (Vec<u64>, Progress) {
         let plan = AbPlan::new(ab_params(cfg)).unwrap();
-        let job = JobDefinition::from_config(cfg);
+        let job = cfg.job_definition();
         let mut g = match resume {
             Some(p) => Guidance::resume(plan, job, guidance_params(cfg), p).unwrap(),
             None => Guidance::new(plan, job, guidance_params(cfg)).unwrap(),
@@ -669,7 +676,7 @@ mod tests {
     fn drive_segments(resume: Option<&Progress>, stop_after: usize) -> (Vec<u64>, Progress) {
         let cfg = Config::default();
         let plan = JobPlan::from(segment_job());
-        let job = JobDefinition::for_job(&cfg, &plan);
+        let job = cfg.job_definition().with_plan(&plan);
         let mut g = match resume {
             Some(p) => Guidance::resume(plan, job, guidance_params(&cfg), p).unwrap(),
             None => Guidance::new(plan, job, guidance_params(&cfg)).unwrap(),
@@ -715,7 +722,7 @@ mod tests {
         let mut other = segment_job().segments().to_vec();
         other[2].points[0].x += 0.5;
         let other = JobPlan::from(SegmentJob::new(other).unwrap());
-        let job = JobDefinition::for_job(&cfg, &other);
+        let job = cfg.job_definition().with_plan(&other);
         let err = Guidance::resume(other, job, guidance_params(&cfg), &saved).err();
         assert_eq!(err, Some(GuidanceError::DifferentJob));
     }
@@ -729,7 +736,7 @@ mod tests {
         let plan = AbPlan::new(ab_params(&other)).unwrap();
         let err = Guidance::resume(
             plan,
-            JobDefinition::from_config(&other),
+            other.job_definition(),
             guidance_params(&other),
             &saved,
         )

@@ -3,7 +3,7 @@
 //! The file holds two lines: the progress as one JSON object, then `crc32c <hex> <length>`
 //! computed over the exact bytes of the first line. Anything that does not match is corrupt and
 //! is never trusted. File handling (temp file, fsync, rename) lives in
-//! [`crate::daemon::progress_file`].
+//! [`crate::store::progress_file`].
 
 use serde::{Deserialize, Serialize};
 
@@ -13,7 +13,9 @@ const CHECKSUM_TAG: &str = "crc32c";
 /// Format version written into every file.
 pub const PROGRESS_VERSION: u32 = 1;
 
-/// The parameters that define an AB job. A saved progress only applies to the same job.
+/// The parameters that define a job (the configuration's job keys, filled in by the
+/// configuration layer, and a segment job's checksum). A saved progress only applies to the
+/// same job.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JobDefinition {
@@ -32,27 +34,12 @@ pub struct JobDefinition {
 }
 
 impl JobDefinition {
-    pub fn from_config(cfg: &crate::config::Config) -> Self {
-        JobDefinition {
-            point_a_m: cfg.job.point_a_m,
-            point_b_m: cfg.job.point_b_m,
-            line_width_m: cfg.job.line_width_m,
-            line_num: cfg.job.line_num,
-            r_min_m: cfg.vehicle.r_min_m,
-            side: cfg.job.side,
-            a: cfg.guidance.a,
-            point_spacing_m: cfg.guidance.point_spacing_m,
-            plan_checksum: None,
+    /// This definition for the job `plan`: a segment job adds its checksum.
+    pub fn with_plan(mut self, plan: &crate::plan::job::JobPlan) -> Self {
+        if let crate::plan::job::JobPlan::Segments(s) = plan {
+            self.plan_checksum = Some(s.checksum());
         }
-    }
-
-    /// The definition of the job `plan` configured by `cfg`.
-    pub fn for_job(cfg: &crate::config::Config, plan: &crate::guidance::JobPlan) -> Self {
-        let mut job = JobDefinition::from_config(cfg);
-        if let crate::guidance::JobPlan::Segments(s) = plan {
-            job.plan_checksum = Some(s.checksum());
-        }
-        job
+        self
     }
 }
 
@@ -154,7 +141,7 @@ mod tests {
     fn sample() -> Progress {
         Progress {
             version: PROGRESS_VERSION,
-            job: JobDefinition::from_config(&crate::config::Config::default()),
+            job: crate::config::Config::default().job_definition(),
             index_block: 2,
             index_rank: 5,
             phase: Phase::Turn,

@@ -1,14 +1,30 @@
 //! Tracking: the local path and the steering laws that follow it.
 //!
-//! [`pure_pursuit`] is the seed-000 law. Which pose it is fed makes the difference between the
-//! plain reference (the latest fix) and the default predictive tracker (a latency-compensated,
-//! dead-reckoned pose from [`crate::estimate`]).
+//! Every law implements [`law::SteeringLaw`] and is registered once in [`registry`], which
+//! builds it from its [`registry::TrackerKind`] (the `track.kind` key). A law states what it
+//! needs from the rest of the controller ([`law::LawNeeds`]: a latency-compensated,
+//! dead-reckoned pose, the disturbance observer, integral action, lost-motion compensation);
+//! the controller asks, it never checks which law it runs. [`pure_pursuit`] is the seed-000
+//! law: fed the latest fix it is the plain reference, fed the predicted pose and the observer's
+//! course it is the default predictive tracker; [`stanley`] is the Stanley reference.
+//!
+//! To add a tracker: a module with a type implementing [`law::SteeringLaw`], and one entry in
+//! [`registry`] (its kind, name and constructor).
+//!
+//! Contract: pure functions of the local path, the pose and the speed; nothing allocates or
+//! logs per call. Uses [`crate::geo`] and [`crate::estimate`] only.
 
+pub mod law;
 pub mod local_path;
 pub mod lost_motion;
+pub mod pure_pursuit;
+pub mod registry;
+pub mod stanley;
 
-use crate::geo::{cross, heading_vec, Direction, Pose, Vec2};
-use local_path::LocalPath;
+pub use pure_pursuit::pure_pursuit;
+pub use stanley::stanley;
+
+use crate::geo::{Direction, Pose, Vec2};
 use std::f64::consts::PI;
 
 /// Tracker parameters, SI units.
@@ -96,65 +112,6 @@ pub fn point_along(points: &[Vec2], start: usize, distance: f64) -> Vec2 {
     points.last().copied().unwrap_or_else(Vec2::zeros)
 }
 
-/// Stanley steering (Hoffmann et al. 2007) on the local path: with the front axle's signed
-/// distance `e` to the path (positive = path to its left) and the heading error ψ = path
-/// heading − vehicle heading at the front axle's nearest point,
-/// δ = ψ + atan(k·e / (v + v_soft)), clamped to ±max_wheel_angle. `gain` is k (1/s),
-/// `soft_speed` is v_soft (m/s).
-pub fn stanley(
-    local: &LocalPath,
-    pose: &Pose,
-    speed: f64,
-    params: &TrackerParams,
-    gain: f64,
-    soft_speed: f64,
-) -> TrackOutput {
-    let points = local.points();
-    let front = pose.pos + heading_vec(pose.heading) * params.wheelbase;
-    let invalid = TrackOutput {
-        wheel_angle: 0.0,
-        curvature: 0.0,
-        lookahead: 0.0,
-        target: front,
-        alpha: 0.0,
-        valid: false,
-    };
-    if points.len() < 2 || !front.x.is_finite() || !front.y.is_finite() || !speed.is_finite() {
-        return invalid;
-    }
-    // Nearest sample to the front axle, searching forward from the rear axle's.
-    let mut best = (f64::INFINITY, local.index_local().min(points.len() - 2));
-    for (i, q) in points.iter().enumerate().skip(local.index_local()) {
-        let d = (q - front).norm();
-        if d < best.0 {
-            best = (d, i);
-        } else if d > best.0 + 2.0 * params.wheelbase {
-            break;
-        }
-    }
-    let i = best.1.min(points.len() - 2);
-    let tangent = points[i + 1] - points[i];
-    if tangent.norm() <= 0.0 {
-        return invalid;
-    }
-    let path_heading = tangent.y.atan2(tangent.x);
-    let h = heading_vec(pose.heading);
-    let psi = crate::geo::wrap_angle(path_heading - pose.heading);
-    let e = -cross(&tangent.normalize(), &(points[i] - front));
-    // e > 0: the front axle is left of the path, steer right.
-    let delta = psi + (-gain * e).atan2(speed.abs() + soft_speed);
-    let max = params.max_wheel_angle;
-    let wheel_angle = delta.clamp(-max, max);
-    TrackOutput {
-        wheel_angle,
-        curvature: wheel_angle.tan() / params.wheelbase,
-        lookahead: (points[i] - pose.pos).norm(),
-        target: points[i],
-        alpha: cross(&h, &(points[i] - pose.pos)).atan2(h.dot(&(points[i] - pose.pos))),
-        valid: true,
-    }
-}
-
 /// Integral action on the cross-track error: a slowly learnt wheel-angle offset that cancels
 /// steady disturbances a pure geometric law leaves as a standing error (a wheel-angle sensor
 /// bias, side-slope slip). It learns only on work paths, driving forward, above a speed and
@@ -196,54 +153,9 @@ impl IntegralAction {
     }
 }
 
-/// Seed-000 pure pursuit: from the nearest local point integrate the look-ahead along the
-/// local path to the preview point; α is the angle from the heading to it;
-/// κ = 2·sin α / Ld and δ = atan(L·κ).
-pub fn pure_pursuit(
-    local: &LocalPath,
-    pose: &Pose,
-    speed: f64,
-    params: &TrackerParams,
-) -> TrackOutput {
-    let ld = lookahead(params, speed);
-    let points = local.points();
-    let invalid = TrackOutput {
-        wheel_angle: 0.0,
-        curvature: 0.0,
-        lookahead: ld,
-        target: pose.pos,
-        alpha: 0.0,
-        valid: false,
-    };
-    if points.is_empty()
-        || !pose.pos.x.is_finite()
-        || !pose.pos.y.is_finite()
-        || !pose.heading.is_finite()
-        || !ld.is_finite()
-        || ld <= 0.0
-    {
-        return invalid;
-    }
-    let target = point_along(points, local.index_local(), ld);
-    let to = target - pose.pos;
-    let h = heading_vec(pose.heading);
-    let alpha = cross(&h, &to).atan2(h.dot(&to));
-    let curvature = 2.0 * alpha.sin() / ld;
-    let max = params.max_wheel_angle;
-    let wheel_angle = (params.wheelbase * curvature).atan().clamp(-max, max);
-    TrackOutput {
-        wheel_angle,
-        curvature,
-        lookahead: ld,
-        target,
-        alpha,
-        valid: true,
-    }
-}
-
 #[cfg(test)]
 mod tests {
-    use super::local_path::LocalPathParams;
+    use super::local_path::{LocalPath, LocalPathParams};
     use super::*;
     use crate::geo::{v2, PathPoint};
 

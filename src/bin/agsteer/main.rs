@@ -8,12 +8,11 @@ mod replay_cmd;
 mod sim_cmd;
 
 use agsteer::config::{Config, JobKind};
-use agsteer::daemon::{field_file, progress_file};
 use agsteer::demo::{self, DemoOptions};
-use agsteer::field::job::{load_configured, FieldJob};
 use agsteer::field::output::PlanSummary;
-use agsteer::guidance::progress::JobDefinition;
 use agsteer::guidance::Event;
+use agsteer::job::{JobDetail, PreparedJob};
+use agsteer::store::progress_file;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -406,13 +405,13 @@ fn daemon_node(
     cfg: &Config,
     progress: Option<&Path>,
 ) -> Result<agsteer::control::node::ControllerNode> {
-    use agsteer::daemon::run::{build_node, load_progress, prepare_job};
-    let job = prepare_job(cfg).context("preparing the job")?;
-    let resume = progress.and_then(|p| load_progress(&job.definition, p));
+    let resolved = cfg.resolve().context("configuration")?;
+    let job = agsteer::job::prepare(&resolved.planning).context("preparing the job")?;
+    let resume = progress.and_then(|p| agsteer::job::resume::resume_or_start(&job.definition, p));
     if progress.is_some() && resume.is_none() {
         anyhow::bail!("--progress: no progress of this job to resume");
     }
-    build_node(cfg, &job, resume.as_ref()).context("building the controller")
+    agsteer::job::build_node(&resolved, &job, resume.as_ref()).context("building the controller")
 }
 
 fn load_config(path: &Path, set: &[String]) -> Result<Config> {
@@ -443,20 +442,42 @@ fn log_event(t: f64, ev: &Event) {
     tracing::info!(t_s = format_args!("{t:.2}"), "{ev}");
 }
 
-/// A field job for the demo: `job.field_path` read, loaded and planned (timed), with the plan's
-/// summary for the report.
-fn prepare_field_job(cfg: &Config) -> Result<(FieldJob, PlanSummary)> {
-    let (path, text) = field_file::read_text(cfg)?;
-    let loaded = load_configured(cfg, &path, &text)?;
-    let (job, plan_time) = plan_cmd::timed("planning", || FieldJob::plan(cfg, &path, loaded));
+/// The configured job set up as agsteerd sets it up (timed, with progress on stderr), and for
+/// a field job the plan's summary for the report.
+fn prepare_demo_job(
+    resolved: &agsteer::config::Resolved,
+) -> Result<(PreparedJob, Option<PlanSummary>)> {
+    let what = match resolved.planning.kind {
+        JobKind::Maneuver => "planning the manoeuvre",
+        JobKind::Ab | JobKind::Arcs | JobKind::Field => "planning",
+    };
+    let (job, ms) = plan_cmd::timed(what, || agsteer::job::prepare(&resolved.planning));
     let job = job?;
-    let (metrics, metrics_time) = plan_cmd::timed("metrics", || job.metrics());
-    let summary = PlanSummary::new(&job.loaded, &job.plan, &metrics, plan_time, metrics_time);
+    let summary = match &job.detail {
+        JobDetail::Field(fj) => {
+            let (metrics, metrics_time) = plan_cmd::timed("metrics", || fj.metrics());
+            Some(PlanSummary::new(
+                &fj.loaded,
+                &fj.plan,
+                &metrics,
+                fj.plan_time,
+                metrics_time,
+            ))
+        }
+        JobDetail::Maneuver(mj, _) => {
+            tracing::info!(
+                "manoeuvre: {:.1} m, {} cusps, {:.1} m in reverse, {} segments, planned in {:.0} ms",
+                mj.path.length(),
+                mj.path.cusps(),
+                mj.path.reverse_length(),
+                mj.job.len(),
+                ms.as_secs_f64() * 1e3
+            );
+            None
+        }
+        JobDetail::Lines => None,
+    };
     Ok((job, summary))
-}
-
-fn checksum_text(c: Option<u32>) -> String {
-    c.map_or_else(|| "none (AB job)".into(), |c| format!("{c:08x}"))
 }
 
 fn run_demo(
@@ -468,90 +489,36 @@ fn run_demo(
     set: &[String],
 ) -> Result<u8> {
     let cfg = load_config(config, set)?;
-    let field = match cfg.job.kind {
-        JobKind::Field => Some(
-            prepare_field_job(&cfg)
-                .with_context(|| format!("job.kind = \"field\" in {}", config.display()))?,
-        ),
-        JobKind::Ab | JobKind::Arcs | JobKind::Maneuver => None,
-    };
-    let maneuver = match cfg.job.kind {
-        JobKind::Maneuver => {
-            let (r, ms) = plan_cmd::timed("planning the manoeuvre", || {
-                agsteer::daemon::maneuver_file::load(&cfg)
-            });
-            let (mj, map) =
-                r.with_context(|| format!("job.kind = \"maneuver\" in {}", config.display()))?;
-            tracing::info!(
-                "manoeuvre: {:.1} m, {} cusps, {:.1} m in reverse, {} segments, planned in {:.0} ms",
-                mj.path.length(),
-                mj.path.cusps(),
-                mj.path.reverse_length(),
-                mj.job.len(),
-                ms.as_secs_f64() * 1e3
-            );
-            Some((mj, map))
-        }
-        _ => None,
-    };
-    let job = field.as_ref().map(|(fj, _)| fj.job_plan()).or_else(|| {
-        maneuver
-            .as_ref()
-            .map(|(mj, _)| agsteer::guidance::JobPlan::Segments(mj.job.clone()))
-    });
-    let expected = match &job {
-        Some(plan) => JobDefinition::for_job(&cfg, plan),
-        None => JobDefinition::from_config(&cfg),
-    };
+    let resolved = cfg.resolve()?;
+    let (job, summary) = prepare_demo_job(&resolved)
+        .with_context(|| format!("setting up the job of {}", config.display()))?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let progress_path = out.join(progress_file::PROGRESS_FILE_NAME);
     let resume_from = if resume {
-        match progress_file::load(&progress_path) {
-            Ok(Some(p)) if p.job != expected => {
-                if p.job.plan_checksum != expected.plan_checksum {
-                    anyhow::bail!(
-                        "--resume: {} was saved for another field plan (checksum {}, this plan {}); run without --resume to start afresh",
-                        progress_path.display(),
-                        checksum_text(p.job.plan_checksum),
-                        checksum_text(expected.plan_checksum)
-                    );
-                }
-                anyhow::bail!(
-                    "--resume: {} belongs to another job (its job parameters differ from {}); run without --resume to start afresh",
-                    progress_path.display(),
-                    config.display()
-                );
-            }
-            Ok(Some(p)) => {
-                tracing::info!(
-                    lines_done = p.lines_done,
-                    block = p.index_block,
-                    rank = p.index_rank,
-                    "resuming from {}",
-                    progress_path.display()
-                );
-                Some(p)
-            }
-            Ok(None) => anyhow::bail!("--resume: no progress file at {}", progress_path.display()),
-            Err(e) => return Err(e).context("--resume"),
-        }
+        Some(agsteer::job::resume::require_resume(
+            &job.definition,
+            &progress_path,
+            config,
+        )?)
     } else {
         None
+    };
+    let field = match &job.detail {
+        JobDetail::Field(fj) => Some(fj.as_ref()),
+        _ => None,
     };
     let opts = DemoOptions {
         resume: resume_from,
         stop_after_lines: stop_after,
         record_trace: true,
-        job,
-        outlines: match (&field, &maneuver) {
-            (Some((fj, _)), _) => fj.outlines(),
-            (None, Some((_, Some(map)))) => std::iter::once(map.boundary.clone())
+        outlines: match &job.detail {
+            JobDetail::Field(fj) => fj.outlines(),
+            JobDetail::Maneuver(_, Some(map)) => std::iter::once(map.boundary.clone())
                 .chain(map.obstacles.iter().cloned())
                 .collect(),
             _ => Vec::new(),
         },
-        origin: field.as_ref().map(|(fj, _)| fj.origin()),
-        field: field.as_ref().map(|(fj, _)| fj.loaded.field.clone()),
+        prepared: Some(job.clone()),
         ..Default::default()
     };
     let mut save_error = None;
@@ -565,7 +532,7 @@ fn run_demo(
     if let Some(e) = save_error {
         tracing::error!("could not save progress: {e}");
     }
-    run.report.plan = field.as_ref().map(|(_, s)| s.clone());
+    run.report.plan = summary.clone();
     let report_json = serde_json::to_string_pretty(&run.report)?;
     std::fs::write(out.join("report.json"), format!("{report_json}\n"))
         .with_context(|| format!("writing {}/report.json", out.display()))?;
@@ -578,7 +545,7 @@ fn run_demo(
         println!("{report_json}");
     } else {
         let r = &run.report;
-        if let Some((fj, p)) = &field {
+        if let (Some(fj), Some(p)) = (field, &summary) {
             println!(
                 "plan of {}: {} cells, {} swaths, {} segments, {:.0} m ({:.0} m work, {:.0} m turns, {:.0} m transit); field worked {:.2} %, outside {:.3} m²; planned in {:.0} ms",
                 fj.title(),
@@ -634,7 +601,7 @@ fn run_demo(
                     )
                 })
         };
-        if maneuver.is_some() {
+        if matches!(job.detail, JobDetail::Maneuver(..)) {
             for s in &r.segments {
                 println!(
                     "segment {} ({:?}, {:.1} m): XTE RMS {:.1} cm, max {:.1} cm",

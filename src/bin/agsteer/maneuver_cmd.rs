@@ -6,8 +6,8 @@ use agsteer::config::{Config, CurveChoice};
 use agsteer::envelope;
 use agsteer::field::load_local_map;
 use agsteer::geo::{Direction, Pose, Vec2};
+use agsteer::job::maneuver::{plan_configured, pose_of};
 use agsteer::plan::maneuver::collision::CollisionMap;
-use agsteer::plan::maneuver::job::{plan_configured, pose_of};
 use agsteer::plan::maneuver::search::{ManeuverError, ManeuverResult, Method};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::Serialize;
@@ -163,7 +163,7 @@ fn plan_one(
     to: &Pose,
 ) -> (Result<ManeuverResult, ManeuverError>, f64) {
     let t0 = Instant::now();
-    let r = plan_configured(cfg, map, curve, from, to);
+    let r = plan_configured(&cfg.planning().maneuver, map, curve, from, to);
     (r, t0.elapsed().as_secs_f64() * 1e3)
 }
 

@@ -3,9 +3,9 @@
 use agsteer::can::bus::{monotonic_s, CanBus, SocketCanBus};
 use agsteer::can::Frame;
 use agsteer::config::{Config, JobKind};
-use agsteer::demo::sim_params;
-use agsteer::geo::wgs84::{EnuFrame, LatLon};
-use agsteer::geo::{left_normal, v2, Pose};
+use agsteer::geo::wgs84::EnuFrame;
+use agsteer::geo::{left_normal, Pose};
+use agsteer::job::JobDetail;
 use agsteer::sim::can_node::{Scenario, SimAddresses, SimNode};
 use agsteer::sim::Simulator;
 use anyhow::{Context, Result};
@@ -33,51 +33,34 @@ pub fn run(
         }
         None => Scenario::default(),
     };
-    // A field or manoeuvre job (as agsteerd drives it): the plan's frame, starting on its
-    // first segment.
-    let (field, segment_job) = match cfg.job.kind {
-        JobKind::Field => {
-            let f = agsteer::daemon::field_file::load(cfg).context("job.kind = \"field\"")?;
-            let job = f.job.clone();
-            (Some(f), Some(job))
-        }
-        JobKind::Ab => (None, None),
-        JobKind::Maneuver => {
-            let (mj, _) =
-                agsteer::daemon::maneuver_file::load(cfg).context("job.kind = \"maneuver\"")?;
-            (None, Some(mj.job))
-        }
-        JobKind::Arcs => (None, None),
+    // The job set up as agsteerd sets it up: a field or manoeuvre job starts on its first
+    // segment, in the plan's frame; AB lines and arcs on line A→B.
+    let resolved = cfg.resolve()?;
+    let job = agsteer::job::prepare(&resolved.planning)
+        .with_context(|| format!("job.kind = \"{}\"", job_kind_name(cfg.job.kind)))?;
+    let segment_job = match &job.detail {
+        JobDetail::Field(fj) => Some(&fj.job),
+        JobDetail::Maneuver(mj, _) => Some(&mj.job),
+        JobDetail::Lines => None,
     };
-    let first = segment_job.as_ref().and_then(|j| j.segments().first());
+    let first = segment_job.and_then(|j| j.segments().first());
+    let ab = &resolved.planning.ab;
     let (a, b) = match first.map(|s| s.points.as_slice()) {
         Some([a, b, ..]) => (*a, *b),
-        _ => (
-            v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]),
-            v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]),
-        ),
+        _ => (ab.point_a, ab.point_b),
     };
+    let setup = &resolved.sim;
     let dir = (b - a).normalize();
-    let p = a + left_normal(&dir) * cfg.sim.start_offset_m;
-    let start = Pose::new(
-        p.x,
-        p.y,
-        dir.y.atan2(dir.x) + cfg.sim.start_heading_deg.to_radians(),
-    );
-    let enu = EnuFrame::new(field.as_ref().map_or(
-        LatLon {
-            lat_deg: cfg.job.origin_lat_deg,
-            lon_deg: cfg.job.origin_lon_deg,
-        },
-        |f| f.origin(),
-    ));
+    let p = a + left_normal(&dir) * setup.start_offset;
+    let start = Pose::new(p.x, p.y, dir.y.atan2(dir.x) + setup.start_heading);
+    let enu = EnuFrame::new(job.origin.unwrap_or(resolved.planning.origin));
     let mut node = SimNode::new(
-        Simulator::new(sim_params(cfg), start, cfg.speed()),
+        Simulator::new(setup.params.clone(), start, setup.speed),
         enu,
         SimAddresses::default(),
         scenario,
     )
-    .with_speed_profile(agsteer::demo::speed_profile(cfg));
+    .with_speed_profile(setup.speed_profile);
     let mut bus =
         SocketCanBus::open(iface, &[]).with_context(|| format!("opening CAN interface {iface}"))?;
     let mut traj = match trajectory {
@@ -147,6 +130,16 @@ pub fn run(
         "simulator stopped"
     );
     Ok(0)
+}
+
+/// The configuration name of a job kind.
+fn job_kind_name(kind: JobKind) -> &'static str {
+    match kind {
+        JobKind::Ab => "ab",
+        JobKind::Field => "field",
+        JobKind::Arcs => "arcs",
+        JobKind::Maneuver => "maneuver",
+    }
 }
 
 /// `agsteer status`: ask the daemon's status socket.

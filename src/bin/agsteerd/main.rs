@@ -1,6 +1,7 @@
 //! `agsteerd`: the steering daemon on SocketCAN.
 
 use agsteer::config::Config;
+use agsteer::job::JobDetail;
 use anyhow::Context;
 use clap::Parser;
 use std::path::PathBuf;
@@ -16,7 +17,8 @@ struct Args {
     /// Configuration file.
     #[arg(long, default_value = "/etc/agsteer/agsteer.toml")]
     config: PathBuf,
-    /// Validate the configuration and exit (0 valid, 2 invalid).
+    /// Validate the configuration and everything it names (a field is read and planned, a
+    /// manoeuvre map read and the manoeuvre planned), then exit (0 valid, 2 invalid).
     #[arg(long)]
     check: bool,
     /// Override a configuration key, e.g. `--set bus.interface=vcan0`.
@@ -41,20 +43,35 @@ fn main() -> ExitCode {
         }
     };
     if args.check {
-        if cfg.job.kind == agsteer::config::JobKind::Field {
-            // The field must load and plan too, or the daemon would not start.
-            match agsteer::daemon::field_file::load(&cfg) {
-                Ok(fj) => println!(
+        // Everything the daemon loads at start-up, set up as it sets it up: the field or the
+        // manoeuvre map read and planned too, or the daemon would not start.
+        let prepared = cfg
+            .resolve()
+            .map_err(anyhow::Error::new)
+            .and_then(|r| agsteer::job::prepare(&r.planning).map_err(anyhow::Error::new));
+        match prepared {
+            Ok(job) => match &job.detail {
+                JobDetail::Field(fj) => println!(
                     "{}: field {} plans into {} segments (checksum {:08x})",
                     args.config.display(),
                     fj.path.display(),
                     fj.job.len(),
                     fj.job.checksum()
                 ),
-                Err(e) => {
-                    eprintln!("{}: {:#}", args.config.display(), anyhow::Error::new(e));
-                    return ExitCode::from(2);
-                }
+                JobDetail::Maneuver(mj, map) => println!(
+                    "{}: manoeuvre on {} plans into {} segments ({:.1} m, {} cusps, checksum {:08x})",
+                    args.config.display(),
+                    if map.is_some() { "its map" } else { "free space" },
+                    mj.job.len(),
+                    mj.path.length(),
+                    mj.path.cusps(),
+                    mj.job.checksum()
+                ),
+                JobDetail::Lines => {}
+            },
+            Err(e) => {
+                eprintln!("{}: {e:#}", args.config.display());
+                return ExitCode::from(2);
             }
         }
         println!("{}: valid", args.config.display());

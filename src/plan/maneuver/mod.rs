@@ -15,6 +15,5 @@ pub mod reeds_shepp;
 
 pub mod collision;
 pub mod expansion;
-pub mod job;
 pub mod search;
 pub mod steering;

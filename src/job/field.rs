@@ -1,21 +1,23 @@
-//! A field job (`job.kind = "field"`): the configured field loaded, its coverage planned and
-//! the plan turned into the segment job the guidance drives. Shared by `agsteerd`,
-//! `agsteer demo` and `agsteer plan`.
+//! A field job (`job.kind = "field"`): the configured field read (through [`crate::store`]),
+//! loaded, its coverage planned and the plan turned into the segment job the guidance drives.
+//! Part of the one job set-up ([`crate::job::prepare`]) of `agsteerd`, `agsteer demo` and
+//! `agsteer sim`.
 //!
-//! Works on text, like the rest of [`crate::field`]; reading `job.field_path` is done by
-//! [`crate::daemon::field_file`]. No clocks here: callers time the planning themselves.
+//! Takes the resolved [`FieldPlanning`]; the planning itself is timed ([`FieldJob::plan_time`])
+//! for the reports.
 
-use super::{load_field, FieldError, LoadedField};
-use crate::config::Config;
+use crate::config::{Config, FieldPlanning, JobKind};
+use crate::envelope::FileKind;
+use crate::field::{load_field, FieldError, LoadedField};
 use crate::geo::wgs84::LatLon;
 use crate::geo::Vec2;
 use crate::guidance::progress::JobDefinition;
-use crate::guidance::JobPlan;
 use crate::plan::coverage::metrics::{plan_metrics, PlanMetrics};
 use crate::plan::coverage::{plan_field, CoverageParams, FieldPlan};
-use crate::plan::job::SegmentJob;
+use crate::plan::job::{JobPlan, SegmentJob};
 use crate::plan::types::PlanError;
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// Why the field job could not be prepared. Every variant names the field file; the detail is
 /// the error's source.
@@ -49,15 +51,34 @@ pub enum FieldJobError {
     },
 }
 
-/// Load the field text read from `path` with the configuration's `[field]` options.
-pub fn load_configured(
-    cfg: &Config,
+/// Read, load and plan the field of `planning` (`job.field_path`).
+pub fn load(planning: &FieldPlanning) -> Result<FieldJob, FieldJobError> {
+    let path = &planning.path;
+    let text =
+        crate::store::read_input(path, FileKind::Field).map_err(|e| FieldJobError::Read {
+            path: path.clone(),
+            source: e.into_io(),
+        })?;
+    FieldJob::from_text(planning, path, &text)
+}
+
+/// [`load`] the configuration's field job; [`FieldJobError::NotAFieldJob`] for another kind.
+pub fn load_config(cfg: &Config) -> Result<FieldJob, FieldJobError> {
+    if cfg.job.kind != JobKind::Field {
+        return Err(FieldJobError::NotAFieldJob);
+    }
+    load(&cfg.planning().field)
+}
+
+/// Load the field text read from `path` with the `[field]` loading options.
+pub fn load_text(
+    planning: &FieldPlanning,
     path: &Path,
     text: &str,
 ) -> Result<LoadedField, FieldJobError> {
-    load_field(text, &cfg.field_load_options())
+    load_field(text, &planning.load)
         .and_then(|loaded| {
-            crate::field::check_plan_size(&loaded, &cfg.coverage_params())?;
+            crate::field::check_plan_size(&loaded, &planning.coverage)?;
             Ok(loaded)
         })
         .map_err(|source| FieldJobError::Field {
@@ -78,23 +99,36 @@ pub struct FieldJob {
     pub plan: FieldPlan,
     /// `plan` as the guidance drives it.
     pub job: SegmentJob,
+    /// How long the coverage planning took (loading not included).
+    pub plan_time: Duration,
 }
 
 impl FieldJob {
-    /// Load the field text read from `path` and plan it, all from the configuration.
-    pub fn from_text(cfg: &Config, path: &Path, text: &str) -> Result<FieldJob, FieldJobError> {
-        let loaded = load_configured(cfg, path, text)?;
-        FieldJob::plan(cfg, path, loaded)
+    /// Load the field text read from `path` and plan it.
+    pub fn from_text(
+        planning: &FieldPlanning,
+        path: &Path,
+        text: &str,
+    ) -> Result<FieldJob, FieldJobError> {
+        let loaded = load_text(planning, path, text)?;
+        FieldJob::plan(&planning.coverage, path, loaded)
     }
 
-    /// Plan a loaded field with the configuration's coverage parameters.
-    pub fn plan(cfg: &Config, path: &Path, loaded: LoadedField) -> Result<FieldJob, FieldJobError> {
-        let params = cfg.coverage_params();
-        let plan = plan_field(&loaded.field, &params).map_err(|source| FieldJobError::Plan {
+    /// Plan a loaded field with the coverage parameters `params`.
+    pub fn plan(
+        params: &CoverageParams,
+        path: &Path,
+        loaded: LoadedField,
+    ) -> Result<FieldJob, FieldJobError> {
+        let start = Instant::now();
+        let plan = plan_field(&loaded.field, params).map_err(|source| FieldJobError::Plan {
             path: path.to_path_buf(),
             source,
         })?;
-        FieldJob::from_plan(path, loaded, params, plan)
+        let plan_time = start.elapsed();
+        let mut job = FieldJob::from_plan(path, loaded, params.clone(), plan)?;
+        job.plan_time = plan_time;
+        Ok(job)
     }
 
     /// A job from a plan made elsewhere (for example timed by the caller).
@@ -117,10 +151,11 @@ impl FieldJob {
             params,
             plan,
             job,
+            plan_time: Duration::ZERO,
         })
     }
 
-    /// The plan for [`ControllerNode::with_job`](crate::control::node::ControllerNode::with_job).
+    /// The plan the guidance drives.
     pub fn job_plan(&self) -> JobPlan {
         JobPlan::Segments(self.job.clone())
     }
@@ -128,7 +163,7 @@ impl FieldJob {
     /// The job definition saved with progress: the configuration's job keys and this plan's
     /// checksum. Progress saved under another definition must not be resumed.
     pub fn job_definition(&self, cfg: &Config) -> JobDefinition {
-        JobDefinition::for_job(cfg, &self.job_plan())
+        cfg.job_definition().with_plan(&self.job_plan())
     }
 
     /// The ENU origin of the plan's coordinates. GNSS positions must be converted about this
@@ -183,7 +218,8 @@ mod tests {
         let cfg = demo_field_config();
         assert_eq!(cfg.job.kind, crate::config::JobKind::Field);
         let path = Path::new("demo-field.geojson");
-        let fj = FieldJob::from_text(&cfg, path, &demo_field_text()).expect("demo field plans");
+        let fj = FieldJob::from_text(&cfg.planning().field, path, &demo_field_text())
+            .expect("demo field plans");
         assert_eq!(fj.loaded.field.obstacles.len(), 1, "one power pole");
         assert!(
             fj.plan.swaths > 0 && fj.plan.cells > 0,
@@ -197,7 +233,7 @@ mod tests {
         // The job definition carries this plan's checksum, and a controller accepts the job.
         let def = fj.job_definition(&cfg);
         assert_eq!(def.plan_checksum, Some(fj.job.checksum()));
-        crate::control::node::ControllerNode::with_job(&cfg, fj.job_plan(), None)
+        crate::control::Controller::new(&cfg.control_params(), fj.job_plan(), def, None)
             .expect("the controller takes the field job");
     }
 
@@ -205,9 +241,32 @@ mod tests {
     fn errors_name_the_file() {
         let cfg = demo_field_config();
         let path = Path::new("fields/broken.geojson");
-        let e = FieldJob::from_text(&cfg, path, "not a field").unwrap_err();
+        let e = FieldJob::from_text(&cfg.planning().field, path, "not a field").unwrap_err();
         assert!(matches!(e, FieldJobError::Field { .. }), "{e:?}");
         assert!(e.to_string().contains("fields/broken.geojson"), "{e}");
         assert!(e.to_string().contains("job.field_path"), "{e}");
+    }
+
+    #[test]
+    fn a_missing_field_file_is_named() {
+        let cfg = Config::parse_with(
+            "[job]\nkind = \"field\"\nfield_path = \"/nonexistent/agsteer/field.geojson\"\n",
+            &[],
+        )
+        .unwrap();
+        let e = load_config(&cfg).unwrap_err();
+        assert!(matches!(e, FieldJobError::Read { .. }), "{e:?}");
+        assert!(
+            e.to_string().contains("/nonexistent/agsteer/field.geojson"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn an_ab_job_has_no_field() {
+        assert!(matches!(
+            load_config(&Config::default()),
+            Err(FieldJobError::NotAFieldJob)
+        ));
     }
 }

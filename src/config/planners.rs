@@ -1,7 +1,55 @@
-//! Parameter builders: the edge units of the file (degrees, km/h) converted to the SI
-//! parameter structs of the planners and the supervisor.
+//! The planners' parameters from the file: AB lines, arcs, field coverage and loading,
+//! manoeuvres. Part of [`Config::resolve`]; edge units converted here, once.
 
-use super::{Config, FieldOrigin, SwathAngleChoice};
+use super::{Config, FieldOrigin, LineSide, SwathAngleChoice};
+use crate::geo::v2;
+use crate::plan::abline::AbParams;
+use crate::plan::arcs::ArcsParams;
+use crate::plan::turns::TurnParams;
+
+impl Config {
+    /// The AB planner's parameters (turns planned at [`Config::turn_radius`]).
+    pub fn ab_params(&self) -> AbParams {
+        let (j, g) = (&self.job, &self.guidance);
+        AbParams {
+            point_a: v2(j.point_a_m[0], j.point_a_m[1]),
+            point_b: v2(j.point_b_m[0], j.point_b_m[1]),
+            line_width: j.line_width_m,
+            line_num: j.line_num,
+            r_min: self.turn_radius(),
+            side: match j.side {
+                LineSide::Left => LineSide::Left,
+                LineSide::Right => LineSide::Right,
+            },
+            block_extra: g.a.max(1) as u32,
+            point_spacing: g.point_spacing_m,
+            turn: TurnParams {
+                r_min: self.turn_radius(),
+                arc_step: g.turn_arc_step_deg.to_radians(),
+                merge_distance: g.turn_merge_distance_m,
+                point_spacing: g.point_spacing_m,
+                max_points: g.turn_max_points,
+                max_curvature_rate: self.vehicle.max_curvature_rate_per_m2,
+            },
+        }
+    }
+
+    /// The arcs job's shape (`job.kind = "arcs"`): about `job.point_a_m`, the first line
+    /// starting due South of it, heading East.
+    pub fn arcs_params(&self) -> ArcsParams {
+        let ab = self.ab_params();
+        ArcsParams {
+            centre: ab.point_a,
+            r_inner: self.job.arc_radius_m,
+            width: self.job.line_width_m,
+            lines: self.job.line_num,
+            sweep: self.job.arc_sweep_deg.to_radians(),
+            start_angle: -std::f64::consts::FRAC_PI_2,
+            point_spacing: self.guidance.point_spacing_m,
+            turn: ab.turn,
+        }
+    }
+}
 
 impl Config {
     /// The curve limits of manoeuvres: κ_max = 1 / vehicle.r_min_m, σ_max =
@@ -93,58 +141,6 @@ impl Config {
                 }),
             },
             boundary_tolerance_m: self.field.boundary_tolerance_m,
-        }
-    }
-}
-
-impl Config {
-    /// Control period, s.
-    pub fn dt(&self) -> f64 {
-        self.control.dt_s
-    }
-    /// Driving speed, m/s.
-    pub fn speed(&self) -> f64 {
-        self.control.speed_kmh / 3.6
-    }
-    /// Radius of the planned turns, m: `vehicle.r_min_m`, or more when the job speed would
-    /// need a lateral acceleration above `safety.a_lat_max_m_s2` on it (v² / a_lat_max). The
-    /// supervisor would not allow the tighter turn at that speed, so it is not planned.
-    pub fn turn_radius(&self) -> f64 {
-        let v = self.speed();
-        let a = self.safety.a_lat_max_m_s2;
-        if a > 0.0 && a.is_finite() {
-            self.vehicle.r_min_m.max(v * v / a)
-        } else {
-            self.vehicle.r_min_m
-        }
-    }
-    /// Largest wheel angle, rad.
-    pub fn max_wheel_angle(&self) -> f64 {
-        self.vehicle.max_wheel_angle_deg.to_radians()
-    }
-
-    /// The safety supervisor's parameters, SI.
-    pub fn safety_params(&self) -> crate::safety::SafetyParams {
-        let f = &self.safety;
-        crate::safety::SafetyParams {
-            gnss_timeout: f.gnss_timeout_s,
-            rtk_float_tolerance: f.rtk_float_tolerance_s,
-            wheel_angle_timeout: f.wheel_angle_timeout_s,
-            invalid_threshold: 5,
-            min_speed: f.min_speed_kmh / 3.6,
-            max_stop_time: f.max_stop_time_s,
-            max_speed: f.max_speed_kmh / 3.6,
-            override_angle: f.override_angle_deg.to_radians(),
-            override_time: f.override_time_s,
-            max_engage_xte: f.max_engage_xte_m,
-            max_engage_heading_error: f.max_engage_heading_error_deg.to_radians(),
-            max_wheel_angle: self.max_wheel_angle(),
-            max_wheel_rate: f.max_wheel_rate_deg_s.to_radians(),
-            a_lat_max: f.a_lat_max_m_s2,
-            wheelbase: self.vehicle.wheelbase_m,
-            actuator_dead_time: f.actuator_dead_time_s,
-            actuator_tau: f.actuator_tau_s,
-            actuator_rate: f.actuator_rate_deg_s.to_radians(),
         }
     }
 }

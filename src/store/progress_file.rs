@@ -84,12 +84,12 @@ pub fn load(path: &Path) -> Result<Option<Progress>, ProgressFileError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::guidance::progress::{JobDefinition, Phase, PROGRESS_VERSION};
+    use crate::guidance::progress::{Phase, PROGRESS_VERSION};
 
     fn sample() -> Progress {
         Progress {
             version: PROGRESS_VERSION,
-            job: JobDefinition::from_config(&crate::config::Config::default()),
+            job: crate::config::Config::default().job_definition(),
             index_block: 0,
             index_rank: 3,
             phase: Phase::Work,

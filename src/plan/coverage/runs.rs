@@ -1,0 +1,252 @@
+//! Driving a cell's runs of swaths: the order of the swaths (adjacent ones in turn, or the
+//! seed-000 block skip order of [`crate::plan::skip_order`]), the turns between them from the
+//! canonical-frame turn cache (swath ends pulled back until the turn is clear), the detours
+//! round small obstacles, and the segments in driving order. Called by [`super::plan_field`].
+
+use super::{swaths, transit, CoverageParams, PlanSegment, RouteOrder, SegmentKind};
+use crate::geo::{v2, vec_heading, wrap_angle, Direction, Vec2};
+use crate::plan::types::PlanError;
+
+/// Appends a transit from the vehicle's pose to the start of a path: (segments, pose, path,
+/// cell) → points cut from the path's start.
+pub(super) type GoTo<'a> =
+    dyn FnMut(&mut Vec<PlanSegment>, &mut Option<(Vec2, f64)>, &[Vec2], usize) -> usize + 'a;
+
+/// A clear path between two poses (position, heading) around a small obstacle.
+pub(super) type Detour<'a> = dyn Fn(Vec2, f64, Vec2, f64) -> Option<Vec<Vec2>> + 'a;
+
+/// Largest dimension of an obstacle (greatest distance between two of its vertices), m.
+pub fn obstacle_size(ring: &[Vec2]) -> f64 {
+    let mut size: f64 = 0.0;
+    for (i, a) in ring.iter().enumerate() {
+        for b in &ring[i + 1..] {
+            size = size.max((b - a).norm());
+        }
+    }
+    size
+}
+
+/// Split a straight work piece where the implement would touch a small obstacle: the work
+/// stops `lead` points before the blocked stretch, a detour goes round it and the work resumes
+/// `lead` points after. Pieces that cannot be split are returned whole.
+fn split_for_detours(
+    pts: Vec<Vec2>,
+    lead: usize,
+    r_min: f64,
+    clear: &dyn Fn(&Vec2) -> bool,
+    detour: &Detour<'_>,
+) -> Vec<(SegmentKind, Vec<Vec2>)> {
+    let n = pts.len();
+    let blocked: Vec<usize> = (0..n).filter(|&i| !clear(&pts[i])).collect();
+    if blocked.is_empty() {
+        return vec![(SegmentKind::Work, pts)];
+    }
+    // Blocked stretches, merged when their leads would overlap.
+    let mut stretches: Vec<(usize, usize)> = Vec::new();
+    for &i in &blocked {
+        match stretches.last_mut() {
+            Some(s) if i <= s.1 + 2 * lead + 1 => s.1 = i,
+            _ => stretches.push((i, i)),
+        }
+    }
+    let heading = vec_heading(&(pts[n - 1] - pts[0]));
+    let mut out = Vec::new();
+    let mut start = 0;
+    for (b0, b1) in stretches {
+        // The shortest lead (a quarter of `lead` first, to leave least unworked) whose clear
+        // detour has no loop (adds less than π·r_min to the straight it replaces); else the
+        // detour that adds least.
+        let candidates: Vec<(f64, usize, usize, Vec<Vec2>)> = (1..=4)
+            .filter_map(|q| {
+                let l = (lead * q).div_ceil(4);
+                let (a, b) = (b0.checked_sub(l)?, b1 + l);
+                if b >= n || a <= start {
+                    return None;
+                }
+                let way = detour(pts[a], heading, pts[b], heading)?;
+                let extra = crate::geo::polygon::polyline_length(&way) - (pts[b] - pts[a]).norm();
+                Some((extra, a, b, way))
+            })
+            .collect();
+        let no_loop = candidates
+            .iter()
+            .position(|c| c.0 < std::f64::consts::PI * r_min);
+        let best = no_loop.or_else(|| {
+            (0..candidates.len()).min_by(|&i, &j| candidates[i].0.total_cmp(&candidates[j].0))
+        });
+        let found = best
+            .and_then(|i| candidates.into_iter().nth(i))
+            .map(|(_, a, b, way)| (a, b, way));
+        let Some((a, b, way)) = found else {
+            return vec![(SegmentKind::Work, pts)];
+        };
+        out.push((SegmentKind::Work, pts[start..=a].to_vec()));
+        out.push((SegmentKind::Detour, way));
+        start = b;
+    }
+    out.push((SegmentKind::Work, pts[start..].to_vec()));
+    out
+}
+
+/// The driving order of a run's swaths (indices into the run): adjacent ones in turn when the
+/// spacing allows a U-turn (or the operator chose sequential lines, with fishtails); otherwise
+/// the seed-000 block skip order ([`crate::plan::skip_order`], blocks of `2·min_gap + 1`), so no
+/// turn is tighter than 2·r_min.
+fn run_order(n: usize, spacing: f64, p: &CoverageParams) -> Vec<usize> {
+    use crate::plan::skip_order::{min_gap_lines, skip_order};
+    if p.route == RouteOrder::Sequential {
+        return (0..n).collect();
+    }
+    skip_order(n, min_gap_lines(p.r_min, spacing), 1)
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn drive_run(
+    run: &[swaths::RunSwath],
+    lines: &swaths::SwathLines,
+    angle: f64,
+    cell: usize,
+    p: &CoverageParams,
+    tp: &crate::plan::turns::TurnParams,
+    cache: &mut crate::plan::turns::TurnCache,
+    clear: &dyn Fn(&Vec2) -> bool,
+    segments: &mut Vec<PlanSegment>,
+    at: &mut Option<(Vec2, f64)>,
+    go_to: &mut GoTo<'_>,
+    detour: &Detour<'_>,
+    small_discs: &[(Vec2, f64)],
+) -> Result<(), PlanError> {
+    let order = run_order(run.len(), lines.spacing, p);
+    let here = at.map(|a| a.0);
+    // Start from the end of the first swath nearest the vehicle.
+    let (l0, (a0, b0)) = run[order[0]];
+    let start_left = match here {
+        Some(h) => {
+            let pa = swaths::unrotate(v2(a0, lines.ys[l0]), angle);
+            let pb = swaths::unrotate(v2(b0, lines.ys[l0]), angle);
+            (pa - h).norm() <= (pb - h).norm()
+        }
+        None => true,
+    };
+    // Swath ends in the rotated frame, possibly pulled back to make room for the turns.
+    let mut ends: Vec<(f64, f64)> = order.iter().map(|&i| run[i].1).collect();
+    let mut forward = start_left;
+    let mut pieces: Vec<(SegmentKind, Direction, Vec<Vec2>)> = Vec::new();
+    for (k, &i) in order.iter().enumerate() {
+        let y = lines.ys[run[i].0];
+        let (a, b) = ends[k];
+        let (s, e) = if forward { (a, b) } else { (b, a) };
+        let world = |x: f64, yy: f64| swaths::unrotate(v2(x, yy), angle);
+        pieces.push((
+            SegmentKind::Work,
+            Direction::Forward,
+            transit::straight(world(s, y), world(e, y), p.point_spacing),
+        ));
+        if let Some(&j) = order.get(k + 1) {
+            let y2 = lines.ys[run[j].0];
+            let (a2, b2) = ends[k + 1];
+            let dir = if forward { 1.0 } else { -1.0 };
+            let end2 = if forward { b2 } else { a2 };
+            // Level the two ends at the outer one (the shorter swath runs on to it), then
+            // pull the apex back, shortening the swaths, until the whole turn is clear.
+            let outer = if forward { e.max(end2) } else { e.min(end2) };
+            let inner = if forward { e.min(end2) } else { e.max(end2) };
+            let tries = ((outer - inner).abs() + 4.0 * p.r_min + 2.0 * p.line_width) as usize;
+            let d = swaths::unrotate(v2(dir, 0.0), angle);
+            let mut best = None;
+            for t in 0..=tries {
+                let apex = outer - dir * t as f64;
+                let e_new = if forward { e.min(apex) } else { e.max(apex) };
+                let start2 = if forward {
+                    end2.min(apex)
+                } else {
+                    end2.max(apex)
+                };
+                let mut parts = cache.turn(world(apex, y), d, world(apex, y2), tp)?;
+                let lead_in = world(e_new, y);
+                if let Some(first) = parts.first_mut() {
+                    let mut pts = transit::straight(lead_in, first.points[0], p.point_spacing);
+                    pts.pop();
+                    pts.extend(first.points.iter().copied());
+                    first.points = pts;
+                }
+                if let Some(last) = parts.last_mut() {
+                    let from = *last.points.last().unwrap_or(&lead_in);
+                    let tail = transit::straight(from, world(start2, y2), p.point_spacing);
+                    last.points.extend(tail.into_iter().skip(1));
+                }
+                let ok = parts.iter().all(|t| t.points.iter().all(clear));
+                if ok || best.is_none() {
+                    best = Some((parts, e_new, start2));
+                }
+                if ok {
+                    break;
+                }
+            }
+            let Some((parts, e_new, start2)) = best else {
+                continue;
+            };
+            // This swath ends where its turn begins.
+            if let Some(last) = pieces.last_mut() {
+                last.2 = transit::straight(world(s, y), world(e_new, y), p.point_spacing);
+            }
+            if forward {
+                ends[k + 1].1 = start2;
+            } else {
+                ends[k + 1].0 = start2;
+            }
+            for t in parts {
+                pieces.push((SegmentKind::Turn, t.direction, t.points));
+            }
+        }
+        forward = !forward;
+    }
+    // Detours round the small obstacles on the swaths.
+    let lead = ((2.0 * p.r_min + p.line_width) / p.point_spacing).ceil() as usize;
+    let pieces: Vec<(SegmentKind, Direction, Vec<Vec2>)> = pieces
+        .into_iter()
+        .flat_map(|(kind, direction, pts)| match kind {
+            SegmentKind::Work
+                if pts.len() >= 2
+                    && small_discs.iter().any(|(c, r)| {
+                        crate::geo::polygon::point_segment_distance(c, &pts[0], &pts[pts.len() - 1])
+                            <= *r
+                    }) =>
+            {
+                split_for_detours(pts, lead, p.r_min, clear, detour)
+                    .into_iter()
+                    .map(|(k, pts)| (k, direction, pts))
+                    .collect()
+            }
+            _ => vec![(kind, direction, pts)],
+        })
+        .collect();
+    // Drive: transit to the first swath, then the pieces in order.
+    let mut first = true;
+    for (kind, direction, mut pts) in pieces {
+        if pts.len() < 2 {
+            continue;
+        }
+        if first {
+            let cut = go_to(segments, at, &pts, cell);
+            pts.drain(..cut);
+            first = false;
+        }
+        let n = pts.len();
+        let travel = vec_heading(&(pts[n - 1] - pts[n - 2]));
+        let index = segments.len();
+        segments.push(PlanSegment {
+            kind,
+            direction,
+            index,
+            cell,
+            points: pts.clone(),
+        });
+        let heading = match direction {
+            Direction::Forward => travel,
+            Direction::Reverse => wrap_angle(travel + std::f64::consts::PI),
+        };
+        *at = Some((pts[n - 1], heading));
+    }
+    Ok(())
+}

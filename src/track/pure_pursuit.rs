@@ -1,0 +1,103 @@
+//! Pure pursuit, the seed-000 law: steer onto the arc through the preview point one look-ahead
+//! along the local path. Registered twice: `predictive` (the default: the predicted pose, the
+//! disturbance observer's course and wheel offset, integral action, lost-motion compensation)
+//! and `pure_pursuit` (the plain reference on the latest fix).
+
+use super::law::{LawNeeds, SteeringLaw};
+use super::local_path::LocalPath;
+use super::{lookahead, point_along, TrackOutput, TrackerParams};
+use crate::geo::{cross, heading_vec, Pose};
+
+/// Pure pursuit with what the controller feeds it chosen by `needs`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PurePursuit {
+    pub needs: LawNeeds,
+}
+
+impl PurePursuit {
+    /// The default tracker: pure pursuit on a latency-compensated, dead-reckoned pose, steering
+    /// the course over ground with every compensation on.
+    pub fn predictive() -> Self {
+        PurePursuit {
+            needs: LawNeeds {
+                prediction: true,
+                observer: true,
+                integral: true,
+                lost_motion: true,
+            },
+        }
+    }
+
+    /// The plain seed-000 reference: the latest fix as it is, nothing added.
+    pub fn plain() -> Self {
+        PurePursuit {
+            needs: LawNeeds {
+                prediction: false,
+                observer: false,
+                integral: false,
+                lost_motion: false,
+            },
+        }
+    }
+}
+
+impl SteeringLaw for PurePursuit {
+    fn needs(&self) -> LawNeeds {
+        self.needs
+    }
+
+    fn steer(
+        &self,
+        local: &LocalPath,
+        pose: &Pose,
+        speed: f64,
+        params: &TrackerParams,
+    ) -> TrackOutput {
+        pure_pursuit(local, pose, speed, params)
+    }
+}
+
+/// Seed-000 pure pursuit: from the nearest local point integrate the look-ahead along the
+/// local path to the preview point; α is the angle from the heading to it;
+/// κ = 2·sin α / Ld and δ = atan(L·κ).
+pub fn pure_pursuit(
+    local: &LocalPath,
+    pose: &Pose,
+    speed: f64,
+    params: &TrackerParams,
+) -> TrackOutput {
+    let ld = lookahead(params, speed);
+    let points = local.points();
+    let invalid = TrackOutput {
+        wheel_angle: 0.0,
+        curvature: 0.0,
+        lookahead: ld,
+        target: pose.pos,
+        alpha: 0.0,
+        valid: false,
+    };
+    if points.is_empty()
+        || !pose.pos.x.is_finite()
+        || !pose.pos.y.is_finite()
+        || !pose.heading.is_finite()
+        || !ld.is_finite()
+        || ld <= 0.0
+    {
+        return invalid;
+    }
+    let target = point_along(points, local.index_local(), ld);
+    let to = target - pose.pos;
+    let h = heading_vec(pose.heading);
+    let alpha = cross(&h, &to).atan2(h.dot(&to));
+    let curvature = 2.0 * alpha.sin() / ld;
+    let max = params.max_wheel_angle;
+    let wheel_angle = (params.wheelbase * curvature).atan().clamp(-max, max);
+    TrackOutput {
+        wheel_angle,
+        curvature,
+        lookahead: ld,
+        target,
+        alpha,
+        valid: true,
+    }
+}

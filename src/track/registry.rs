@@ -1,0 +1,85 @@
+//! The one place trackers are registered: the kinds the configuration names (`track.kind`),
+//! their names and their constructors.
+//!
+//! To add a tracker: a variant of [`TrackerKind`] (its configuration name follows from serde's
+//! snake case), its entry in [`TrackerKind::ALL`] and [`TrackerKind::name`], and its arm in
+//! [`law`].
+
+use super::law::{LawParams, SteeringLaw};
+use super::pure_pursuit::PurePursuit;
+use super::stanley::Stanley;
+use serde::{Deserialize, Serialize};
+
+/// Which tracker steers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum TrackerKind {
+    /// Pure pursuit on a latency-compensated, dead-reckoned pose (the default).
+    #[default]
+    Predictive,
+    /// Plain seed-000 pure pursuit on the latest fix: the reference.
+    PurePursuit,
+    /// Stanley steering on the same latency-compensated, dead-reckoned pose.
+    Stanley,
+}
+
+impl TrackerKind {
+    /// Every tracker, the default first.
+    pub const ALL: &'static [TrackerKind] = &[
+        TrackerKind::Predictive,
+        TrackerKind::PurePursuit,
+        TrackerKind::Stanley,
+    ];
+
+    /// The configuration name (`track.kind`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TrackerKind::Predictive => "predictive",
+            TrackerKind::PurePursuit => "pure_pursuit",
+            TrackerKind::Stanley => "stanley",
+        }
+    }
+}
+
+/// The law of `kind` with its gains. Called when a job starts and when it is re-tuned, never
+/// per control period.
+pub fn law(kind: TrackerKind, params: &LawParams) -> Box<dyn SteeringLaw> {
+    match kind {
+        TrackerKind::Predictive => Box::new(PurePursuit::predictive()),
+        TrackerKind::PurePursuit => Box::new(PurePursuit::plain()),
+        TrackerKind::Stanley => Box::new(Stanley::new(params)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_the_configuration_names() {
+        for &k in TrackerKind::ALL {
+            let toml = format!("kind = \"{}\"", k.name());
+            #[derive(Deserialize)]
+            struct T {
+                kind: TrackerKind,
+            }
+            let t: T = toml::from_str(&toml).expect("the name parses");
+            assert_eq!(t.kind, k);
+        }
+    }
+
+    #[test]
+    fn only_the_default_tracker_uses_every_compensation() {
+        let p = LawParams {
+            stanley_gain: 2.5,
+            stanley_soft_speed: 1.0,
+        };
+        let needs = |k| law(k, &p).needs();
+        let d = needs(TrackerKind::Predictive);
+        assert!(d.prediction && d.observer && d.integral && d.lost_motion);
+        let r = needs(TrackerKind::PurePursuit);
+        assert!(!r.prediction && !r.observer && !r.integral && !r.lost_motion);
+        let s = needs(TrackerKind::Stanley);
+        assert!(s.prediction && s.integral && !s.observer && !s.lost_motion);
+    }
+}
