@@ -8,7 +8,6 @@ use agsteer::can::fastpacket::Reassembler;
 use agsteer::can::gnss::GnssPosition;
 use agsteer::can::TimedFrame;
 use agsteer::config::Config;
-use agsteer::control::node::ControllerNode;
 use agsteer::input::can::CanAdapter;
 use agsteer::input::Input;
 use std::f64::consts::{PI, TAU};
@@ -134,7 +133,7 @@ fn the_stopped_receivers_cog_is_absent_not_6_55_rad() {
 fn the_node_takes_every_frame_and_its_inputs_hold_no_absent_numbers() {
     let cfg = Config::default();
     for name in LOGS {
-        let mut node = ControllerNode::new(&cfg, None).unwrap();
+        let mut node = agsteer::job::node_for_config(&cfg, None).unwrap();
         let mut adapter = CanAdapter::default();
         let mut out = Vec::new();
         let mut last_tick = 0.0;

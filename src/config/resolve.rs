@@ -125,14 +125,21 @@ impl Config {
         if !problems.is_empty() {
             return Err(ConfigError::Invalid(problems));
         }
-        Ok(Resolved {
+        Ok(self.resolved())
+    }
+
+    /// Every consumer's parameters, unchecked: for a configuration validated already
+    /// ([`Config::load`] does) or built in code (a test's variation, the demo's scenarios),
+    /// taken as it is.
+    pub fn resolved(&self) -> Resolved {
+        Resolved {
             planning: self.planning(),
             control: self.control_params(),
             safety: self.safety_params(),
             bus: self.bus_params(),
             sim: self.sim_setup(),
             daemon: self.daemon_params(),
-        })
+        }
     }
 
     /// What job to plan and how.

@@ -381,7 +381,7 @@ pub fn run(
     on_event: &mut dyn FnMut(f64, &Event),
 ) -> Result<DemoRun, JobError> {
     let wall = std::time::Instant::now();
-    let resolved = cfg.resolve()?;
+    let resolved = cfg.resolved();
     // The job given, or the configured one, set up as agsteerd sets it up.
     let job = match (&opts.prepared, &opts.job) {
         (Some(prepared), _) => prepared.clone(),

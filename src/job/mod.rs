@@ -118,9 +118,9 @@ pub fn prepare(planning: &Planning) -> Result<PreparedJob, JobError> {
     })
 }
 
-/// [`prepare`] the job of a configuration.
+/// [`prepare`] the job of a configuration (taken as it is: see [`Config::resolved`]).
 pub fn prepare_config(cfg: &Config) -> Result<PreparedJob, JobError> {
-    prepare(&cfg.resolve()?.planning)
+    prepare(&cfg.planning())
 }
 
 /// The job `plan` given by a caller (for example a field plan made elsewhere) as a prepared
@@ -164,12 +164,13 @@ pub fn build_node(
     Ok(node)
 }
 
-/// The controller node of a configuration's job, new or continuing `resume`.
+/// The controller node of a configuration's job (taken as it is: see [`Config::resolved`]),
+/// new or continuing `resume`.
 pub fn node_for_config(
     cfg: &Config,
     resume: Option<&Progress>,
 ) -> Result<ControllerNode, JobError> {
-    let resolved = cfg.resolve()?;
+    let resolved = cfg.resolved();
     let job = prepare(&resolved.planning)?;
     Ok(build_node(&resolved, &job, resume)?)
 }
