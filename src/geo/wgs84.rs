@@ -75,15 +75,29 @@ pub fn centre(points: &[LatLon]) -> Option<LatLon> {
     let first = points.first()?;
     let (mut lat0, mut lat1, mut lon0, mut lon1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for p in points {
-        let lon = first.lon_deg + wrap_lon_deg(p.lon_deg - first.lon_deg);
+        // Moved by a whole turn only when the short way round crosses the antimeridian, so a
+        // field elsewhere keeps its longitudes to the last bit.
+        let d = p.lon_deg - first.lon_deg;
+        let lon = if d > 180.0 {
+            p.lon_deg - 360.0
+        } else if d < -180.0 {
+            p.lon_deg + 360.0
+        } else {
+            p.lon_deg
+        };
         lat0 = lat0.min(p.lat_deg);
         lat1 = lat1.max(p.lat_deg);
         lon0 = lon0.min(lon);
         lon1 = lon1.max(lon);
     }
+    let lon = 0.5 * (lon0 + lon1);
     Some(LatLon {
         lat_deg: 0.5 * (lat0 + lat1),
-        lon_deg: wrap_lon_deg(0.5 * (lon0 + lon1)),
+        lon_deg: if (-180.0..=180.0).contains(&lon) {
+            lon
+        } else {
+            wrap_lon_deg(lon)
+        },
     })
 }
 

@@ -6,6 +6,7 @@ mod maneuver_cmd;
 mod plan_cmd;
 mod replay_cmd;
 mod sim_cmd;
+mod status_cmd;
 
 use agsteer::config::{Config, JobKind};
 use agsteer::demo::{self, DemoOptions};
@@ -161,6 +162,10 @@ enum Command {
         /// Configuration file naming the socket.
         #[arg(long, default_value = "/etc/agsteer/agsteer.toml")]
         config: PathBuf,
+        /// Overall deadline for connecting and reading the whole reply, s (the reply is also
+        /// limited to 1 MiB).
+        #[arg(long, default_value_t = 2.0)]
+        timeout_s: f64,
     },
     /// The DBC codec: decode candump logs, encode frames, print the frame table.
     Dbc {
@@ -357,12 +362,16 @@ fn main() -> ExitCode {
                 },
             )
         }),
-        Command::Status { socket, config } => {
+        Command::Status {
+            socket,
+            config,
+            timeout_s,
+        } => {
             let path = match socket {
                 Some(p) => Ok(p),
                 None => load_config(&config, &[]).map(|c| PathBuf::from(c.bus.status_socket)),
             };
-            path.and_then(|p| sim_cmd::status(&p))
+            path.and_then(|p| status_cmd::status(&p, timeout_s))
         }
     };
     match result {

@@ -141,24 +141,3 @@ fn job_kind_name(kind: JobKind) -> &'static str {
         JobKind::Maneuver => "maneuver",
     }
 }
-
-/// `agsteer status`: ask the daemon's status socket.
-pub fn status(socket: &Path) -> Result<u8> {
-    use std::io::Read;
-    let s = std::os::unix::net::UnixStream::connect(socket)
-        .with_context(|| format!("connecting to {}", socket.display()))?;
-    s.set_read_timeout(Some(Duration::from_secs(2)))?;
-    let mut text = String::new();
-    // A status reply is a few kB; a peer that streams without end is cut at 1 MiB.
-    const MAX_REPLY_BYTES: u64 = 1024 * 1024;
-    s.take(MAX_REPLY_BYTES + 1).read_to_string(&mut text)?;
-    if text.len() as u64 > MAX_REPLY_BYTES {
-        anyhow::bail!(
-            "status reply from {} over {MAX_REPLY_BYTES} bytes",
-            socket.display()
-        );
-    }
-    let v: serde_json::Value = serde_json::from_str(text.trim()).context("status reply")?;
-    println!("{}", serde_json::to_string_pretty(&v)?);
-    Ok(0)
-}
