@@ -2,8 +2,8 @@
 //! saves leaves the old or the new file, never a torn one, and the temp files it leaves are
 //! swept on the next load.
 
-use agsteer::store::progress_file;
 use agsteer::guidance::progress::{Phase, Progress, PROGRESS_VERSION};
+use agsteer::store::progress_file;
 use rand::{Rng, SeedableRng};
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
