@@ -6,6 +6,7 @@ mod maneuver_cmd;
 mod plan_cmd;
 mod replay_cmd;
 mod sim_cmd;
+mod sim_gnss;
 mod status_cmd;
 
 use agsteer::config::{Config, JobKind};
@@ -119,6 +120,22 @@ enum Command {
         /// the simulated sensors.
         #[arg(long, default_value_t = 0)]
         rt_priority: u8,
+        /// Be a serial GNSS receiver: make a pseudo-terminal and a symbolic link LINK to its
+        /// device (agsteerd's `gnss.device = LINK`); GNSS leaves there as NMEA 0183 or UBX
+        /// (`--gnss-messages`) instead of NMEA 2000 frames on the bus.
+        #[arg(long, value_name = "LINK")]
+        gnss_pty: Option<PathBuf>,
+        /// Be a UDP GNSS receiver: one datagram per epoch to ADDR (e.g. 127.0.0.1:9999;
+        /// agsteerd's `gnss.transport = "udp"`), instead of NMEA 2000 frames on the bus.
+        #[arg(long, value_name = "ADDR", conflicts_with = "gnss_pty")]
+        gnss_udp: Option<std::net::SocketAddr>,
+        /// Messages of an epoch, in sending order: gga, rmc, vtg, hdt, paogi (NMEA 0183),
+        /// nav-pvt, nav-hpposllh, nav-relposned (UBX).
+        #[arg(long, value_name = "LIST", default_value = "gga,rmc,hdt")]
+        gnss_messages: String,
+        /// With --gnss-pty or --gnss-udp: write each epoch's send time (UTC s) here (CSV).
+        #[arg(long, value_name = "FILE")]
+        gnss_log: Option<PathBuf>,
         #[command(flatten)]
         cfg: ConfigArgs,
     },
@@ -326,9 +343,20 @@ fn main() -> ExitCode {
             trajectory,
             duration,
             rt_priority,
+            gnss_pty,
+            gnss_udp,
+            gnss_messages,
+            gnss_log,
             cfg,
         } => load_config(&config, &cfg.set).and_then(|c| {
             let iface = iface.unwrap_or_else(|| c.bus.interface.clone());
+            let gnss = sim_cmd::SimGnssArgs {
+                pty: gnss_pty,
+                udp: gnss_udp,
+                messages: agsteer::sim::gnss_stream::parse_messages(&gnss_messages)
+                    .context("--gnss-messages")?,
+                log: gnss_log,
+            };
             sim_cmd::run(
                 &iface,
                 &c,
@@ -336,6 +364,7 @@ fn main() -> ExitCode {
                 trajectory.as_deref(),
                 duration,
                 rt_priority,
+                &gnss,
             )
         }),
         Command::Replay {

@@ -1,5 +1,7 @@
 //! `agsteer sim`: the vehicle simulator on a CAN interface, in real time.
 
+use crate::sim_gnss::GnssOut;
+pub use crate::sim_gnss::SimGnssArgs;
 use agsteer::can::bus::{monotonic_s, CanBus, SocketCanBus};
 use agsteer::can::Frame;
 use agsteer::config::{Config, JobKind};
@@ -23,6 +25,7 @@ pub fn run(
     trajectory: Option<&Path>,
     duration_s: Option<f64>,
     realtime_priority: u8,
+    gnss: &SimGnssArgs,
 ) -> Result<u8> {
     // The simulator stands in for sensors that are separate devices on a real bus.
     agsteer::daemon::run::set_realtime_priority(realtime_priority);
@@ -61,6 +64,10 @@ pub fn run(
         scenario,
     )
     .with_speed_profile(setup.speed_profile);
+    let gnss_sink = gnss.sink()?;
+    if gnss_sink.is_some() {
+        node = node.with_gnss_off_bus();
+    }
     let mut bus =
         SocketCanBus::open(iface, &[]).with_context(|| format!("opening CAN interface {iface}"))?;
     let mut traj = match trajectory {
@@ -77,6 +84,16 @@ pub fn run(
         None => None,
     };
     let t0 = monotonic_s();
+    let mut gnss_out = match gnss_sink {
+        Some(sink) => Some(GnssOut::new(
+            sink,
+            gnss.messages.clone(),
+            enu,
+            t0,
+            gnss.log.as_deref(),
+        )?),
+        None => None,
+    };
     let mut frames: Vec<(f64, Frame)> = Vec::with_capacity(64);
     let mut next_traj = 0.0;
     let mut send_errors = 0u64;
@@ -92,6 +109,9 @@ pub fn run(
             if bus.send(f).is_err() {
                 send_errors += 1;
             }
+        }
+        if let Some(g) = gnss_out.as_mut() {
+            g.pump(&mut node)?;
         }
         loop {
             match bus.try_recv() {
@@ -127,6 +147,8 @@ pub fn run(
     tracing::info!(
         rejected_commands = node.rejected(),
         send_errors,
+        gnss_epochs = gnss_out.as_ref().map_or(0, |g| g.epochs),
+        gnss_epochs_unsent = gnss_out.as_ref().map_or(0, |g| g.unsent),
         "simulator stopped"
     );
     Ok(0)
