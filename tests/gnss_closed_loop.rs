@@ -1,0 +1,486 @@
+//! The AB job closed-loop in real time with GNSS on a real serial path: the simulator writes
+//! NMEA 0183 (or UBX) to a pseudo-terminal or in UDP datagrams, and the controller reads them
+//! through the daemon's own GNSS task (`daemon::gnss::spawn`, the `[gnss]` stream), while wheel
+//! angle, speed, operator and steering frames go over an in-memory bus (this host's kernel has
+//! no CAN; the same run on vcan is in `vcan_tests`). Scored on the simulator's true trajectory
+//! against the same job with GNSS as NMEA 2000 frames on the bus.
+//!
+//! The control loop is the daemon's: a timer every `dt` on the latest inputs, GNSS inputs taken
+//! as they arrive. Everything runs in real time (the stream stamps its receipts on the
+//! monotonic clock and measures latency from the sentences' UTC), so figures vary a little
+//! from run to run; bounds leave room for a loaded 2-core host.
+
+use agsteer::can::bus::monotonic_s;
+use agsteer::can::codec::{OperatorCommand, OperatorCommandCommand, Packer};
+use agsteer::can::{Frame, TimedFrame};
+use agsteer::config::Config;
+use agsteer::geo::{left_normal, signed_offset, v2, Pose};
+use agsteer::input::Input;
+use agsteer::io::pty::Pty;
+use agsteer::plan::abline::AbPlan;
+use agsteer::safety::FaultCode;
+use agsteer::sim::can_node::{Scenario, SimAddresses, SimNode};
+use agsteer::sim::gnss_stream::{GnssStreamEncoder, GnssStreamParams, DEFAULT_NMEA};
+use agsteer::sim::{GnssMeasurement, Simulator};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc};
+use std::time::Duration;
+
+const CONFIG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/config/vcan.toml");
+/// The PGN 129025 (position, rapid update) part of an identifier.
+const POSITION_RAPID: u32 = 0x01F8_0100;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum GnssPath {
+    /// NMEA 2000 frames on the bus (the all-CAN reference).
+    Can,
+    /// NMEA 0183 on a pseudo-terminal behind a `/dev/serial/by-id`-style link.
+    Pty,
+    /// NMEA 0183 in UDP datagrams to this port on loopback.
+    Udp(u16),
+}
+
+/// Unplug the receiver `at_s` into the run (its device disappears), plug one back `for_s`
+/// later behind the same link.
+#[derive(Debug, Clone, Copy)]
+struct Unplug {
+    at_s: f64,
+    for_s: f64,
+}
+
+#[derive(Debug, Default)]
+struct Outcome {
+    finished: bool,
+    /// True |XTE| on the work lines: (rms, p95, max, samples), m.
+    xte: (f64, f64, f64, usize),
+    reengaged: u32,
+    /// GNSS sent (position frame or epoch written) → the next command frame, s.
+    fix_to_command: Vec<f64>,
+    /// Epoch written → its position input reaching the control loop, s (streams only).
+    transport: Vec<f64>,
+    /// Unplug → first disengaged command, s, and the fault then.
+    unplug: Option<(f64, FaultCode)>,
+    /// Replug → first position input, s.
+    replug_to_fix: Option<f64>,
+    stream: Option<agsteer::io::transport::StreamStatus>,
+    /// The fixes' latency the stream measured from the sentences' UTC, s.
+    fix_latency: Vec<f64>,
+}
+
+fn config(path: GnssPath, dir: &Path, extra: &[&str]) -> Config {
+    let mut set: Vec<String> = extra.iter().map(|s| s.to_string()).collect();
+    // Quick reopening for the replug; the rest is [gnss]'s defaults.
+    set.push("gnss.backoff_min_s=0.05".into());
+    set.push("gnss.backoff_max_s=0.2".into());
+    match path {
+        GnssPath::Can => {}
+        GnssPath::Pty => {
+            set.push("gnss.source=\"nmea0183\"".into());
+            set.push("gnss.transport=\"serial\"".into());
+            set.push(format!("gnss.device=\"{}\"", link_path(dir).display()));
+        }
+        GnssPath::Udp(port) => {
+            set.push("gnss.source=\"nmea0183\"".into());
+            set.push("gnss.transport=\"udp\"".into());
+            set.push("gnss.udp_bind=\"127.0.0.1\"".into());
+            set.push(format!("gnss.udp_port={port}"));
+            set.push("gnss.udp_source=\"127.0.0.1\"".into());
+        }
+    }
+    Config::load(Path::new(CONFIG), &set).unwrap()
+}
+
+fn link_path(dir: &Path) -> PathBuf {
+    dir.join("usb-u-blox_AG_-_www.u-blox.com_u-blox_GNSS_receiver-if00")
+}
+
+/// The simulated receiver's device or socket.
+enum Sink {
+    None,
+    Pty(Option<Pty>, PathBuf),
+    Udp(std::net::UdpSocket, u16),
+}
+
+impl Sink {
+    fn plug(link: &Path) -> Pty {
+        let pty = Pty::open().unwrap();
+        pty.set_nonblocking().unwrap();
+        let _ = std::fs::remove_file(link);
+        std::os::unix::fs::symlink(pty.path(), link).unwrap();
+        pty
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        match self {
+            Sink::None | Sink::Pty(None, _) => {}
+            Sink::Pty(Some(p), _) => {
+                let _ = p.master().write_all(bytes);
+            }
+            Sink::Udp(s, port) => {
+                let _ = s.send_to(bytes, ("127.0.0.1", *port));
+            }
+        }
+    }
+}
+
+/// What the simulator thread saw.
+#[derive(Default)]
+struct SimRecord {
+    /// (t, x, y, engaged) every 50 ms.
+    trajectory: Vec<(f64, f64, f64, bool)>,
+    /// Monotonic time of each GNSS send.
+    gnss_sent: Vec<f64>,
+    unplugged_at: Option<f64>,
+    replugged_at: Option<f64>,
+}
+
+/// The simulator in real time, as `agsteer sim` runs it: sensors every 2 ms.
+fn simulate(
+    cfg: &Config,
+    path: GnssPath,
+    dir: &Path,
+    unplug: Option<Unplug>,
+    to_ctrl: mpsc::Sender<TimedFrame>,
+    from_ctrl: mpsc::Receiver<TimedFrame>,
+    stop: Arc<AtomicBool>,
+) -> SimRecord {
+    let (a, b) = (
+        v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]),
+        v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]),
+    );
+    let dir_ab = (b - a).normalize();
+    let p = a + left_normal(&dir_ab) * cfg.sim.start_offset_m;
+    let start = Pose::new(
+        p.x,
+        p.y,
+        dir_ab.y.atan2(dir_ab.x) + cfg.sim.start_heading_deg.to_radians(),
+    );
+    let enu = agsteer::geo::wgs84::EnuFrame::new(agsteer::geo::wgs84::LatLon {
+        lat_deg: cfg.job.origin_lat_deg,
+        lon_deg: cfg.job.origin_lon_deg,
+    });
+    let mut node = SimNode::new(
+        Simulator::new(agsteer::demo::sim_params(cfg), start, cfg.speed()),
+        enu,
+        SimAddresses::default(),
+        Scenario::default(),
+    );
+    let mut sink = match path {
+        GnssPath::Can => Sink::None,
+        GnssPath::Pty => Sink::Pty(Some(Sink::plug(&link_path(dir))), link_path(dir)),
+        GnssPath::Udp(port) => Sink::Udp(std::net::UdpSocket::bind("127.0.0.1:0").unwrap(), port),
+    };
+    if path != GnssPath::Can {
+        node = node.with_gnss_off_bus();
+    }
+    let t0 = monotonic_s();
+    let utc_now = || {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_secs_f64()
+    };
+    let mut encoder =
+        GnssStreamEncoder::new(GnssStreamParams::new(DEFAULT_NMEA.to_vec(), utc_now()), enu);
+    let mut rec = SimRecord::default();
+    let (mut frames, mut epochs, mut bytes) =
+        (Vec::new(), Vec::<GnssMeasurement>::new(), Vec::new());
+    let mut next_sample = 0.0;
+    while !stop.load(Ordering::Relaxed) {
+        let t = monotonic_s() - t0;
+        frames.clear();
+        node.advance_to(t, &mut frames);
+        for (_, f) in &frames {
+            let now = monotonic_s();
+            if f.id & 0x03FF_FF00 == POSITION_RAPID {
+                rec.gnss_sent.push(now);
+            }
+            let _ = to_ctrl.send(TimedFrame { t: now, frame: *f });
+        }
+        epochs.clear();
+        node.drain_gnss(&mut epochs);
+        for m in &epochs {
+            bytes.clear();
+            encoder.encode(m, &mut bytes);
+            // Stamped before the write: the reader may have it before this thread goes on.
+            rec.gnss_sent.push(monotonic_s());
+            sink.write(&bytes);
+        }
+        while let Ok(tf) = from_ctrl.try_recv() {
+            node.on_frame(&tf);
+        }
+        if let (Some(u), Sink::Pty(pty, link)) = (unplug, &mut sink) {
+            if t >= u.at_s && rec.unplugged_at.is_none() {
+                // The USB device disappears: its node and its link go.
+                *pty = None;
+                let _ = std::fs::remove_file(&*link);
+                rec.unplugged_at = Some(monotonic_s());
+            }
+            if t >= u.at_s + u.for_s && rec.replugged_at.is_none() {
+                *pty = Some(Sink::plug(link));
+                rec.replugged_at = Some(monotonic_s());
+            }
+        }
+        if t >= next_sample {
+            let s = node.sim().true_state();
+            rec.trajectory
+                .push((t, s.pose.pos.x, s.pose.pos.y, node.engaged()));
+            next_sample = t + 0.05;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    rec
+}
+
+/// One job, closed-loop in real time, for at most `max_s`.
+fn run_job(path: GnssPath, extra: &[&str], unplug: Option<Unplug>, max_s: f64) -> Outcome {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = config(path, dir.path(), extra);
+    let dt = cfg.dt();
+    let (to_ctrl, from_sim) = mpsc::channel();
+    let (to_sim, from_ctrl) = mpsc::channel();
+    let stop = Arc::new(AtomicBool::new(false));
+    let sim = {
+        let (cfg, stop, dir) = (cfg.clone(), stop.clone(), dir.path().to_path_buf());
+        std::thread::spawn(move || simulate(&cfg, path, &dir, unplug, to_ctrl, from_ctrl, stop))
+    };
+    let mut node = agsteer::control::node::ControllerNode::new(&cfg, None).unwrap();
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    let local = tokio::task::LocalSet::new();
+    let mut gnss = agsteer::daemon::gnss::spawn(&cfg, &local).unwrap();
+    let mut terminal = Packer::new(0x26);
+    let mut out = Outcome::default();
+    // (tick time, engaged, fault), and position inputs' arrival times.
+    let mut ticks: Vec<(f64, bool, FaultCode)> = Vec::new();
+    let mut arrivals: Vec<f64> = Vec::new();
+    let mut frames: Vec<Frame> = Vec::with_capacity(8);
+    let mut engaged_once = false;
+    local.block_on(&rt, async {
+        let mut interval = tokio::time::interval(Duration::from_secs_f64(dt));
+        interval.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+        let t_start = monotonic_s();
+        loop {
+            tokio::select! {
+                biased;
+                _ = interval.tick() => {
+                    let t = monotonic_s();
+                    while let Ok(tf) = from_sim.try_recv() {
+                        node.on_frame(&tf);
+                    }
+                    let st = node.status();
+                    if !st.engaged && st.state == agsteer::safety::SafetyState::Ready {
+                        // The operator presses engage (again after a fault).
+                        if let Ok(f) = terminal.pack(&OperatorCommand {
+                            command: Some(OperatorCommandCommand::Engage),
+                            nudge: Some(0.0),
+                            job: Some(0.0),
+                        }) {
+                            node.on_frame(&TimedFrame { t, frame: f });
+                            out.reengaged += engaged_once as u32;
+                        }
+                    }
+                    frames.clear();
+                    let cmd = node.tick(t, &mut frames);
+                    engaged_once |= cmd.engaged;
+                    ticks.push((monotonic_s(), cmd.engaged, cmd.fault));
+                    for f in &frames {
+                        let _ = to_sim.send(TimedFrame { t: monotonic_s(), frame: *f });
+                    }
+                    if node.status().finished || t - t_start > max_s {
+                        break;
+                    }
+                }
+                input = async {
+                    match gnss.as_mut() {
+                        Some(g) => g.inputs.recv().await,
+                        None => std::future::pending().await,
+                    }
+                } => {
+                    if let Some(i) = input {
+                        if let Input::Position(p) = &i {
+                            arrivals.push(monotonic_s());
+                            if let Some(l) = p.latency_s {
+                                out.fix_latency.push(l);
+                            }
+                        }
+                        node.on_input(&i);
+                    }
+                }
+            }
+        }
+    });
+    out.finished = node.status().finished;
+    out.stream = gnss.as_ref().map(|g| g.status(monotonic_s()).stream);
+    stop.store(true, Ordering::Relaxed);
+    let rec = sim.join().unwrap();
+    // Each GNSS send → the first command after it; → its input's arrival (streams).
+    let next_tick = |t: f64| ticks.iter().find(|k| k.0 >= t).map(|k| k.0 - t);
+    let on_line = |t: f64| {
+        rec.unplugged_at
+            .is_none_or(|u| t < u - 0.5 || t > rec.replugged_at.unwrap_or(f64::MAX) + 2.0)
+    };
+    for &s in rec.gnss_sent.iter().filter(|&&s| on_line(s)) {
+        if let Some(l) = next_tick(s) {
+            out.fix_to_command.push(l);
+        }
+        if path != GnssPath::Can {
+            if let Some(a) = arrivals.iter().find(|&&a| a >= s) {
+                out.transport.push(a - s);
+            }
+        }
+    }
+    if let Some(u) = rec.unplugged_at {
+        out.unplug = ticks
+            .iter()
+            .find(|k| k.0 >= u && !k.1)
+            .map(|k| (k.0 - u, k.2));
+    }
+    if let Some(r) = rec.replugged_at {
+        out.replug_to_fix = arrivals.iter().find(|&&a| a >= r).map(|a| a - r);
+    }
+    out.xte = xte(&cfg, &rec.trajectory);
+    out
+}
+
+/// True |XTE| on the work lines, 10 m at each line end excluded (as `vcan_tests`).
+fn xte(cfg: &Config, traj: &[(f64, f64, f64, bool)]) -> (f64, f64, f64, usize) {
+    let plan = AbPlan::new(agsteer::control::ab_params(cfg)).unwrap();
+    let (a, b) = plan.line_endpoints(0, false);
+    let dir = (b - a).normalize();
+    let mut xs: Vec<f64> = traj
+        .iter()
+        .filter(|s| s.3)
+        .filter_map(|&(_, x, y, _)| {
+            let p = v2(x, y);
+            let along = (p - a).dot(&dir);
+            if along < 10.0 || along > plan.line_length() - 10.0 {
+                return None;
+            }
+            (0..cfg.job.line_num)
+                .map(|i| signed_offset(&p, &plan.line_endpoints(i, false).0, &dir).abs())
+                .min_by(|x, y| x.total_cmp(y))
+        })
+        .collect();
+    xs.sort_by(|a, b| a.total_cmp(b));
+    let n = xs.len();
+    if n == 0 {
+        return (f64::NAN, f64::NAN, f64::NAN, 0);
+    }
+    let rms = (xs.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
+    (rms, pct(&xs, 0.95), xs[n - 1], n)
+}
+
+fn pct(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    sorted[((sorted.len() as f64 * p) as usize).min(sorted.len() - 1)]
+}
+
+fn print(name: &str, o: &mut Outcome) {
+    o.fix_to_command.sort_by(|a, b| a.total_cmp(b));
+    o.transport.sort_by(|a, b| a.total_cmp(b));
+    o.fix_latency.sort_by(|a, b| a.total_cmp(b));
+    println!(
+        "GNSS-LOOP {name}: finished={} reengaged={} XTE rms_m={:.4} p95_m={:.4} max_m={:.4} \
+         samples={}; fix→command median_ms={:.2} p99_ms={:.2} over {}; \
+         write→input median_ms={:.2} p99_ms={:.2}; measured fix latency median_ms={:.1}",
+        o.finished,
+        o.reengaged,
+        o.xte.0,
+        o.xte.1,
+        o.xte.2,
+        o.xte.3,
+        pct(&o.fix_to_command, 0.5) * 1e3,
+        pct(&o.fix_to_command, 0.99) * 1e3,
+        o.fix_to_command.len(),
+        pct(&o.transport, 0.5) * 1e3,
+        pct(&o.transport, 0.99) * 1e3,
+        pct(&o.fix_latency, 0.5) * 1e3,
+    );
+}
+
+/// A free UDP port on loopback (bound, then released for the stream to take).
+fn free_udp_port() -> u16 {
+    std::net::UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
+}
+
+/// Two 60 m lines: 40 m of each scored.
+const JOB: [&str; 2] = ["job.point_b_m=[0.0, 60.0]", "job.line_num=2"];
+
+#[test]
+fn ab_job_with_gnss_on_a_pty_tracks_within_twice_the_all_can_xte() {
+    let mut can = run_job(GnssPath::Can, &JOB, None, 120.0);
+    print("can", &mut can);
+    let mut pty = run_job(GnssPath::Pty, &JOB, None, 120.0);
+    print("pty", &mut pty);
+    assert!(can.finished && pty.finished, "both jobs finish");
+    assert!(can.xte.3 > 500 && pty.xte.3 > 500, "samples on the lines");
+    // The all-CAN run is itself a few millimetres; a millimetre of floor keeps the ratio from
+    // judging sub-millimetre noise.
+    assert!(
+        pty.xte.0 <= 2.0 * can.xte.0.max(0.001),
+        "pty XTE RMS {} vs all-CAN {}",
+        pty.xte.0,
+        can.xte.0
+    );
+    assert_eq!(pty.reengaged, 0, "no disengage on the pty path");
+    let s = pty.stream.as_ref().unwrap();
+    assert_eq!(s.checksum_errors, 0, "{s:?}");
+    assert_eq!(s.reconnects, 0, "{s:?}");
+    // The fixes' latency measured from the sentences' UTC: the simulator's 50 ms plus the
+    // path (host clock and the simulator's are the same clock here), to the sentences'
+    // centisecond.
+    let median = pct(&pty.fix_latency, 0.5);
+    assert!((0.04..0.1).contains(&median), "fix latency {median}");
+    // The command after a fix: the loop runs on a timer, so within a period of its arrival.
+    let dt = 0.01;
+    assert!(pct(&pty.fix_to_command, 0.5) <= dt + 0.002);
+}
+
+#[test]
+fn ab_job_with_gnss_over_udp() {
+    let mut udp = run_job(GnssPath::Udp(free_udp_port()), &JOB, None, 120.0);
+    print("udp", &mut udp);
+    assert!(udp.finished);
+    assert!(udp.xte.3 > 500);
+    // Within 2× of the all-CAN figure measured in the pty test (a few mm; the bound is 2 cm).
+    assert!(udp.xte.0 < 0.02, "{}", udp.xte.0);
+    assert_eq!(udp.reengaged, 0);
+    assert!(udp.stream.as_ref().unwrap().counters.decoded > 0);
+}
+
+/// The receiver unplugged mid-line: the GNSS timeout reaches the safe state in time; plugged
+/// back behind the same link, fixes return and the operator's engage finishes the job.
+#[test]
+fn receiver_unplugged_mid_line_disengages_within_the_gnss_timeout() {
+    let unplug = Unplug {
+        at_s: 12.0,
+        for_s: 2.0,
+    };
+    let mut o = run_job(GnssPath::Pty, &JOB, Some(unplug), 150.0);
+    print("pty-unplug", &mut o);
+    let (to_safe, fault) = o.unplug.expect("disengaged after the unplug");
+    let replug = o.replug_to_fix.expect("fixes after the replug");
+    println!(
+        "GNSS-UNPLUG time_to_safe_ms={:.1} fault={fault:?} replug_to_first_fix_ms={:.1} reconnects={}",
+        to_safe * 1e3,
+        replug * 1e3,
+        o.stream.as_ref().map_or(0, |s| s.reconnects)
+    );
+    assert_eq!(fault, FaultCode::GnssTimeout);
+    // gnss_timeout_s (0.3 s) after the last fix, which came up to a GNSS period before the
+    // unplug, plus a control period; 50 ms more for a loaded host's scheduling.
+    assert!(to_safe <= 0.3 + 0.01 + 0.05, "{to_safe}");
+    assert!(o.finished, "the job finishes after the operator re-engages");
+    assert_eq!(o.reengaged, 1);
+    assert!(o.stream.as_ref().unwrap().reconnects >= 1);
+}
