@@ -25,7 +25,11 @@ use agsteer::sim::{GnssMeasurement, Simulator};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{mpsc, Arc};
+use std::sync::{mpsc, Arc, Mutex};
+
+#[path = "common/caster.rs"]
+mod caster;
+use caster::{Caster, MOUNT, PASSWORD, USER};
 use std::time::Duration;
 
 const CONFIG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/config/vcan.toml");
@@ -42,12 +46,25 @@ enum GnssPath {
     Udp(u16),
 }
 
-/// Unplug the receiver `at_s` into the run (its device disappears), plug one back `for_s`
-/// later behind the same link.
+/// A fault `at_s` into the run, undone `for_s` later.
 #[derive(Debug, Clone, Copy)]
-struct Unplug {
+struct Cut {
     at_s: f64,
     for_s: f64,
+    what: CutKind,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum CutKind {
+    /// The receiver is unplugged (a pty's device and link disappear; UDP datagrams stop),
+    /// then plugged back behind the same link.
+    Receiver,
+    /// The NTRIP caster is killed, then started again on the same port.
+    Caster,
+    /// The fixes stop and bad input takes their place: binary garbage, sentences with a wrong
+    /// checksum, truncated ones and replays of the last good epoch (on the pty at 100 kB/s;
+    /// over UDP a flood of 1400-byte datagrams, far above `gnss.max_rate_bytes_s`).
+    Garbage,
 }
 
 #[derive(Debug, Default)]
@@ -60,10 +77,13 @@ struct Outcome {
     fix_to_command: Vec<f64>,
     /// Epoch written → its position input reaching the control loop, s (streams only).
     transport: Vec<f64>,
-    /// Unplug → first disengaged command, s, and the fault then.
-    unplug: Option<(f64, FaultCode)>,
-    /// Replug → first position input, s.
-    replug_to_fix: Option<f64>,
+    /// Cut → first disengaged command, s, and the fault then.
+    cut: Option<(f64, FaultCode)>,
+    /// Cut undone → first RTK-fixed position input, s.
+    restored_to_fix: Option<f64>,
+    /// RTCM bytes the simulated receiver got from the daemon (pty).
+    rtcm_in: u64,
+    ntrip: Option<agsteer::io::ntrip::NtripStatus>,
     stream: Option<agsteer::io::transport::StreamStatus>,
     /// The fixes' latency the stream measured from the sentences' UTC, s.
     fix_latency: Vec<f64>,
@@ -131,8 +151,7 @@ struct SimRecord {
     trajectory: Vec<(f64, f64, f64, bool)>,
     /// Monotonic time of each GNSS send.
     gnss_sent: Vec<f64>,
-    unplugged_at: Option<f64>,
-    replugged_at: Option<f64>,
+    rtcm_in: u64,
 }
 
 /// The simulator in real time, as `agsteer sim` runs it: sensors every 2 ms.
@@ -140,9 +159,9 @@ fn simulate(
     cfg: &Config,
     path: GnssPath,
     dir: &Path,
-    unplug: Option<Unplug>,
-    to_ctrl: mpsc::Sender<TimedFrame>,
-    from_ctrl: mpsc::Receiver<TimedFrame>,
+    cut: Option<Cut>,
+    cut_times: &Mutex<(Option<f64>, Option<f64>)>,
+    (to_ctrl, from_ctrl): (mpsc::Sender<TimedFrame>, mpsc::Receiver<TimedFrame>),
     stop: Arc<AtomicBool>,
 ) -> SimRecord {
     let (a, b) = (
@@ -187,6 +206,8 @@ fn simulate(
     let (mut frames, mut epochs, mut bytes) =
         (Vec::new(), Vec::<GnssMeasurement>::new(), Vec::new());
     let mut next_sample = 0.0;
+    let mut rtcm = [0u8; 4096];
+    let (mut seed, mut last_epoch, mut junk) = (0x9E37_79B9_7F4A_7C15u64, Vec::new(), Vec::new());
     while !stop.load(Ordering::Relaxed) {
         let t = monotonic_s() - t0;
         frames.clear();
@@ -200,26 +221,63 @@ fn simulate(
         }
         epochs.clear();
         node.drain_gnss(&mut epochs);
+        let receiver_cut = cut.filter(|c| c.what == CutKind::Receiver);
+        let in_cut = |c: &Cut| t >= c.at_s && t < c.at_s + c.for_s;
+        let garbling = cut.is_some_and(|c| c.what == CutKind::Garbage && in_cut(&c));
+        let silent = receiver_cut.is_some_and(|c| in_cut(&c)) || garbling;
+        if garbling {
+            let mut times = cut_times.lock().unwrap();
+            times.0.get_or_insert(monotonic_s());
+            drop(times);
+            // 200 bytes per 2 ms loop: 100 kB/s on the pty; 10 datagrams of 1400 bytes
+            // per loop over UDP.
+            let (chunk, count) = match path {
+                GnssPath::Udp(_) => (1400, 10),
+                _ => (200, 1),
+            };
+            for _ in 0..count {
+                bad_input(&mut seed, &last_epoch, chunk, &mut junk);
+                sink.write(&junk);
+            }
+        } else if cut.is_some_and(|c| c.what == CutKind::Garbage && t >= c.at_s) {
+            cut_times.lock().unwrap().1.get_or_insert(monotonic_s());
+        }
         for m in &epochs {
             bytes.clear();
             encoder.encode(m, &mut bytes);
             // Stamped before the write: the reader may have it before this thread goes on.
-            rec.gnss_sent.push(monotonic_s());
-            sink.write(&bytes);
+            if !silent {
+                rec.gnss_sent.push(monotonic_s());
+                sink.write(&bytes);
+                last_epoch.clone_from(&bytes);
+            }
         }
         while let Ok(tf) = from_ctrl.try_recv() {
             node.on_frame(&tf);
         }
-        if let (Some(u), Sink::Pty(pty, link)) = (unplug, &mut sink) {
-            if t >= u.at_s && rec.unplugged_at.is_none() {
-                // The USB device disappears: its node and its link go.
-                *pty = None;
-                let _ = std::fs::remove_file(&*link);
-                rec.unplugged_at = Some(monotonic_s());
+        if let Sink::Pty(Some(p), _) = &sink {
+            // The receiver takes the corrections the daemon writes back.
+            use std::io::Read;
+            let mut m = p.master();
+            while let Ok(n @ 1..) = m.read(&mut rtcm) {
+                rec.rtcm_in += n as u64;
             }
-            if t >= u.at_s + u.for_s && rec.replugged_at.is_none() {
-                *pty = Some(Sink::plug(link));
-                rec.replugged_at = Some(monotonic_s());
+        }
+        if let Some(c) = receiver_cut {
+            let mut times = cut_times.lock().unwrap();
+            if t >= c.at_s && times.0.is_none() {
+                if let Sink::Pty(pty, link) = &mut sink {
+                    // The USB device disappears: its node and its link go.
+                    *pty = None;
+                    let _ = std::fs::remove_file(&*link);
+                }
+                times.0 = Some(monotonic_s());
+            }
+            if t >= c.at_s + c.for_s && times.1.is_none() {
+                if let Sink::Pty(pty, link) = &mut sink {
+                    *pty = Some(Sink::plug(link));
+                }
+                times.1 = Some(monotonic_s());
             }
         }
         if t >= next_sample {
@@ -233,17 +291,76 @@ fn simulate(
     rec
 }
 
+/// `len` bytes of bad input into `out`: random bytes, then the last good epoch with one
+/// checksum digit wrong, a replay of it whole (a valid checksum, an old time), and its first
+/// half (a truncated line).
+fn bad_input(seed: &mut u64, last_epoch: &[u8], len: usize, out: &mut Vec<u8>) {
+    out.clear();
+    while out.len() < len / 2 {
+        *seed ^= *seed << 13;
+        *seed ^= *seed >> 7;
+        *seed ^= *seed << 17;
+        out.extend_from_slice(&seed.to_le_bytes());
+    }
+    if let Some(star) = last_epoch.iter().position(|&b| b == b'*') {
+        let mut wrong = last_epoch.to_vec();
+        if let Some(d) = wrong.get_mut(star + 1) {
+            *d = if *d == b'0' { b'1' } else { b'0' };
+        }
+        out.extend_from_slice(&wrong);
+    }
+    out.extend_from_slice(last_epoch);
+    out.extend_from_slice(&last_epoch[..last_epoch.len() / 2]);
+    out.truncate(len);
+}
+
 /// One job, closed-loop in real time, for at most `max_s`.
-fn run_job(path: GnssPath, extra: &[&str], unplug: Option<Unplug>, max_s: f64) -> Outcome {
+fn run_job(path: GnssPath, extra: &[&str], cut: Option<Cut>, max_s: f64) -> Outcome {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = config(path, dir.path(), extra);
+    let mut extra: Vec<String> = extra.iter().map(|s| s.to_string()).collect();
+    // An NTRIP caster (str2str) whose corrections the daemon forwards to the receiver.
+    let caster_port = cut
+        .filter(|c| c.what == CutKind::Caster)
+        .map(|_| free_tcp_port());
+    let mut caster = caster_port.map(|port| {
+        extra.extend([
+            "gnss.ntrip_host=\"127.0.0.1\"".to_string(),
+            format!("gnss.ntrip_port={port}"),
+            format!("gnss.ntrip_mountpoint=\"{MOUNT}\""),
+            format!("gnss.ntrip_user=\"{USER}\""),
+            format!("gnss.ntrip_password=\"{PASSWORD}\""),
+        ]);
+        Caster::start(port)
+    });
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let cfg = config(path, dir.path(), &extra);
     let dt = cfg.dt();
     let (to_ctrl, from_sim) = mpsc::channel();
     let (to_sim, from_ctrl) = mpsc::channel();
     let stop = Arc::new(AtomicBool::new(false));
+    let cut_times = Arc::new(Mutex::new((None, None)));
     let sim = {
         let (cfg, stop, dir) = (cfg.clone(), stop.clone(), dir.path().to_path_buf());
-        std::thread::spawn(move || simulate(&cfg, path, &dir, unplug, to_ctrl, from_ctrl, stop))
+        let times = cut_times.clone();
+        std::thread::spawn(move || {
+            simulate(&cfg, path, &dir, cut, &times, (to_ctrl, from_ctrl), stop)
+        })
+    };
+    // The caster is killed and started again by its own thread (str2str takes a while).
+    let caster_cut = match (cut, caster.take(), caster_port) {
+        (Some(c), Some(mut running), Some(port)) => {
+            let times = cut_times.clone();
+            Some(std::thread::spawn(move || {
+                std::thread::sleep(Duration::from_secs_f64(c.at_s));
+                times.lock().unwrap().0 = Some(monotonic_s());
+                running.kill();
+                std::thread::sleep(Duration::from_secs_f64(c.for_s));
+                let again = Caster::start(port);
+                times.lock().unwrap().1 = Some(monotonic_s());
+                again
+            }))
+        }
+        _ => None,
     };
     let mut node = agsteer::control::node::ControllerNode::new(&cfg, None).unwrap();
     let rt = tokio::runtime::Builder::new_current_thread()
@@ -254,11 +371,12 @@ fn run_job(path: GnssPath, extra: &[&str], unplug: Option<Unplug>, max_s: f64) -
     let mut gnss = agsteer::daemon::gnss::spawn(&cfg, &local).unwrap();
     let mut terminal = Packer::new(0x26);
     let mut out = Outcome::default();
-    // (tick time, engaged, fault), and position inputs' arrival times.
+    // (tick time, engaged, fault), and position inputs' arrival times and RTK fixed or not.
     let mut ticks: Vec<(f64, bool, FaultCode)> = Vec::new();
-    let mut arrivals: Vec<f64> = Vec::new();
+    let mut arrivals: Vec<(f64, bool)> = Vec::new();
     let mut frames: Vec<Frame> = Vec::with_capacity(8);
     let mut engaged_once = false;
+    let mut was_engaged = false;
     local.block_on(&rt, async {
         let mut interval = tokio::time::interval(Duration::from_secs_f64(dt));
         interval.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
@@ -280,12 +398,16 @@ fn run_job(path: GnssPath, extra: &[&str], unplug: Option<Unplug>, max_s: f64) -
                             job: Some(0.0),
                         }) {
                             node.on_frame(&TimedFrame { t, frame: f });
-                            out.reengaged += engaged_once as u32;
                         }
                     }
                     frames.clear();
                     let cmd = node.tick(t, &mut frames);
+                    // Engaged again after a disengage: the operator re-engaged.
+                    if cmd.engaged && !was_engaged && engaged_once {
+                        out.reengaged += 1;
+                    }
                     engaged_once |= cmd.engaged;
+                    was_engaged = cmd.engaged;
                     ticks.push((monotonic_s(), cmd.engaged, cmd.fault));
                     for f in &frames {
                         let _ = to_sim.send(TimedFrame { t: monotonic_s(), frame: *f });
@@ -302,7 +424,8 @@ fn run_job(path: GnssPath, extra: &[&str], unplug: Option<Unplug>, max_s: f64) -
                 } => {
                     if let Some(i) = input {
                         if let Input::Position(p) = &i {
-                            arrivals.push(monotonic_s());
+                            let fixed = p.quality == Some(agsteer::input::FixQuality::RtkFixed);
+                            arrivals.push((monotonic_s(), fixed));
                             if let Some(l) = p.latency_s {
                                 out.fix_latency.push(l);
                             }
@@ -314,33 +437,36 @@ fn run_job(path: GnssPath, extra: &[&str], unplug: Option<Unplug>, max_s: f64) -
         }
     });
     out.finished = node.status().finished;
-    out.stream = gnss.as_ref().map(|g| g.status(monotonic_s()).stream);
+    let status = gnss.as_ref().map(|g| g.status(monotonic_s()));
+    out.stream = status.as_ref().map(|s| s.stream.clone());
+    out.ntrip = status.and_then(|s| s.ntrip).map(|n| n.status);
     stop.store(true, Ordering::Relaxed);
     let rec = sim.join().unwrap();
+    out.rtcm_in = rec.rtcm_in;
+    let _caster = caster_cut.map(|h| h.join().unwrap());
+    let (cut_at, restored_at) = *cut_times.lock().unwrap();
     // Each GNSS send → the first command after it; → its input's arrival (streams).
     let next_tick = |t: f64| ticks.iter().find(|k| k.0 >= t).map(|k| k.0 - t);
-    let on_line = |t: f64| {
-        rec.unplugged_at
-            .is_none_or(|u| t < u - 0.5 || t > rec.replugged_at.unwrap_or(f64::MAX) + 2.0)
-    };
+    let on_line =
+        |t: f64| cut_at.is_none_or(|u| t < u - 0.5 || t > restored_at.unwrap_or(f64::MAX) + 2.0);
     for &s in rec.gnss_sent.iter().filter(|&&s| on_line(s)) {
         if let Some(l) = next_tick(s) {
             out.fix_to_command.push(l);
         }
         if path != GnssPath::Can {
-            if let Some(a) = arrivals.iter().find(|&&a| a >= s) {
-                out.transport.push(a - s);
+            if let Some(a) = arrivals.iter().find(|a| a.0 >= s) {
+                out.transport.push(a.0 - s);
             }
         }
     }
-    if let Some(u) = rec.unplugged_at {
-        out.unplug = ticks
+    if let Some(u) = cut_at {
+        out.cut = ticks
             .iter()
             .find(|k| k.0 >= u && !k.1)
             .map(|k| (k.0 - u, k.2));
     }
-    if let Some(r) = rec.replugged_at {
-        out.replug_to_fix = arrivals.iter().find(|&&a| a >= r).map(|a| a - r);
+    if let Some(r) = restored_at {
+        out.restored_to_fix = arrivals.iter().find(|a| a.0 >= r && a.1).map(|a| a.0 - r);
     }
     out.xte = xte(&cfg, &rec.trajectory);
     out
@@ -402,6 +528,21 @@ fn print(name: &str, o: &mut Outcome) {
         pct(&o.transport, 0.99) * 1e3,
         pct(&o.fix_latency, 0.5) * 1e3,
     );
+    if let Some(s) = &o.stream {
+        println!(
+            "GNSS-LOOP {name} stream: {}",
+            serde_json::to_string(s).unwrap()
+        );
+    }
+}
+
+/// A free TCP port on loopback (for the caster).
+fn free_tcp_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
 }
 
 /// A free UDP port on loopback (bound, then released for the stream to take).
@@ -462,16 +603,17 @@ fn ab_job_with_gnss_over_udp() {
 /// back behind the same link, fixes return and the operator's engage finishes the job.
 #[test]
 fn receiver_unplugged_mid_line_disengages_within_the_gnss_timeout() {
-    let unplug = Unplug {
+    let cut = Cut {
         at_s: 12.0,
         for_s: 2.0,
+        what: CutKind::Receiver,
     };
-    let mut o = run_job(GnssPath::Pty, &JOB, Some(unplug), 150.0);
+    let mut o = run_job(GnssPath::Pty, &JOB, Some(cut), 150.0);
     print("pty-unplug", &mut o);
-    let (to_safe, fault) = o.unplug.expect("disengaged after the unplug");
-    let replug = o.replug_to_fix.expect("fixes after the replug");
+    let (to_safe, fault) = o.cut.expect("disengaged after the unplug");
+    let replug = o.restored_to_fix.expect("fixes after the replug");
     println!(
-        "GNSS-UNPLUG time_to_safe_ms={:.1} fault={fault:?} replug_to_first_fix_ms={:.1} reconnects={}",
+        "GNSS-UNPLUG pty: time_to_safe_ms={:.1} fault={fault:?} replug_to_first_fix_ms={:.1} reconnects={}",
         to_safe * 1e3,
         replug * 1e3,
         o.stream.as_ref().map_or(0, |s| s.reconnects)
@@ -483,4 +625,112 @@ fn receiver_unplugged_mid_line_disengages_within_the_gnss_timeout() {
     assert!(o.finished, "the job finishes after the operator re-engages");
     assert_eq!(o.reengaged, 1);
     assert!(o.stream.as_ref().unwrap().reconnects >= 1);
+}
+
+/// The UDP receiver falls silent mid-line (a board powered off, a cable pulled): the same
+/// timeout; its datagrams back, the job finishes after the operator's engage.
+#[test]
+fn udp_receiver_silent_mid_line_disengages_within_the_gnss_timeout() {
+    let cut = Cut {
+        at_s: 12.0,
+        for_s: 2.0,
+        what: CutKind::Receiver,
+    };
+    let mut o = run_job(GnssPath::Udp(free_udp_port()), &JOB, Some(cut), 150.0);
+    print("udp-silent", &mut o);
+    let (to_safe, fault) = o.cut.expect("disengaged after the silence");
+    let back = o.restored_to_fix.expect("fixes after the silence");
+    println!(
+        "GNSS-UNPLUG udp: time_to_safe_ms={:.1} fault={fault:?} back_to_first_fix_ms={:.1}",
+        to_safe * 1e3,
+        back * 1e3
+    );
+    assert_eq!(fault, FaultCode::GnssTimeout);
+    assert!(to_safe <= 0.3 + 0.01 + 0.05, "{to_safe}");
+    assert!(o.finished);
+    assert_eq!(o.reengaged, 1);
+}
+
+/// The NTRIP caster goes away mid-line: once the corrections are older than
+/// `gnss.max_correction_age_s` (2 s here) the RTK fixed solution is taken as float and the
+/// supervisor disengages (RTK float tolerance 0); the caster back, the client reconnects, the
+/// fixes are RTK fixed again, the operator re-engages and the job finishes.
+#[test]
+fn caster_gone_mid_line_degrades_the_fix_and_disengages() {
+    if !caster::str2str_installed() {
+        println!("skipped: str2str (Debian package rtklib) not installed");
+        return;
+    }
+    let cut = Cut {
+        at_s: 12.0,
+        for_s: 3.0,
+        what: CutKind::Caster,
+    };
+    let max_age = 2.0;
+    let set = [JOB[0], JOB[1], "gnss.max_correction_age_s=2.0"];
+    let mut o = run_job(GnssPath::Pty, &set, Some(cut), 150.0);
+    print("pty-caster-gone", &mut o);
+    let (to_safe, fault) = o.cut.expect("disengaged after the caster went");
+    let back = o
+        .restored_to_fix
+        .expect("RTK fixed again after the caster returned");
+    let ntrip = o.ntrip.clone().unwrap();
+    println!(
+        "GNSS-CASTER-GONE time_to_safe_ms={:.1} fault={fault:?} restart_to_rtk_fixed_ms={:.1} \
+         rtcm_to_receiver_bytes={} ntrip_reconnects={} degraded_fixes={}",
+        to_safe * 1e3,
+        back * 1e3,
+        o.rtcm_in,
+        ntrip.reconnects,
+        o.stream.as_ref().map_or(0, |s| s.counters.degraded_fixes)
+    );
+    assert_eq!(fault, FaultCode::FixQuality);
+    // The corrections' age passes the limit 2 s after the last RTCM frame (which came within
+    // 100 ms before the kill), then the next fix (0.1 s) is degraded, then a control period.
+    assert!(
+        to_safe >= max_age - 0.15 && to_safe <= max_age + 0.1 + 0.01 + 0.05,
+        "{to_safe}"
+    );
+    assert!(o.rtcm_in > 1000, "corrections reached the receiver");
+    assert!(ntrip.reconnects >= 1);
+    assert!(o.finished);
+    assert_eq!(o.reengaged, 1);
+}
+
+/// Bad input in place of the fixes (see [`CutKind::Garbage`]): nothing of it is taken as a fix,
+/// so the GNSS timeout reaches the safe state in time, on the pty and under a UDP flood; good
+/// epochs back, the job finishes after the operator's engage.
+#[test]
+fn garbage_and_a_udp_flood_in_place_of_fixes_disengage_within_the_gnss_timeout() {
+    let cut = Cut {
+        at_s: 12.0,
+        for_s: 2.0,
+        what: CutKind::Garbage,
+    };
+    for (name, path) in [
+        ("pty-garbage", GnssPath::Pty),
+        ("udp-flood", GnssPath::Udp(free_udp_port())),
+    ] {
+        let mut o = run_job(path, &JOB, Some(cut), 150.0);
+        print(name, &mut o);
+        let (to_safe, fault) = o.cut.expect("disengaged during the bad input");
+        let s = o.stream.clone().unwrap();
+        println!(
+            "GNSS-BAD-INPUT {name}: time_to_safe_ms={:.1} fault={fault:?} garbage_bytes={} \
+             checksum_errors={} stale={} dropped_bytes={}",
+            to_safe * 1e3,
+            s.counters.framer.garbage_bytes,
+            s.checksum_errors,
+            s.counters.convert.stale,
+            s.dropped_bytes
+        );
+        assert_eq!(fault, FaultCode::GnssTimeout, "{name}");
+        assert!(to_safe <= 0.3 + 0.01 + 0.05, "{name}: {to_safe}");
+        assert!(o.finished, "{name}");
+        assert_eq!(o.reengaged, 1, "{name}");
+        match path {
+            GnssPath::Udp(_) => assert!(s.dropped_bytes > 0, "{name}: the flood is rate-limited"),
+            _ => assert!(s.checksum_errors > 0 && s.counters.framer.garbage_bytes > 0),
+        }
+    }
 }

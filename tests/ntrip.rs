@@ -10,97 +10,16 @@
 //! Skipped, saying so, when `str2str` is not installed (CI installs it: `.ci/run`).
 
 use agsteer::input::FixQuality;
-use agsteer::io::framer::{Frame, Framer};
 use agsteer::io::ntrip::{
     run_ntrip, CasterState, GgaSource, NtripConfig, NtripPorts, NtripStatus, NtripVersion,
 };
-use std::io::Write;
-use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tokio::sync::{mpsc, watch};
 
-const MOUNT: &str = "AGSTEER";
-const USER: &str = "farmer";
-const PASSWORD: &str = "s3cret";
-
-fn str2str_installed() -> bool {
-    Command::new("str2str")
-        .arg("-h")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok()
-}
-
-/// The RTCM frames of the recorded stream.
-fn recorded_frames() -> Vec<Vec<u8>> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/gnss/logs/rtcm3.2.log");
-    let data = std::fs::read(p).unwrap();
-    let mut frames = Vec::new();
-    Framer::new().push(&data, &mut |f| {
-        if let Frame::Rtcm(r) = f {
-            frames.push(r.to_vec());
-        }
-    });
-    assert!(frames.len() > 150);
-    frames
-}
-
-/// str2str as an NTRIP caster on `port`, fed by a thread that writes the recorded frames to
-/// its stdin, ten frames every 100 ms, until the caster goes away.
-struct Caster {
-    child: Child,
-    feeder: Option<std::thread::JoinHandle<()>>,
-}
-
-impl Caster {
-    fn start(port: u16) -> Caster {
-        let mut child = Command::new("str2str")
-            .arg("-out")
-            .arg(format!("ntripc://{USER}:{PASSWORD}@:{port}/{MOUNT}"))
-            .stdin(Stdio::piped())
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("str2str");
-        let mut stdin = child.stdin.take().unwrap();
-        let frames = recorded_frames();
-        let feeder = std::thread::spawn(move || {
-            let start = Instant::now();
-            // Bounded: at most 60 s, whatever happens.
-            for (k, f) in frames.iter().cycle().enumerate() {
-                if stdin.write_all(f).is_err() || start.elapsed() > Duration::from_secs(60) {
-                    return;
-                }
-                if k % 10 == 9 {
-                    let _ = stdin.flush();
-                    std::thread::sleep(Duration::from_millis(100));
-                }
-            }
-        });
-        // Let it listen.
-        std::thread::sleep(Duration::from_millis(300));
-        Caster {
-            child,
-            feeder: Some(feeder),
-        }
-    }
-
-    fn kill(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        if let Some(f) = self.feeder.take() {
-            let _ = f.join();
-        }
-    }
-}
-
-impl Drop for Caster {
-    fn drop(&mut self) {
-        self.kill();
-    }
-}
+#[path = "common/caster.rs"]
+mod caster;
+use caster::*;
 
 fn free_port() -> u16 {
     std::net::TcpListener::bind("127.0.0.1:0")

@@ -215,6 +215,41 @@ struct Sink<'a> {
     limit: RateLimit,
     /// The latest quality report, for GGA.
     quality: (FixQuality, u8, f64),
+    /// One chunk's inputs, in the order they go to the controller (reused: no allocation).
+    pending: Vec<Input>,
+}
+
+/// Inputs per chunk kept without reallocating (a 4 kB chunk of short sentences is ~60).
+const PENDING_INPUTS: usize = 64;
+
+/// Put each heading of a chunk before the position it follows, when that position had no
+/// heading before it (since the previous position, or the chunk's start). The controller
+/// makes a fix of a position and the newest heading when the position arrives; most receivers
+/// send an epoch's heading after its position (u-blox and Unicore: GGA before HDT;
+/// NAV-HPPOSLLH before NAV-RELPOSNED), so without this the fix would carry the previous
+/// epoch's heading, one GNSS period old. An epoch read in one chunk (a UDP datagram, a pty,
+/// a USB CDC read) gets its own heading; a heading-first stream is left as it is; an epoch
+/// split across reads keeps the arrival order.
+fn heading_with_its_position(inputs: &mut [Input]) {
+    let mut open_position = None;
+    let mut unclaimed_heading = false;
+    for k in 0..inputs.len() {
+        match inputs.get(k) {
+            Some(Input::Position(_)) => {
+                open_position = (!unclaimed_heading).then_some(k);
+                unclaimed_heading = false;
+            }
+            Some(Input::Heading(_)) => match open_position.take() {
+                Some(p) => {
+                    if let Some(run) = inputs.get_mut(p..=k) {
+                        run.rotate_right(1);
+                    }
+                }
+                None => unclaimed_heading = true,
+            },
+            _ => {}
+        }
+    }
 }
 
 impl Sink<'_> {
@@ -235,34 +270,37 @@ impl Sink<'_> {
         let inputs = &self.ports.inputs;
         let position = &self.ports.position;
         let quality = &mut self.quality;
-        self.decoder.push(
-            data,
-            &receipt,
-            &mut |i| {
-                match &i {
-                    Input::Quality(q) => {
-                        *quality = (q.quality, q.satellites.unwrap_or(0), q.hdop.unwrap_or(1.0));
-                    }
-                    Input::Position(p) => {
-                        if let Some(tx) = position {
-                            tx.send_replace(Some(GgaSource {
-                                lat_deg: p.lat_deg,
-                                lon_deg: p.lon_deg,
-                                altitude_m: p.altitude_m.unwrap_or(0.0),
-                                quality: p.quality.unwrap_or(quality.0),
-                                satellites: quality.1,
-                                hdop: quality.2,
-                            }));
-                        }
-                    }
-                    _ => {}
+        let pending = &mut self.pending;
+        pending.clear();
+        self.decoder
+            .push(data, &receipt, &mut |i| pending.push(i), &mut |_| {});
+        heading_with_its_position(pending);
+        for i in pending.drain(..) {
+            match &i {
+                Input::Quality(q) => {
+                    *quality = (q.quality, q.satellites.unwrap_or(0), q.hdop.unwrap_or(1.0));
                 }
-                if inputs.try_send(i).is_err() {
-                    dropped += 1;
+                Input::Position(p) => {
+                    if let Some(tx) = position {
+                        tx.send_replace(Some(GgaSource {
+                            lat_deg: p.lat_deg,
+                            lon_deg: p.lon_deg,
+                            altitude_m: p.altitude_m.unwrap_or(0.0),
+                            quality: p.quality.unwrap_or(quality.0),
+                            satellites: quality.1,
+                            hdop: quality.2,
+                        }));
+                    }
                 }
-            },
-            &mut |_| {},
-        );
+                _ => {}
+            }
+            if inputs.try_send(i).is_err() {
+                dropped += 1;
+            }
+        }
+        // A burst larger than usual (a buffer flushed after a stall) must not keep its
+        // memory for ever.
+        pending.shrink_to(PENDING_INPUTS);
         let counters = self.decoder.counters();
         set_status(&self.ports.status, |s| {
             s.counters = counters;
@@ -283,6 +321,7 @@ pub async fn run_stream(cfg: StreamConfig, mut ports: StreamPorts) {
         limit: RateLimit::new(cfg.max_rate_bytes_s, crate::can::bus::monotonic_s()),
         ports: &mut ports,
         quality: (FixQuality::None, 0, 1.0),
+        pending: Vec::with_capacity(PENDING_INPUTS),
     };
     let mut rtcm = sink.ports.rtcm.take();
     let mut backoff = cfg.backoff_min_s;
@@ -400,5 +439,66 @@ async fn session(
                 w = writer => w,
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod order_tests {
+    use super::heading_with_its_position;
+    use crate::input::{HeadingInput, HeadingReference, Input, PositionInput, SourceId};
+
+    fn position(k: u8) -> Input {
+        Input::Position(PositionInput {
+            t: 0.0,
+            source: SourceId::Stream(0),
+            lat_deg: k as f64,
+            lon_deg: 0.0,
+            altitude_m: None,
+            latency_s: None,
+            quality: None,
+        })
+    }
+    fn heading(k: u8) -> Input {
+        Input::Heading(HeadingInput {
+            t: 0.0,
+            source: SourceId::Stream(0),
+            heading: k as f64,
+            reference: HeadingReference::True,
+            variation: None,
+        })
+    }
+    /// "P1" / "H1" for a position / heading of epoch 1.
+    fn names(inputs: &[Input]) -> Vec<String> {
+        inputs
+            .iter()
+            .map(|i| match i {
+                Input::Position(p) => format!("P{}", p.lat_deg),
+                Input::Heading(h) => format!("H{}", h.heading),
+                _ => "?".into(),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn each_heading_goes_before_the_position_it_follows() {
+        // GGA (position), RMC, HDT of epoch 1, then epoch 2; a chunk ending after a position.
+        let mut v = vec![
+            position(1),
+            heading(1),
+            position(2),
+            heading(2),
+            position(3),
+        ];
+        heading_with_its_position(&mut v);
+        assert_eq!(names(&v), ["H1", "P1", "H2", "P2", "P3"]);
+        // A heading that starts the chunk (the end of an epoch split across reads): the
+        // arrival order is kept (it cannot be told from a heading-first stream).
+        let mut v = vec![heading(0), position(1), heading(1)];
+        heading_with_its_position(&mut v);
+        assert_eq!(names(&v), ["H0", "P1", "H1"]);
+        // Heading-first receivers are left as they are.
+        let mut v = vec![heading(1), position(1), heading(2), position(2)];
+        heading_with_its_position(&mut v);
+        assert_eq!(names(&v), ["H1", "P1", "H2", "P2"]);
     }
 }
