@@ -180,7 +180,7 @@ fn simulate(
         lon_deg: cfg.job.origin_lon_deg,
     });
     let mut node = SimNode::new(
-        Simulator::new(agsteer::demo::sim_params(cfg), start, cfg.speed()),
+        Simulator::new(cfg.sim_params(), start, cfg.speed()),
         enu,
         SimAddresses::default(),
         Scenario::default(),
@@ -362,7 +362,7 @@ fn run_job(path: GnssPath, extra: &[&str], cut: Option<Cut>, max_s: f64) -> Outc
         }
         _ => None,
     };
-    let mut node = agsteer::control::node::ControllerNode::new(&cfg, None).unwrap();
+    let mut node = agsteer::job::node_for_config(&cfg, None).unwrap();
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
@@ -474,7 +474,7 @@ fn run_job(path: GnssPath, extra: &[&str], cut: Option<Cut>, max_s: f64) -> Outc
 
 /// True |XTE| on the work lines, 10 m at each line end excluded (as `vcan_tests`).
 fn xte(cfg: &Config, traj: &[(f64, f64, f64, bool)]) -> (f64, f64, f64, usize) {
-    let plan = AbPlan::new(agsteer::control::ab_params(cfg)).unwrap();
+    let plan = AbPlan::new(cfg.ab_params()).unwrap();
     let (a, b) = plan.line_endpoints(0, false);
     let dir = (b - a).normalize();
     let mut xs: Vec<f64> = traj
