@@ -360,6 +360,11 @@ impl Packer {
     pub fn source(&self) -> u8 {
         self.source
     }
+    /// Send from another source address from now on (a new address claimed), keeping the
+    /// rolling counters.
+    pub fn set_source(&mut self, source: u8) {
+        self.source = source;
+    }
     /// Pack the next frame of `msg`, advancing its counter.
     pub fn pack<M: DbcMessage>(&mut self, msg: &M) -> Result<Frame, CodecError> {
         let c = &mut self.counters[M::INDEX % 64];

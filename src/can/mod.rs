@@ -3,11 +3,13 @@
 //! Every frame agsteer reads or writes is defined once, in `dbc/agsteer.dbc`; `build.rs`
 //! generates the codec tables and typed messages from it.
 
+pub mod address_claim;
 pub mod bus;
 pub mod candump;
 pub mod codec;
 pub mod fastpacket;
 pub mod gnss;
+pub mod isobus;
 
 /// One classic CAN frame with a 29-bit extended identifier.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

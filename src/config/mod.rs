@@ -7,7 +7,7 @@
 //! is deserialised, so they go through exactly the same checks as the file.
 //!
 //! One file per section (`job.rs`, `guidance.rs`, `vehicle.rs`, `control.rs`, `track.rs`,
-//! `sim.rs`, `bus.rs`, `safety.rs`, `daemon.rs`, `progress.rs`, `field.rs`, `maneuver.rs`,
+//! `sim.rs`, `bus.rs`, `isobus.rs`, `safety.rs`, `daemon.rs`, `progress.rs`, `field.rs`, `maneuver.rs`,
 //! `gnss.rs`), each
 //! holding the section's struct, its defaults and its validation; [`check`] holds the
 //! range-check helpers. This module holds the whole [`Config`], loading, `--set` overrides and
@@ -25,6 +25,7 @@ mod envelope;
 mod field;
 mod gnss;
 mod guidance;
+mod isobus;
 mod job;
 mod maneuver;
 mod planners;
@@ -41,6 +42,7 @@ pub use daemon::DaemonConfig;
 pub use field::{FieldConfig, FieldOrigin, SwathAngleChoice};
 pub use gnss::{ntrip_password, GnssConfig, GnssSource, PasswordFileError, TransportKind};
 pub use guidance::GuidanceConfig;
+pub use isobus::IsobusConfig;
 pub use job::{JobConfig, JobKind, LineOrder, LineSide};
 pub use maneuver::{CurveChoice, ManeuverConfig};
 pub use progress::ProgressConfig;
@@ -97,6 +99,7 @@ pub struct Config {
     pub sim: SimConfig,
     pub progress: ProgressConfig,
     pub bus: BusConfig,
+    pub isobus: IsobusConfig,
     pub safety: SafetyConfig,
     pub daemon: DaemonConfig,
     pub field: FieldConfig,
@@ -232,6 +235,7 @@ impl Config {
         self.sim.validate(&mut c);
         self.sim.validate_plant(self.vehicle.wheelbase_m, &mut c);
         self.bus.validate(&mut c);
+        self.isobus.validate(&mut c);
         self.safety.validate(&mut c);
         self.vehicle.validate_body(&mut c);
         self.maneuver.validate(&self.vehicle, &mut c);
@@ -265,6 +269,7 @@ impl Config {
             "bus.source_address",
             self.bus.source_address == new.bus.source_address,
         );
+        check("isobus", self.isobus == new.isobus);
         check(
             "bus.status_socket",
             self.bus.status_socket == new.bus.status_socket,

@@ -286,6 +286,14 @@ impl Config {
             output: self.bus.output,
             status_period: self.bus.status_period_s,
             gnss_from_stream: self.gnss.is_stream(),
+            iso: crate::control::isobus::IsoParams {
+                claim: self.isobus.claim_params(self.bus.source_address),
+                source_address: self.bus.source_address,
+                steering_address: self.isobus.steering_address,
+                steering_function: self.isobus.steering_function,
+                steer_ready_loop: self.bus.output == super::OutputKind::Curvature,
+            },
+            machine_info_timeout: self.isobus.machine_info_timeout_s,
         }
     }
 

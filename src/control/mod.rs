@@ -17,6 +17,7 @@ use crate::track::law::SteeringLaw;
 use crate::track::lost_motion::LostMotion;
 use crate::track::{registry, steering_from_travel, travel_pose, IntegralAction, TrackOutput};
 
+pub mod isobus;
 pub mod node;
 pub mod params;
 pub mod replay;

@@ -2,6 +2,7 @@
 //! → `track` → `safety` → `can`, without I/O: the daemon feeds it SocketCAN frames, the demo
 //! feeds it in-memory ones, so both run exactly the same code on exactly the same frames.
 
+use super::isobus::{IsoLink, IsoStatus, GUIDANCE_MESSAGE_PERIOD};
 use super::params::{BusParams, OutputKind};
 use super::Controller;
 use crate::can::codec::{
@@ -29,7 +30,7 @@ const ROLL_MAX_AGE: f64 = 0.5;
 /// A 129029 quality older than this no longer vouches for positions, s.
 const QUALITY_MAX_AGE: f64 = 2.0;
 /// The largest fault code GuidanceStatus.Fault carries (its DBC range).
-const GUIDANCE_STATUS_FAULT_MAX: f64 = 13.0;
+const GUIDANCE_STATUS_FAULT_MAX: f64 = 61.0;
 
 /// What `agsteer status` and the guidance status frame report.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -48,6 +49,9 @@ pub struct NodeStatus {
     /// The steering's lost motion (backlash + actuator deadband) learnt so far, degrees.
     pub steering_lost_motion_deg: f64,
     pub bad_frames: u64,
+    /// The address claim and the steering ECU (ISO 11783).
+    #[serde(flatten)]
+    pub isobus: IsoStatus,
 }
 
 /// The controller node.
@@ -63,6 +67,12 @@ pub struct ControllerNode {
     /// GNSS comes from a byte stream (`gnss.source`): GNSS inputs from the bus are ignored.
     gnss_from_stream: bool,
     output: OutputKind,
+    /// Address claim and steering ECU.
+    iso: IsoLink,
+    /// Control periods between two Guidance System Commands.
+    command_every: u64,
+    /// The command status last sent in a Guidance System Command.
+    last_intended: Option<bool>,
     heading: Option<(f64, f64)>,
     /// Latest IMU roll: (time s, rad, positive right side down).
     roll: Option<(f64, f64)>,
@@ -99,6 +109,16 @@ fn status_every(status_period: f64, dt: f64) -> u64 {
     ((status_period / dt).round() as u64).max(1)
 }
 
+/// The supervisor's parameters: with the steer-ready loop, the steering feedback is Guidance
+/// Machine Info, stale after `bus.machine_info_timeout`.
+fn node_safety_params(safety: &SafetyParams, bus: &BusParams) -> SafetyParams {
+    let mut p = safety.clone();
+    if bus.iso.steer_ready_loop {
+        p.wheel_angle_timeout = bus.machine_info_timeout;
+    }
+    p
+}
+
 fn request_of(d: Direction) -> DirectionRequestDirection {
     match d {
         Direction::Forward => DirectionRequestDirection::Forward,
@@ -123,13 +143,16 @@ impl ControllerNode {
         let dt = ctrl.params().dt;
         ControllerNode {
             ctrl,
-            supervisor: Supervisor::new(safety.clone()),
+            supervisor: Supervisor::new(node_safety_params(safety, bus)),
             enu: EnuFrame::new(origin),
             packer: Packer::new(bus.source_address),
             can: CanAdapter::default(),
             sources: SourceSelector::new(SourceParams::default()),
             gnss_from_stream: bus.gnss_from_stream,
             output: bus.output,
+            iso: IsoLink::new(bus.iso),
+            command_every: ((GUIDANCE_MESSAGE_PERIOD / dt).round() as u64).max(1),
+            last_intended: None,
             heading: None,
             roll: None,
             speed: 0.0,
@@ -161,6 +184,7 @@ impl ControllerNode {
                 wheel_angle_command_deg: 0.0,
                 steering_lost_motion_deg: 0.0,
                 bad_frames: 0,
+                isobus: IsoLink::new(bus.iso).status(),
             },
         }
     }
@@ -186,7 +210,7 @@ impl ControllerNode {
         bus: &BusParams,
     ) {
         self.ctrl.set_tuning(control);
-        self.supervisor.set_params(safety.clone());
+        self.supervisor.set_params(node_safety_params(safety, bus));
         self.output = bus.output;
         self.status_every = status_every(bus.status_period, self.ctrl.params().dt);
     }
@@ -199,10 +223,16 @@ impl ControllerNode {
         &self.enu
     }
 
+    /// The CAN link came up again (or recovered from bus-off): the address is claimed again.
+    pub fn on_link_up(&mut self) {
+        self.iso.restart();
+    }
+
     /// One received frame: the CAN adapter's inputs, in order. True when a GNSS fix entered
     /// the controller (the daemon then computes the command at once, issue 16 point 7).
     pub fn on_frame(&mut self, tf: &TimedFrame) -> bool {
         let mut fix = false;
+        self.iso.on_frame(tf.t, &tf.frame);
         for input in self.can.on_frame(tf) {
             let gnss = matches!(
                 input,
@@ -243,6 +273,17 @@ impl ControllerNode {
                 }
                 if let Some(link) = c.link {
                     self.supervisor.on_frame_check(checked_input(link), c.ok);
+                }
+            }
+            // With the steer-ready loop the steering feedback is Guidance Machine Info.
+            Input::WheelAngle(_) if self.iso.params().steer_ready_loop => {}
+            Input::MachineInfo(m) => {
+                if self.iso.on_machine_info(&m) && self.iso.params().steer_ready_loop {
+                    if let Some(k) = m.curvature {
+                        let a = (k * self.supervisor.params().wheelbase).atan();
+                        self.supervisor.on_wheel_angle(m.t, a, false, false);
+                        self.ctrl.on_wheel_angle(m.t, a);
+                    }
                 }
             }
             Input::WheelAngle(w) => {
@@ -419,6 +460,13 @@ impl ControllerNode {
 
     /// One control period at `t`: appends the frames to send.
     pub fn tick(&mut self, t: f64, out: &mut Vec<Frame>) -> Cmd {
+        // The address claim first: until it stands, nothing else goes out.
+        let address = self.iso.begin_tick(t, out);
+        if let Some(a) = address {
+            self.packer.set_source(a);
+        }
+        let first_app = out.len();
+        self.supervisor.set_interlock(self.iso.interlock(t));
         let c = match self.ctrl.tick(t) {
             Ok(c) => {
                 if self.guidance_failing {
@@ -474,10 +522,16 @@ impl ControllerNode {
                 out.push(f);
             }
         }
-        if matches!(self.output, OutputKind::Curvature | OutputKind::Both) {
+        let due = self.ticks % self.command_every == 0 || self.last_intended != Some(cmd.engaged);
+        let dest = self.iso.steering_destination();
+        if let (true, Some(dest), true) = (
+            matches!(self.output, OutputKind::Curvature | OutputKind::Both),
+            dest,
+            due,
+        ) {
             // ISO 11783-7: km⁻¹, positive = right turn; ours is 1/m, positive = left.
             let k = (-cmd.curvature * 1000.0).clamp(-8032.0, 8031.75);
-            if let Ok(f) = self.packer.pack(&GuidanceSystemCommand {
+            if let Ok(mut f) = self.packer.pack(&GuidanceSystemCommand {
                 curvature: Some(k),
                 command_status: Some(if cmd.engaged {
                     GuidanceSystemCommandCommandStatus::IntendedToSteer
@@ -485,7 +539,10 @@ impl ControllerNode {
                     GuidanceSystemCommandCommandStatus::NotIntendedToSteer
                 }),
             }) {
+                // Destination specific (PDU1): to the steering ECU.
+                f.id = crate::can::isobus::with_destination(f.id, dest);
                 out.push(f);
+                self.last_intended = Some(cmd.engaged);
             }
         }
         let g = self.ctrl.guidance();
@@ -501,12 +558,13 @@ impl ControllerNode {
             finished: g.is_finished(),
             wheel_angle_command_deg: angle_deg,
             steering_lost_motion_deg: self.ctrl.lost_motion().to_degrees(),
+            isobus: self.iso.status(),
             ..self.status
         };
         if self.ticks % self.status_every == 0 {
             let s = &self.status;
             let msg = GuidanceStatus {
-                state: Some(GuidanceStatusState::from_raw(s.state.code())),
+                state: GuidanceStatusState::from_raw(s.state.code()),
                 // The DBC's range ends below the field's not-available codes (J1939-71): a
                 // value past it is sent as not available.
                 fault: Some(s.fault as u8 as f64).filter(|&f| f <= GUIDANCE_STATUS_FAULT_MAX),
@@ -520,6 +578,10 @@ impl ControllerNode {
             if let Ok(f) = self.packer.pack(&msg) {
                 out.push(f);
             }
+        }
+        if address.is_none() {
+            // No address: the claim's frames only.
+            out.truncate(first_app);
         }
         self.ticks += 1;
         cmd

@@ -143,4 +143,8 @@ pub struct BusParams {
     pub status_period: f64,
     /// GNSS comes from a byte stream (`gnss.source`): GNSS inputs from the bus are ignored.
     pub gnss_from_stream: bool,
+    /// The address claim and the steering ECU (ISO 11783).
+    pub iso: super::isobus::IsoParams,
+    /// With the steer-ready loop: Guidance Machine Info older than this is stale, s.
+    pub machine_info_timeout: f64,
 }

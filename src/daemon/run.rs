@@ -78,8 +78,10 @@ enum BusEvent {
     Down(String),
 }
 
-/// The frames agsteerd listens to (by PGN, any source address).
+/// The frames agsteerd listens to (by PGN, any source address): the DBC's inputs, and the
+/// ISO 11783-5 Request and Address Claimed (to any destination).
 pub fn receive_filters() -> Vec<Filter> {
+    use crate::can::isobus::{PGN_ADDRESS_CLAIMED, PGN_REQUEST};
     crate::can::codec::MESSAGES
         .iter()
         .filter(|m| m.transmitter != "AGSTEER")
@@ -87,6 +89,10 @@ pub fn receive_filters() -> Vec<Filter> {
             id: m.id,
             mask: if m.pdu1 { 0x03FF_0000 } else { 0x03FF_FF00 },
         })
+        .chain([PGN_REQUEST, PGN_ADDRESS_CLAIMED].map(|pgn| Filter {
+            id: pgn << 8,
+            mask: 0x03FF_0000,
+        }))
         .collect()
 }
 
@@ -329,11 +335,13 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                         let t = monotonic_s();
                         frames.clear();
                         node.tick(t, &mut frames);
+                        // A period without frames (claiming) says nothing of the link.
                         let sent = send_all(&bus, &frames, &mut stats);
-                        if sent && !bus_up {
-                            tracing::info!("CAN interface {iface} is back");
+                        if sent && !bus_up && !frames.is_empty() {
+                            tracing::info!("CAN interface {iface} is back; claiming the address again");
                             bus_up = true;
                             node.supervisor_mut().on_bus(true);
+                            node.on_link_up();
                         } else if !sent && bus_up {
                             tracing::error!("CAN interface {iface} is down");
                             bus_up = false;

@@ -8,8 +8,8 @@
 
 use super::{
     AttitudeInput, CheckedLink, CourseSpeedInput, FixQuality, FrameCheckInput, HeadingInput,
-    HeadingReference, Input, OperatorCommand, OperatorInput, PositionInput, QualityInput,
-    SensorStatus, SourceId, WheelAngleInput, WheelSpeedInput,
+    HeadingReference, Input, MachineInfoInput, OperatorCommand, OperatorInput, PositionInput,
+    QualityInput, SensorStatus, SourceId, WheelAngleInput, WheelSpeedInput,
 };
 use crate::can::codec::{
     self, CodecError, CogSogRapidCogReference, CounterCheck, Message, OperatorCommandCommand,
@@ -122,8 +122,8 @@ fn operator_command(c: &codec::OperatorCommand) -> OperatorCommand {
         OperatorCommandCommand::Pause => OperatorCommand::Pause,
         OperatorCommandCommand::Resume => OperatorCommand::Resume,
         OperatorCommandCommand::Nudge => match c.nudge {
-            Some(cm) => OperatorCommand::Nudge {
-                offset_m: cm * 0.01,
+            Some(steps) => OperatorCommand::Nudge {
+                steps: steps.round() as i32,
             },
             None => OperatorCommand::None,
         },
@@ -261,12 +261,31 @@ impl CanAdapter {
                 source,
                 command: operator_command(&m),
             })),
-            // agsteer's own outputs, and Guidance Machine Info (not read yet).
+            Message::GuidanceMachineInfo(m) => {
+                use codec::{
+                    GuidanceMachineInfoMechanicalLockout as Lockout,
+                    GuidanceMachineInfoRequestResetCommandStatus as Reset,
+                    GuidanceMachineInfoSteeringReadiness as Ready,
+                };
+                out.push(Input::MachineInfo(MachineInfoInput {
+                    t,
+                    source,
+                    // ISO 11783-7: km⁻¹, positive = right turn; ours is 1/m, positive left.
+                    curvature: m.estimated_curvature.map(|k| -k * 1e-3),
+                    ready: m.steering_readiness.map(|r| r == Ready::Ready),
+                    lockout: m.mechanical_lockout.map(|l| l != Lockout::NotActive),
+                    reset_requested: m
+                        .request_reset_command_status
+                        .map(|r| r != Reset::ResetNotRequired),
+                    exit_reason: m.exit_reason_code.map(|c| c.clamp(0.0, 63.0) as u8),
+                }))
+            }
+            // agsteer's own outputs.
             Message::SteeringCommand(_)
             | Message::GuidanceStatus(_)
             | Message::DirectionRequest(_)
-            | Message::GuidanceSystemCommand(_)
-            | Message::GuidanceMachineInfo(_) => {}
+            | Message::OperatorReply(_)
+            | Message::GuidanceSystemCommand(_) => {}
         }
         out
     }
@@ -374,7 +393,50 @@ mod tests {
         let Input::Operator(o) = got[1] else {
             panic!("{got:?}")
         };
-        assert_eq!(o.command, OperatorCommand::Nudge { offset_m: -0.15 });
+        assert_eq!(o.command, OperatorCommand::Nudge { steps: -15 });
+    }
+
+    #[test]
+    fn guidance_machine_info_reads_byte_3_as_iso_11783_7_lays_it_out() {
+        let mut a = CanAdapter::default();
+        // Bytes as AgIsoStack++ (isobus_guidance_interface.cpp) sends them: curvature raw
+        // 32128 + 40 (10 km⁻¹ right); byte 2: lockout not active (00), readiness ready (01)
+        // << 2, input position (11 n/a) << 4, request reset required (01) << 6; byte 3: limit
+        // status not limited << 5; byte 4: exit reason 5 (remote command timeout), remote
+        // engage switch n/a (11) << 6.
+        let k = (32128u16 + 40).to_le_bytes();
+        let b2 = 0b01_11_01_00;
+        let f = Frame::new(0x0CAC_FF1C, &[k[0], k[1], b2, 0x1F, 0xC5, 0xFF, 0xFF, 0xFF]);
+        let [Input::MachineInfo(m)] = inputs(&mut a, f)[..] else {
+            panic!()
+        };
+        assert_eq!(m.source, SourceId::Can(0x1C));
+        assert!(
+            (m.curvature.unwrap() + 0.010).abs() < 1e-12,
+            "10 km⁻¹ right = −0.01 /m"
+        );
+        assert_eq!(m.lockout, Some(false));
+        assert_eq!(m.ready, Some(true));
+        assert_eq!(m.reset_requested, Some(true));
+        assert_eq!(m.exit_reason, Some(5));
+        // Lockout active, not ready, no reset; everything else not available.
+        let f = Frame::new(
+            0x0CAC_FF1C,
+            &[0xFF, 0xFF, 0b11_11_00_01, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF],
+        );
+        let [Input::MachineInfo(m)] = inputs(&mut a, f)[..] else {
+            panic!()
+        };
+        assert_eq!(
+            (
+                m.curvature,
+                m.lockout,
+                m.ready,
+                m.reset_requested,
+                m.exit_reason
+            ),
+            (None, Some(true), Some(false), None, None)
+        );
     }
 
     #[test]

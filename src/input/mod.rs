@@ -161,6 +161,25 @@ pub struct WheelSpeedInput {
     pub direction: Option<crate::geo::Direction>,
 }
 
+/// The steering ECU's report (ISO 11783-7 Guidance Machine Info, PGN 0xAC00): its steering
+/// feedback and its gate for guidance commands. A field not available is `None`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MachineInfoInput {
+    pub t: f64,
+    pub source: SourceId,
+    /// Estimated curvature of the path driven, 1/m, positive left.
+    pub curvature: Option<f64>,
+    /// The steering system is ready for guidance commands.
+    pub ready: Option<bool>,
+    /// The mechanical system lockout (the operator's switch) is active.
+    pub lockout: Option<bool>,
+    /// The steering asks the guidance system to reset its command status to "not intended to
+    /// steer".
+    pub reset_requested: Option<bool>,
+    /// Why the steering cannot accept (or last stopped accepting) commands (0 = all clear).
+    pub exit_reason: Option<u8>,
+}
+
 /// A command from the operator's terminal.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "command", rename_all = "snake_case")]
@@ -170,9 +189,9 @@ pub enum OperatorCommand {
     Disengage,
     Pause,
     Resume,
-    /// Shift the line sideways, m, positive left.
+    /// Shift the line sideways by this many nudge steps, positive left.
     Nudge {
-        offset_m: f64,
+        steps: i32,
     },
     SetA,
     SetB,
@@ -227,6 +246,7 @@ pub enum Input {
     WheelAngle(WheelAngleInput),
     WheelSpeed(WheelSpeedInput),
     Operator(OperatorInput),
+    MachineInfo(MachineInfoInput),
     FrameCheck(FrameCheckInput),
 }
 
@@ -242,6 +262,7 @@ impl Input {
             Input::WheelAngle(i) => i.t,
             Input::WheelSpeed(i) => i.t,
             Input::Operator(i) => i.t,
+            Input::MachineInfo(i) => i.t,
             Input::FrameCheck(i) => i.t,
         }
     }
@@ -257,6 +278,7 @@ impl Input {
             Input::WheelAngle(i) => i.source,
             Input::WheelSpeed(i) => i.source,
             Input::Operator(i) => i.source,
+            Input::MachineInfo(i) => i.source,
             Input::FrameCheck(i) => i.source,
         }
     }

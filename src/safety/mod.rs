@@ -34,6 +34,17 @@ pub enum FaultCode {
     /// The rate limit cannot bring the angle within the lateral-acceleration limit (the speed
     /// rose too fast): steering is given back rather than break either limit.
     LateralAccelLimit = 13,
+    /// No ISO 11783-5 source address: not claimed yet, lost to a device with a lower NAME, or
+    /// none free (Cannot Claim). Nothing but address claims is sent meanwhile.
+    AddressLost = 14,
+    /// The steering ECU reports it is not ready for guidance (Guidance Machine Info readiness).
+    SteeringNotReady = 15,
+    /// The steering ECU reports its mechanical system lockout active (ISO 11783-7).
+    SteeringLockout = 16,
+    /// The steering ECU requests a reset of the command status (ISO 11783-7 request reset):
+    /// the command goes to "not intended to steer" until the request clears and the operator
+    /// engages again.
+    SteeringResetRequested = 17,
 }
 
 /// Supervisor state.
@@ -172,6 +183,9 @@ pub struct Supervisor {
     last_t: Option<f64>,
     engage_requested: bool,
     bus_down: bool,
+    /// A condition outside the inputs that forbids steering (the node's bus and steering-ECU
+    /// state), `FaultCode::None` when clear.
+    interlock: FaultCode,
     last_refusal: FaultCode,
     /// Where the actuator model says the wheels should be, rad.
     expected: f64,
@@ -204,6 +218,7 @@ impl Supervisor {
             last_t: None,
             engage_requested: false,
             bus_down: false,
+            interlock: FaultCode::None,
             last_refusal: FaultCode::None,
             expected: 0.0,
             history: [(0.0, 0.0); HISTORY],
@@ -326,6 +341,12 @@ impl Supervisor {
         self.bus_down = !up;
     }
 
+    /// A condition outside the inputs forbids steering (`code`), or none does
+    /// (`FaultCode::None`): the node's address claim and the steering ECU's readiness.
+    pub fn set_interlock(&mut self, code: FaultCode) {
+        self.interlock = code;
+    }
+
     /// The operator asked to engage. Acted on in the next [`Supervisor::step`].
     pub fn request_engage(&mut self) {
         self.engage_requested = true;
@@ -352,6 +373,9 @@ impl Supervisor {
         };
         if self.bus_down {
             return FaultCode::BusDown;
+        }
+        if self.interlock != FaultCode::None {
+            return self.interlock;
         }
         if !fresh(self.gnss_t, p.gnss_timeout) {
             return FaultCode::GnssTimeout;
