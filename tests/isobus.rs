@@ -66,7 +66,7 @@ fn name(self_configurable: bool, identity: u32) -> Name {
 fn claims_before_any_other_frame_and_answers_a_request() {
     let cfg = config(&[]);
     let dt = cfg.dt();
-    let mut node = ControllerNode::new(&cfg, None).unwrap();
+    let mut node = agsteer::job::node_for_config(&cfg, None).unwrap();
     let sent = run(&mut node, dt, 0.0, 2.0, &[]);
     // The first frame is the Request for Address Claimed, the second our claim of the
     // preferred address; every other frame comes 250 ms after it, from that address.
@@ -114,7 +114,7 @@ fn claims_before_any_other_frame_and_answers_a_request() {
 fn a_second_claimant_with_a_lower_name_moves_us_and_a_fixed_name_goes_silent() {
     let cfg = config(&[]);
     let dt = cfg.dt();
-    let mut node = ControllerNode::new(&cfg, None).unwrap();
+    let mut node = agsteer::job::node_for_config(&cfg, None).unwrap();
     run(&mut node, dt, 0.0, 1.0, &[]);
     let ours = cfg.isobus.name();
     // A higher NAME claims 0x2A: we keep it (our claim again).
@@ -160,7 +160,7 @@ fn a_second_claimant_with_a_lower_name_moves_us_and_a_fixed_name_goes_silent() {
 
     // Not self-configurable: Cannot Claim, then silence, and the fault says why.
     let cfg = config(&["isobus.self_configurable=false"]);
-    let mut node = ControllerNode::new(&cfg, None).unwrap();
+    let mut node = agsteer::job::node_for_config(&cfg, None).unwrap();
     run(&mut node, dt, 0.0, 1.0, &[]);
     let lower = name(false, 0);
     assert!(lower < cfg.isobus.name());
@@ -185,7 +185,7 @@ fn a_second_claimant_with_a_lower_name_moves_us_and_a_fixed_name_goes_silent() {
 #[test]
 fn without_address_claim_frames_go_out_at_once() {
     let cfg = config(&["isobus.address_claim=false"]);
-    let mut node = ControllerNode::new(&cfg, None).unwrap();
+    let mut node = agsteer::job::node_for_config(&cfg, None).unwrap();
     let sent = run(&mut node, cfg.dt(), 0.0, 0.1, &[]);
     assert!(sent.iter().all(|(_, f)| read(f).is_none()));
     assert_eq!(sent[0].0, 0.0);

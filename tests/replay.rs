@@ -65,7 +65,13 @@ fn closed_loop(cfg: &Config, seconds: f64, log: &BusLog) -> (u64, u64, u64) {
             .guidance_mut()
             .drain_events()
             .for_each(drop);
-        ticks += 1;
+        // Periods on the bus (none before the ISO 11783-5 address is claimed).
+        if out
+            .iter()
+            .any(|f| agsteer::control::replay::is_own(f, cfg.bus.source_address))
+        {
+            ticks += 1;
+        }
         if cmd.engaged {
             engaged += 1;
         }

@@ -223,6 +223,15 @@ impl ControllerNode {
         &self.enu
     }
 
+    /// Send from the configured source address without claiming it (an offline replay of a
+    /// log, whose frames show the address the daemon held).
+    pub fn without_address_claim(mut self) -> Self {
+        let mut p = *self.iso.params();
+        p.claim = None;
+        self.iso = IsoLink::new(p);
+        self
+    }
+
     /// The CAN link came up again (or recovered from bus-off): the address is claimed again.
     pub fn on_link_up(&mut self) {
         self.iso.restart();
@@ -458,6 +467,36 @@ impl ControllerNode {
         Some(request_of(want))
     }
 
+    /// A period without an ISO 11783-5 address (claiming, lost, or Cannot Claim): nothing but
+    /// the claim goes out and the control loop idles (inputs are still taken), so that the
+    /// first period with an address is the first period on the bus, as a replay of the log
+    /// sees it. Steering stops: the operator engages again once the address is claimed.
+    fn idle_without_address(&mut self) -> Cmd {
+        let was_engaged = self.supervisor.state() == SafetyState::Engaged;
+        self.supervisor.request_disengage();
+        self.ctrl.set_engaged(false);
+        let angle = self.supervisor.expected_wheel_angle();
+        let state = if was_engaged || matches!(self.status.state, SafetyState::Fault(_)) {
+            SafetyState::Fault(FaultCode::AddressLost)
+        } else {
+            SafetyState::Disengaged
+        };
+        self.status = NodeStatus {
+            state,
+            fault: FaultCode::AddressLost,
+            engaged: false,
+            isobus: self.iso.status(),
+            ..self.status
+        };
+        Cmd {
+            engaged: false,
+            wheel_angle: angle,
+            curvature: angle.tan() / self.supervisor.params().wheelbase,
+            state,
+            fault: FaultCode::AddressLost,
+        }
+    }
+
     /// One control period at `t`: appends the frames to send.
     pub fn tick(&mut self, t: f64, out: &mut Vec<Frame>) -> Cmd {
         // The address claim first: until it stands, nothing else goes out.
@@ -465,7 +504,9 @@ impl ControllerNode {
         if let Some(a) = address {
             self.packer.set_source(a);
         }
-        let first_app = out.len();
+        if address.is_none() {
+            return self.idle_without_address();
+        }
         self.supervisor.set_interlock(self.iso.interlock(t));
         let c = match self.ctrl.tick(t) {
             Ok(c) => {
@@ -578,10 +619,6 @@ impl ControllerNode {
             if let Ok(f) = self.packer.pack(&msg) {
                 out.push(f);
             }
-        }
-        if address.is_none() {
-            // No address: the claim's frames only.
-            out.truncate(first_app);
         }
         self.ticks += 1;
         cmd

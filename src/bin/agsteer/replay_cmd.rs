@@ -83,7 +83,8 @@ pub fn run(cfg: &Config, args: &ReplayArgs) -> Result<u8> {
     } else {
         ticks_for(frames.iter().map(|(_, f)| f), own, cfg.dt(), true)
     };
-    let node = crate::daemon_node(cfg, args.progress)?;
+    // Offline: the address is the one the log shows, not claimed again.
+    let node = crate::daemon_node(cfg, args.progress)?.without_address_claim();
     let mut out_frames = match args.frames_out {
         Some(p) => Some(std::io::BufWriter::new(
             std::fs::File::create(p).with_context(|| format!("{}", p.display()))?,
