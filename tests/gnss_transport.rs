@@ -320,3 +320,73 @@ async fn tcp_client_reconnects_when_the_server_drops_it() {
     let s = status(&r);
     assert!(s.reconnects >= 1, "{s:?}");
 }
+
+/// Read what the pty's slave side was given, for up to `within`.
+async fn read_master(pty: &Pty, within: Duration) -> Vec<u8> {
+    use std::io::Read;
+    pty.set_nonblocking().unwrap();
+    let mut got = Vec::new();
+    let mut buf = [0u8; 1024];
+    let end = Instant::now() + within;
+    while Instant::now() < end {
+        let mut m = pty.master();
+        match m.read(&mut buf) {
+            Ok(n) if n > 0 => got.extend_from_slice(&buf[..n]),
+            _ => tokio::time::sleep(Duration::from_millis(10)).await,
+        }
+    }
+    got
+}
+
+/// `gnss.rtcm_device`: corrections go to a separate serial port (a pty behind a link), in
+/// order and whole; unplugged and plugged back, the port is reopened and gets the new ones.
+#[tokio::test(flavor = "current_thread")]
+async fn rtcm_to_a_separate_serial_port() {
+    use agsteer::io::framer::rtcm_frame;
+    let dir = tempfile::tempdir().unwrap();
+    let link = dir.path().join("usb-FTDI_UART2-if00-port0");
+    let pty = Pty::open().unwrap();
+    std::os::unix::fs::symlink(pty.path(), &link).unwrap();
+    let status: SharedStatus = Arc::new(Mutex::new(StreamStatus::default()));
+    let (tx, rx) = mpsc::channel(16);
+    tokio::spawn(agsteer::io::transport::run_rtcm_serial(
+        link.clone(),
+        38_400,
+        rx,
+        status.clone(),
+        0.05,
+        0.2,
+    ));
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    let frames: Vec<Vec<u8>> = (0..3u8).map(|k| rtcm_frame(&[0x3E, 0xD0 | k, k])).collect();
+    for f in &frames {
+        tx.send(f.clone()).await.unwrap();
+    }
+    let got = read_master(&pty, Duration::from_millis(300)).await;
+    assert_eq!(got, frames.concat());
+    assert_eq!(
+        status.lock().unwrap().rtcm_bytes_out,
+        frames.concat().len() as u64
+    );
+    // Unplugged: the next write fails; plugged back behind the same link.
+    drop(pty);
+    std::fs::remove_file(&link).unwrap();
+    let _ = tx.send(frames[0].clone()).await;
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let pty = Pty::open().unwrap();
+    std::os::unix::fs::symlink(pty.path(), &link).unwrap();
+    let fresh = rtcm_frame(&[0x3E, 0xD7, 7]);
+    let mut got = Vec::new();
+    for _ in 0..20 {
+        tx.send(fresh.clone()).await.unwrap();
+        got.extend(read_master(&pty, Duration::from_millis(100)).await);
+        if !got.is_empty() {
+            break;
+        }
+    }
+    assert!(!got.is_empty(), "written again after the replug");
+    assert!(
+        got.chunks(fresh.len()).all(|c| c == fresh.as_slice()),
+        "only new corrections after the replug"
+    );
+}

@@ -62,6 +62,11 @@ pub struct GnssConfig {
     pub udp_source: String,
     /// UDP: send RTCM corrections to this "address:port" ("" = nowhere).
     pub udp_rtcm_to: String,
+    /// A separate serial port for the RTCM corrections (a receiver's second UART), "" = the
+    /// receiver's own port (or `udp_rtcm_to`).
+    pub rtcm_device: String,
+    /// Baud rate of `rtcm_device` (8N1).
+    pub rtcm_baud: u32,
     /// TCP client: the receiver's (or bridge's) host and port.
     pub tcp_host: String,
     pub tcp_port: u16,
@@ -115,6 +120,8 @@ impl Default for GnssConfig {
             udp_bind: "0.0.0.0".into(),
             udp_source: String::new(),
             udp_rtcm_to: String::new(),
+            rtcm_device: String::new(),
+            rtcm_baud: 115_200,
             tcp_host: String::new(),
             tcp_port: 0,
             baseline_angle_deg: 0.0,
@@ -151,6 +158,13 @@ impl GnssConfig {
             c.push(
                 "gnss.baud",
                 g.baud.to_string(),
+                "must be one of 4800, 9600, 19200, 38400, 57600, 115200, 230400, 460800, 921600",
+            );
+        }
+        if !BAUD_RATES.contains(&g.rtcm_baud) {
+            c.push(
+                "gnss.rtcm_baud",
+                g.rtcm_baud.to_string(),
                 "must be one of 4800, 9600, 19200, 38400, 57600, 115200, 230400, 460800, 921600",
             );
         }
@@ -261,14 +275,23 @@ impl GnssConfig {
                     "give the password or a password file, not both",
                 );
             }
-            if g.transport == TransportKind::Udp && g.udp_rtcm_to.is_empty() && g.is_stream() {
+            if g.transport == TransportKind::Udp
+                && g.udp_rtcm_to.is_empty()
+                && g.rtcm_device.is_empty()
+                && g.is_stream()
+            {
                 c.push(
                     "gnss.udp_rtcm_to",
                     "\"\"".into(),
-                    "must say where the corrections go (the receiver's \"address:port\") when NTRIP feeds a UDP receiver",
+                    "must say where the corrections go (the receiver's \"address:port\", or set gnss.rtcm_device) when NTRIP feeds a UDP receiver",
                 );
             }
         }
+    }
+
+    /// The separate serial port for the corrections (device, baud), if one is configured.
+    pub fn rtcm_serial(&self) -> Option<(std::path::PathBuf, u32)> {
+        (!self.rtcm_device.is_empty()).then(|| (self.rtcm_device.clone().into(), self.rtcm_baud))
     }
 
     /// The byte stream's parameters, when GNSS comes from one.

@@ -5,7 +5,7 @@
 use crate::config::{Config, PasswordFileError};
 use crate::input::Input;
 use crate::io::ntrip::{run_ntrip, GgaSource, NtripPorts, NtripStatus};
-use crate::io::transport::{run_stream, SharedStatus, StreamPorts, StreamStatus};
+use crate::io::transport::{run_rtcm_serial, run_stream, SharedStatus, StreamPorts, StreamStatus};
 use serde::Serialize;
 use std::sync::{Arc, Mutex};
 use tokio::sync::{mpsc, watch};
@@ -92,11 +92,28 @@ pub fn spawn(
         stream_cfg.transport,
         stream_cfg.decoder.protocol
     );
+    // Corrections to a separate serial port, or to the receiver's own.
+    let rtcm_serial = cfg.gnss.rtcm_serial().filter(|_| ntrip.is_some());
+    let rtcm_rx = match rtcm_serial {
+        Some((device, baud)) => {
+            tracing::info!("NTRIP corrections to {}", device.display());
+            local.spawn_local(run_rtcm_serial(
+                device,
+                baud,
+                rtcm_rx,
+                stream.clone(),
+                stream_cfg.backoff_min_s,
+                stream_cfg.backoff_max_s,
+            ));
+            None
+        }
+        None => ntrip.is_some().then_some(rtcm_rx),
+    };
     local.spawn_local(run_stream(
         stream_cfg,
         StreamPorts {
             inputs: tx,
-            rtcm: ntrip.is_some().then_some(rtcm_rx),
+            rtcm: rtcm_rx,
             last_rtcm: ntrip.is_some().then_some(last_rtcm_rx),
             position: ntrip.is_some().then_some(position_tx),
             status: stream.clone(),

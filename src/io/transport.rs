@@ -311,6 +311,49 @@ impl Sink<'_> {
     }
 }
 
+/// Write the NTRIP corrections to a separate serial port (`gnss.rtcm_device`: a receiver's
+/// second UART) for ever: reopened with back-off when it fails or disappears; frames queued
+/// while it was away are dropped on reopening (old corrections are of no use). Bytes written
+/// count in `status.rtcm_bytes_out`.
+pub async fn run_rtcm_serial(
+    device: PathBuf,
+    baud: u32,
+    mut rtcm: mpsc::Receiver<Vec<u8>>,
+    status: SharedStatus,
+    backoff_min_s: f64,
+    backoff_max_s: f64,
+) {
+    let transport = Transport::Serial { device, baud };
+    let mut backoff = backoff_min_s;
+    let mut last_error = String::new();
+    loop {
+        let reason = match open(&transport).await {
+            Ok(Conn::Stream(_, mut w)) => {
+                tracing::info!("RTCM to {transport}: open");
+                backoff = backoff_min_s;
+                while rtcm.try_recv().is_ok() {}
+                loop {
+                    let Some(data) = rtcm.recv().await else {
+                        return;
+                    };
+                    if let Err(e) = w.write_all(&data).await {
+                        break format!("write error: {e}");
+                    }
+                    set_status(&status, |s| s.rtcm_bytes_out += data.len() as u64);
+                }
+            }
+            Ok(Conn::Udp(_)) => return,
+            Err(e) => format!("cannot open: {e}"),
+        };
+        if reason != last_error {
+            tracing::warn!("RTCM to {transport}: {reason}; retrying");
+            last_error = reason;
+        }
+        tokio::time::sleep(Duration::from_secs_f64(backoff)).await;
+        backoff = (backoff * 2.0).min(backoff_max_s);
+    }
+}
+
 /// Run one stream for ever (see the module doc).
 pub async fn run_stream(cfg: StreamConfig, mut ports: StreamPorts) {
     let name = cfg.transport.to_string();
