@@ -184,6 +184,7 @@ impl Config {
             a: self.guidance.a,
             point_spacing_m: self.guidance.point_spacing_m,
             plan_checksum: None,
+            identity: Default::default(),
         }
     }
 

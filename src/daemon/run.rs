@@ -239,7 +239,7 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
         },
     )?);
     let progress_path = progress_file::progress_path(&resolved.daemon.state_dir);
-    let resume = crate::job::resume::resume_or_start(&job.definition, &progress_path);
+    let resume = crate::job::resume::resume_or_start(&job, &progress_path);
     // The node is built once; a SIGHUP only retunes it (apply_reload), so the plan is kept.
     let mut node = crate::job::build_node(&resolved, &job, resume.as_ref())?;
     let progress_tx = spawn_progress_writer(progress_path.clone());

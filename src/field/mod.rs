@@ -475,7 +475,6 @@ impl Accum {
         tolerance: f64,
     ) -> Result<(Vec<Vec2>, f64, f64), FieldError> {
         let local: Vec<Vec2> = ring.iter().map(|p| frame.to_enu(*p)).collect();
-        check_near_origin(feature, frame.origin(), &local)?;
         let cleaned = clean_ring(&local, tolerance);
         let r = &mut self.report;
         r.vertices_before += local.len();
@@ -591,6 +590,7 @@ fn assemble(parsed: Parsed, options: &LoadOptions) -> Result<LoadedField, FieldE
         tol,
     )?;
     check_extent(&boundary.label, &outer)?;
+    check_near_origin(&boundary.label, origin, &outer)?;
     let (mut area_before, mut area_after) = (a_before, a_after);
     // Holes of the boundary become obstacles, labelled after the boundary feature.
     for (k, hole) in boundary.holes.iter().enumerate() {

@@ -57,6 +57,8 @@ pub enum GuidanceError {
         "saved progress belongs to a different job (job parameters differ); refusing to resume"
     )]
     DifferentJob,
+    #[error("saved progress is impossible in this plan: {0}")]
+    Impossible(String),
     #[error("saved progress points at block {block}, rank {rank}, which this job does not have")]
     OutOfRange { block: u64, rank: u64 },
     #[error(transparent)]
@@ -121,6 +123,8 @@ impl Guidance {
         if saved.job != job {
             return Err(GuidanceError::DifferentJob);
         }
+        let plan = plan.into();
+        super::progress::check_against_plan(saved, &plan).map_err(GuidanceError::Impossible)?;
         let mut g = Guidance::new(plan, job, params)?;
         g.events.clear();
         let (block, rank) = (saved.index_block, saved.index_rank);

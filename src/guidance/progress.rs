@@ -11,7 +11,7 @@ const CRC: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI);
 /// First word of the checksum line.
 const CHECKSUM_TAG: &str = "crc32c";
 /// Format version written into every file.
-pub const PROGRESS_VERSION: u32 = 1;
+pub const PROGRESS_VERSION: u32 = 2;
 
 /// The parameters that define a job (the configuration's job keys, filled in by the
 /// configuration layer, and a segment job's checksum). A saved progress only applies to the
@@ -31,15 +31,191 @@ pub struct JobDefinition {
     /// ([`SegmentJob::checksum`](crate::plan::job::SegmentJob::checksum)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plan_checksum: Option<u32>,
+    /// The plan's identity: every input of the driven order and geometry, by name (the
+    /// planner's revision, the job kind, the ENU origin, every field of the planner's
+    /// parameters as resolved, the plan's checksum), filled in by the job layer
+    /// (`job::identity`). Progress saved under another identity is not resumed.
+    pub identity: std::collections::BTreeMap<String, String>,
 }
 
 impl JobDefinition {
+    /// What differs between this definition and `saved`, one line each naming the item with
+    /// the saved and the current value (empty when they are equal).
+    pub fn differences(&self, saved: &JobDefinition) -> Vec<String> {
+        let (mut now, mut then) = (Vec::new(), Vec::new());
+        flatten_json(
+            "",
+            &serde_json::to_value(self).unwrap_or_default(),
+            &mut now,
+        );
+        flatten_json(
+            "",
+            &serde_json::to_value(saved).unwrap_or_default(),
+            &mut then,
+        );
+        let now: std::collections::BTreeMap<_, _> = now.into_iter().collect();
+        let then: std::collections::BTreeMap<_, _> = then.into_iter().collect();
+        let mut keys: Vec<&String> = now.keys().chain(then.keys()).collect();
+        keys.sort();
+        keys.dedup();
+        keys.into_iter()
+            .filter(|k| now.get(*k) != then.get(*k))
+            .map(|k| {
+                let show = |v: Option<&String>| v.map_or("(none)", String::as_str).to_string();
+                format!(
+                    "{}: saved {}, now {}",
+                    k.strip_prefix("identity.").unwrap_or(k),
+                    show(then.get(k)),
+                    show(now.get(k))
+                )
+            })
+            .collect()
+    }
+
     /// This definition for the job `plan`: a segment job adds its checksum.
     pub fn with_plan(mut self, plan: &crate::plan::job::JobPlan) -> Self {
         if let crate::plan::job::JobPlan::Segments(s) = plan {
             self.plan_checksum = Some(s.checksum());
         }
         self
+    }
+}
+
+/// Dotted paths and leaf values of a JSON value.
+fn flatten_json(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, String)>) {
+    match v {
+        serde_json::Value::Object(m) => {
+            for (k, v) in m {
+                let key = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                flatten_json(&key, v, out);
+            }
+        }
+        serde_json::Value::String(s) => out.push((prefix.to_string(), s.clone())),
+        other => out.push((prefix.to_string(), other.to_string())),
+    }
+}
+
+/// Flatten a value's `Debug` text (`Name { field: value, inner: Inner { … } }`) into
+/// `prefix.field` → value entries, so every field of a parameter struct is named without a
+/// hand-written list (a new field is included by itself). Lists, tuples and enum payloads
+/// stay whole values.
+pub fn flatten_debug(
+    prefix: &str,
+    text: &str,
+    out: &mut std::collections::BTreeMap<String, String>,
+) {
+    let text = text.trim();
+    let body = text
+        .find(" {")
+        .filter(|&i| {
+            text.ends_with('}')
+                && text[..i]
+                    .chars()
+                    .all(|c| c.is_alphanumeric() || c == '_' || c == ':')
+        })
+        .map(|i| &text[i + 2..text.len() - 1]);
+    let Some(body) = body else {
+        out.insert(prefix.to_string(), text.to_string());
+        return;
+    };
+    for field in split_top_level(body) {
+        match field.split_once(": ") {
+            Some((name, value)) if !name.trim().is_empty() => {
+                flatten_debug(&format!("{prefix}.{}", name.trim()), value, out)
+            }
+            _ if field.trim().is_empty() => {}
+            _ => {
+                out.insert(prefix.to_string(), text.to_string());
+                return;
+            }
+        }
+    }
+}
+
+/// `a, b { c, d }, [e, f]` split at the commas outside brackets and quotes.
+fn split_top_level(s: &str) -> Vec<&str> {
+    let (mut depth, mut quoted, mut escaped, mut start) = (0i32, false, false, 0usize);
+    let mut out = Vec::new();
+    for (i, c) in s.char_indices() {
+        if quoted {
+            match c {
+                _ if escaped => escaped = false,
+                '\\' => escaped = true,
+                '"' => quoted = false,
+                _ => {}
+            }
+            continue;
+        }
+        match c {
+            '"' => quoted = true,
+            '{' | '[' | '(' => depth += 1,
+            '}' | ']' | ')' => depth -= 1,
+            ',' if depth == 0 => {
+                out.push(s[start..i].trim());
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    out.push(s[start..].trim());
+    out
+}
+
+/// Why saved progress is impossible for the plan it claims: names the field, its value and
+/// what the plan allows.
+pub fn check_against_plan(p: &Progress, plan: &crate::plan::job::JobPlan) -> Result<(), String> {
+    use crate::plan::job::JobPlan;
+    let (block, rank) = (p.index_block, p.index_rank);
+    let (expected_done, last) = match plan {
+        JobPlan::Ab(ab) => {
+            if let Some(n) = ab.block_count() {
+                if block >= n {
+                    return Err(format!("index_block {block}: the plan has {n} blocks"));
+                }
+            }
+            if block.checked_mul(ab.block_size() as u64).is_none() {
+                return Err(format!("index_block {block}: out of range"));
+            }
+            let len = ab.block_len(block) as u64;
+            if rank >= len {
+                return Err(format!("index_rank {rank}: block {block} has {len} lines"));
+            }
+            (
+                ab.sequence_number(block, rank as usize),
+                ab.next_position(block, rank as usize).is_none(),
+            )
+        }
+        JobPlan::Segments(job) => {
+            if block != 0 {
+                return Err(format!(
+                    "index_block {block}: a segment job has block 0 only"
+                ));
+            }
+            let n = job.len() as u64;
+            if rank >= n {
+                return Err(format!("index_rank {rank}: the plan has {n} segments"));
+            }
+            (rank, rank + 1 == n)
+        }
+    };
+    match p.phase {
+        Phase::Finished if !last => Err(format!(
+            "phase \"finished\" at index_block {block}, index_rank {rank}, which is not the plan's last line"
+        )),
+        Phase::Finished if p.lines_done != expected_done + 1 => Err(format!(
+            "lines_done {}: a finished plan has {} lines done",
+            p.lines_done,
+            expected_done + 1
+        )),
+        Phase::Work | Phase::Turn if p.lines_done != expected_done => Err(format!(
+            "lines_done {}: at index_block {block}, index_rank {rank} the plan has {expected_done} lines done",
+            p.lines_done
+        )),
+        _ => Ok(()),
     }
 }
 

@@ -163,7 +163,7 @@ impl FieldJob {
     /// The job definition saved with progress: the configuration's job keys and this plan's
     /// checksum. Progress saved under another definition must not be resumed.
     pub fn job_definition(&self, cfg: &Config) -> JobDefinition {
-        cfg.job_definition().with_plan(&self.job_plan())
+        super::identity::define(&cfg.planning(), &self.job_plan(), Some(self.origin()))
     }
 
     /// The ENU origin of the plan's coordinates. GNSS positions must be converted about this

@@ -14,6 +14,7 @@
 //! gets typed parameters.
 
 pub mod field;
+pub mod identity;
 pub mod maneuver;
 pub mod resume;
 
@@ -110,7 +111,7 @@ pub fn prepare(planning: &Planning) -> Result<PreparedJob, JobError> {
         }
     };
     Ok(PreparedJob {
-        definition: planning.definition.clone().with_plan(&plan),
+        definition: identity::define(planning, &plan, origin),
         plan,
         origin,
         field,
@@ -132,7 +133,7 @@ pub fn given(
     field: Option<Field>,
 ) -> PreparedJob {
     PreparedJob {
-        definition: planning.definition.clone().with_plan(&plan),
+        definition: identity::define(planning, &plan, origin),
         plan,
         origin,
         field,
@@ -177,3 +178,5 @@ pub fn node_for_config(
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_identity;

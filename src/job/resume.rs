@@ -1,13 +1,20 @@
 //! The one resume: read a saved progress through [`crate::store::progress_file`], check that
-//! it belongs to the job, and say what was found. A corrupt file is moved aside by the store
-//! and reported; progress of another job is left where it is (it may still be wanted for its
-//! own job) and not resumed.
+//! it belongs to the job and is possible in its plan, and say what was found.
+//!
+//! - A file that fails its checksum, or whose contents are impossible for the plan it claims
+//!   (a block, rank or lines-done count the plan does not have, or that do not agree, a
+//!   "finished" phase short of the end), is corrupt: moved aside (`*.corrupt-N`) and
+//!   reported naming the file and the field, never trusted.
+//! - Progress of another plan (any difference in the job's identity:
+//!   [`crate::job::identity`]) is left where it is and not resumed; the report names every
+//!   item that changed with its saved and current value.
 //!
 //! Two policies on top: the daemon starts afresh on anything but its own progress
 //! ([`resume_or_start`], logged), `agsteer demo --resume` refuses to run
-//! ([`require_resume`]).
+//! ([`require_resume`]) and says the way forward.
 
-use crate::guidance::progress::{JobDefinition, Progress};
+use super::PreparedJob;
+use crate::guidance::progress::{check_against_plan, Progress, ProgressError};
 use crate::store::progress_file::{self, ProgressFileError};
 use std::path::Path;
 
@@ -18,49 +25,45 @@ pub enum Saved {
     Nothing,
     /// Progress of this job.
     Ours(Progress),
-    /// Progress of another job (left in place).
-    Foreign(Foreign),
+    /// Progress of another plan (left in place): what differs, one item each
+    /// (`"ab.r_min: saved 6.0, now 8.1"`).
+    Foreign(Vec<String>),
 }
 
-/// Why saved progress belongs to another job.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Foreign {
-    /// Another segment plan (or an AB job's progress for a segment job, or back): the plan
-    /// checksums differ.
-    OtherPlan {
-        saved: Option<u32>,
-        expected: Option<u32>,
-    },
-    /// Same plan checksum, other job keys.
-    OtherJob,
-}
-
-/// A plan checksum for messages.
-pub fn checksum_text(c: Option<u32>) -> String {
-    c.map_or_else(|| "none (AB job)".into(), |c| format!("{c:08x}"))
-}
-
-/// Read the progress at `path` and check it against the job `expected`. A corrupt file is
+/// Read the progress at `path` and check it against `job`. A corrupt or impossible file is
 /// moved aside ([`ProgressFileError::Corrupt`]).
-pub fn load_saved(expected: &JobDefinition, path: &Path) -> Result<Saved, ProgressFileError> {
-    Ok(match progress_file::load(path)? {
-        None => Saved::Nothing,
-        Some(p) if p.job == *expected => Saved::Ours(p),
-        Some(p) if p.job.plan_checksum != expected.plan_checksum => {
-            Saved::Foreign(Foreign::OtherPlan {
-                saved: p.job.plan_checksum,
-                expected: expected.plan_checksum,
-            })
-        }
-        Some(_) => Saved::Foreign(Foreign::OtherJob),
-    })
+pub fn load_saved(job: &PreparedJob, path: &Path) -> Result<Saved, ProgressFileError> {
+    let Some(p) = progress_file::load(path)? else {
+        return Ok(Saved::Nothing);
+    };
+    let changes = job.definition.differences(&p.job);
+    if !changes.is_empty() {
+        return Ok(Saved::Foreign(changes));
+    }
+    match check_against_plan(&p, &job.plan) {
+        Ok(()) => Ok(Saved::Ours(p)),
+        Err(why) => Err(progress_file::move_aside(path, ProgressError::Content(why))),
+    }
 }
 
-/// The daemon's resume: the saved progress of the job `expected`, or `None` (and a log line)
-/// when there is none, it is corrupt (moved aside) or it belongs to another job (other
-/// parameters, or another field plan).
-pub fn resume_or_start(expected: &JobDefinition, path: &Path) -> Option<Progress> {
-    match load_saved(expected, path) {
+fn summary(changes: &[String]) -> String {
+    const SHOWN: usize = 8;
+    let mut s = changes
+        .iter()
+        .take(SHOWN)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join("; ");
+    if changes.len() > SHOWN {
+        s.push_str(&format!("; and {} more", changes.len() - SHOWN));
+    }
+    s
+}
+
+/// The daemon's resume: the saved progress of `job`, or `None` (and a log line) when there is
+/// none, it is corrupt or impossible (moved aside) or it belongs to another plan.
+pub fn resume_or_start(job: &PreparedJob, path: &Path) -> Option<Progress> {
+    match load_saved(job, path) {
         Ok(Saved::Ours(p)) => {
             tracing::info!(
                 lines_done = p.lines_done,
@@ -71,19 +74,11 @@ pub fn resume_or_start(expected: &JobDefinition, path: &Path) -> Option<Progress
             );
             Some(p)
         }
-        Ok(Saved::Foreign(Foreign::OtherPlan { saved, expected })) => {
+        Ok(Saved::Foreign(changes)) => {
             tracing::warn!(
-                "{} belongs to another field plan (checksum {}, this plan {}); starting this job from the beginning",
+                "{} was saved for another plan ({}); starting this job from the beginning (the file is overwritten at the first line change)",
                 path.display(),
-                checksum_text(saved),
-                checksum_text(expected)
-            );
-            None
-        }
-        Ok(Saved::Foreign(Foreign::OtherJob)) => {
-            tracing::warn!(
-                "{} belongs to another job (its parameters differ); starting this job from the beginning",
-                path.display()
+                summary(&changes)
             );
             None
         }
@@ -100,29 +95,24 @@ pub fn resume_or_start(expected: &JobDefinition, path: &Path) -> Option<Progress
 pub enum ResumeError {
     #[error("--resume: no progress file at {}", path.display())]
     Nothing { path: std::path::PathBuf },
-    #[error("--resume: {} was saved for another field plan (checksum {}, this plan {}); run without --resume to start afresh", path.display(), checksum_text(*saved), checksum_text(*expected))]
+    #[error("--resume: {} was saved for another plan than the one {config} gives now ({}). Run without --resume to start this plan afresh (the saved progress is then overwritten), or restore the saved values to keep driving the old plan", path.display(), summary(changes))]
     OtherPlan {
         path: std::path::PathBuf,
-        saved: Option<u32>,
-        expected: Option<u32>,
-    },
-    #[error("--resume: {} belongs to another job (its job parameters differ from {config}); run without --resume to start afresh", path.display())]
-    OtherJob {
-        path: std::path::PathBuf,
         config: String,
+        changes: Vec<String>,
     },
-    #[error("--resume")]
+    #[error("--resume: {0}")]
     File(#[source] ProgressFileError),
 }
 
-/// `agsteer demo --resume`: the saved progress of the job `expected` (defined by the
-/// configuration file `config`), or why there is none to resume.
+/// `agsteer demo --resume`: the saved progress of `job` (configured by the file `config`), or
+/// why there is none to resume.
 pub fn require_resume(
-    expected: &JobDefinition,
+    job: &PreparedJob,
     path: &Path,
     config: &Path,
 ) -> Result<Progress, ResumeError> {
-    match load_saved(expected, path).map_err(ResumeError::File)? {
+    match load_saved(job, path).map_err(ResumeError::File)? {
         Saved::Ours(p) => {
             tracing::info!(
                 lines_done = p.lines_done,
@@ -136,14 +126,10 @@ pub fn require_resume(
         Saved::Nothing => Err(ResumeError::Nothing {
             path: path.to_path_buf(),
         }),
-        Saved::Foreign(Foreign::OtherPlan { saved, expected }) => Err(ResumeError::OtherPlan {
-            path: path.to_path_buf(),
-            saved,
-            expected,
-        }),
-        Saved::Foreign(Foreign::OtherJob) => Err(ResumeError::OtherJob {
+        Saved::Foreign(changes) => Err(ResumeError::OtherPlan {
             path: path.to_path_buf(),
             config: config.display().to_string(),
+            changes,
         }),
     }
 }

@@ -32,7 +32,7 @@ fn field_job_is_planned_and_its_progress_resumed() {
     let dir = tempfile::tempdir().unwrap();
     let path = progress_file::progress_path(dir.path());
     progress_file::save(&path, &progress(&job.definition)).unwrap();
-    let resume = load_progress(&job.definition, &path).expect("same plan resumes");
+    let resume = load_progress(&job, &path).expect("same plan resumes");
     let node = build_node(&cfg.resolve().unwrap(), &job, Some(&resume)).expect("node resumes");
     assert_eq!(node.controller().guidance().lines_done(), 3);
     // GNSS positions are converted about the field's origin, not job.origin_*.
@@ -50,19 +50,21 @@ fn progress_saved_with_another_plan_checksum_is_not_resumed() {
     let other_cfg = demo_field_config(&["field.headland_passes=4"]);
     let other = prepare_config(&other_cfg).unwrap();
     assert_ne!(other.definition.plan_checksum, job.definition.plan_checksum);
-    let mut same_keys = other.definition.clone();
-    same_keys.plan_checksum = job.definition.plan_checksum;
-    assert_eq!(same_keys, job.definition, "only the checksum differs");
+    let changes = other.definition.differences(&job.definition);
+    assert!(
+        changes.iter().all(|c| c.starts_with("plan")),
+        "only the plan differs: {changes:?}"
+    );
 
     let dir = tempfile::tempdir().unwrap();
     let path = progress_file::progress_path(dir.path());
     progress_file::save(&path, &progress(&other.definition)).unwrap();
-    assert_eq!(load_progress(&job.definition, &path), None);
+    assert_eq!(load_progress(&job, &path), None);
     // The file is left alone (not corrupt), and is still good for its own plan.
-    assert!(load_progress(&other.definition, &path).is_some());
+    assert!(load_progress(&other, &path).is_some());
     // Progress of an AB job (no checksum) does not resume a field job either.
     progress_file::save(&path, &progress(&cfg.job_definition())).unwrap();
-    assert_eq!(load_progress(&job.definition, &path), None);
+    assert_eq!(load_progress(&job, &path), None);
     // And the controller itself refuses it too.
     let saved = progress(&other.definition);
     assert!(build_node(&cfg.resolve().unwrap(), &job, Some(&saved)).is_err());
@@ -73,7 +75,11 @@ fn ab_job_definition_is_the_configured_one() {
     let cfg = Config::default();
     let job = prepare_config(&cfg).unwrap();
     assert!(job.origin.is_none());
-    assert_eq!(job.definition, cfg.job_definition());
+    // The configured job keys, and the plan's identity on top.
+    let mut keys = job.definition.clone();
+    keys.identity.clear();
+    assert_eq!(keys, cfg.job_definition());
+    assert!(job.definition.identity.contains_key("ab.r_min"));
 }
 
 #[test]

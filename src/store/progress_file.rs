@@ -232,7 +232,7 @@ fn remove_stale_temps(path: &Path) {
 }
 
 /// Move a corrupt file aside (`*.corrupt-N`) and say where.
-fn move_aside(path: &Path, reason: ProgressError) -> ProgressFileError {
+pub fn move_aside(path: &Path, reason: ProgressError) -> ProgressFileError {
     let moved_to = (0u32..1000)
         .map(|n| path.with_extension(format!("json.corrupt-{n}")))
         .find(|p| fs::symlink_metadata(p).is_err())

@@ -445,7 +445,7 @@ fn daemon_node(
 ) -> Result<agsteer::control::node::ControllerNode> {
     let resolved = cfg.resolve().context("configuration")?;
     let job = agsteer::job::prepare(&resolved.planning).context("preparing the job")?;
-    let resume = progress.and_then(|p| agsteer::job::resume::resume_or_start(&job.definition, p));
+    let resume = progress.and_then(|p| agsteer::job::resume::resume_or_start(&job, p));
     if progress.is_some() && resume.is_none() {
         anyhow::bail!("--progress: no progress of this job to resume");
     }
@@ -534,7 +534,7 @@ fn run_demo(
     let progress_path = out.join(progress_file::PROGRESS_FILE_NAME);
     let resume_from = if resume {
         Some(agsteer::job::resume::require_resume(
-            &job.definition,
+            &job,
             &progress_path,
             config,
         )?)
