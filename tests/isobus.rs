@@ -190,3 +190,79 @@ fn without_address_claim_frames_go_out_at_once() {
     assert!(sent.iter().all(|(_, f)| read(f).is_none()));
     assert_eq!(sent[0].0, 0.0);
 }
+
+/// An AB job closed-loop over the ISO 11783-7 messages only (the simulator's steer-ready
+/// tractor: Guidance System Command in, Guidance Machine Info out, no wheel-angle frame),
+/// against the same job with the proprietary angle frames.
+#[test]
+fn steer_ready_loop_drives_the_job_within_twice_the_angle_mode_xte() {
+    use agsteer::demo::{run, DemoOptions};
+    let angle = config(&["job.line_num=3"]);
+    let iso = config(&["job.line_num=3", "bus.output=\"curvature\""]);
+    let go = |cfg: &Config| run(cfg, &DemoOptions::default(), &mut |_| {}, &mut |_, _| {}).unwrap();
+    let a = go(&angle);
+    let b = go(&iso);
+    println!(
+        "STEER-READY xte_rms angle {:.4} m iso {:.4} m; p95 {:.4} / {:.4}; max {:.4} / {:.4}; disengagements {:?}",
+        a.report.xte_rms_m,
+        b.report.xte_rms_m,
+        a.report.xte_p95_m,
+        b.report.xte_p95_m,
+        a.report.xte_max_m,
+        b.report.xte_max_m,
+        b.disengage_events
+    );
+    assert!(a.report.finished && b.report.finished, "{:?}", b.report);
+    assert_eq!(b.report.lines_completed, a.report.lines_completed);
+    // No disengagement but the job's end (no guidance once finished).
+    assert!(
+        b.disengage_events.iter().all(|(_, c)| c == "no_guidance"),
+        "{:?}",
+        b.disengage_events
+    );
+    assert!(
+        b.report.xte_rms_m <= 2.0 * a.report.xte_rms_m,
+        "iso {} vs angle {}",
+        b.report.xte_rms_m,
+        a.report.xte_rms_m
+    );
+    assert!(b.report.xte_p95_m <= 2.0 * a.report.xte_p95_m);
+}
+
+/// The steer-ready tractor's gate: a lockout stops steering (fault steering_lockout), an
+/// operator override makes its ECU request a reset, which the node honours (not intended to
+/// steer) before the operator engages again.
+#[test]
+fn steer_ready_lockout_and_request_reset_stop_steering_until_cleared() {
+    use agsteer::demo::{run, DemoOptions};
+    use agsteer::sim::can_node::{Fault, FaultKind, Scenario};
+    let cfg = config(&["job.line_num=2", "bus.output=\"curvature\""]);
+    for (kind, code) in [
+        (FaultKind::SteeringLockout, "steering_lockout"),
+        (FaultKind::OperatorOverride, "steering_reset_requested"),
+    ] {
+        let opts = DemoOptions {
+            scenario: Scenario {
+                fault: vec![Fault {
+                    kind,
+                    at_s: 20.0,
+                    duration_s: 1.0,
+                }],
+            },
+            ..Default::default()
+        };
+        let r = run(&cfg, &opts, &mut |_| {}, &mut |_, _| {}).unwrap();
+        let after: Vec<_> = r
+            .disengage_events
+            .iter()
+            .filter(|(t, _)| *t >= 20.0)
+            .collect();
+        println!("STEER-READY {kind:?}: {after:?}");
+        let (t, c) = after.first().expect("disengaged");
+        assert_eq!(c, code);
+        // Within two Machine Info periods and a control period.
+        assert!(*t - 20.0 <= 0.2 + cfg.dt() + 1e-9, "{t}");
+        // Engaged again once cleared: the job finishes.
+        assert!(r.report.finished, "{:?}", r.report);
+    }
+}

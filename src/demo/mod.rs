@@ -429,6 +429,10 @@ pub fn run(
         opts.scenario.clone(),
     )
     .with_speed_profile(sim_setup.speed_profile);
+    // With the ISO curvature output the tractor is a steer-ready one (ISO 11783-7 only).
+    if cfg.bus.output == crate::config::OutputKind::Curvature {
+        sim = sim.with_steer_ready();
+    }
     // The controller and the simulator talk only through frames on an in-memory bus.
     let mut bus_ctrl = MemBus::new();
     let mut bus_sim = bus_ctrl.node();

@@ -8,6 +8,7 @@
 //! With an IMU configured it sends the roll and pitch (0xFF30) at the IMU rate with counter
 //! and CRC; during the simulator's RTK-float windows 129029 reports method 5 (RTK float).
 
+use super::steer_ready::{Steer, SteerReadyEcu};
 use super::{FixQuality, GnssMeasurement, SimOutput, Simulator};
 use crate::can::codec::{
     self, CogSogRapid, CogSogRapidCogReference, CounterCheck, DbcMessage, DirectionRequest,
@@ -39,8 +40,11 @@ pub enum FaultKind {
     WheelAngleSilence,
     /// No wheel-speed frames.
     SpeedSilence,
-    /// The operator-override bit set in the wheel-angle status.
+    /// The operator-override bit set in the wheel-angle status (the steer-ready tractor: the
+    /// operator takes the wheel, its ECU leaves automatic steering).
     OperatorOverride,
+    /// The steer-ready tractor's mechanical lockout switch active (and the ECU not ready).
+    SteeringLockout,
 }
 
 /// One fault window.
@@ -129,6 +133,8 @@ pub struct SimNode {
     /// GNSS goes to a byte stream ([`SimNode::with_gnss_off_bus`]), not onto the bus.
     gnss_off_bus: bool,
     gnss_out: Vec<GnssMeasurement>,
+    /// The steer-ready tractor ([`SimNode::with_steer_ready`]).
+    steer_ready: Option<SteerReadyEcu>,
 }
 
 impl SimNode {
@@ -155,6 +161,37 @@ impl SimNode {
             forward: true,
             gnss_off_bus: false,
             gnss_out: Vec::new(),
+            steer_ready: None,
+        }
+    }
+
+    /// A steer-ready tractor: its steering ECU (at the tractor's address) speaks ISO 11783-7
+    /// only — Guidance System Command in, Guidance Machine Info out, no wheel-angle frame
+    /// (see [`steer_ready`](super::steer_ready)).
+    pub fn with_steer_ready(mut self) -> Self {
+        self.steer_ready = Some(SteerReadyEcu::new(
+            self.tractor.source(),
+            self.sim.params().wheelbase,
+        ));
+        self
+    }
+
+    /// The steer-ready tractor's steering ECU, when simulated.
+    pub fn steer_ready(&self) -> Option<&SteerReadyEcu> {
+        self.steer_ready.as_ref()
+    }
+
+    fn steer(&mut self, s: Option<Steer>) {
+        match s {
+            Some(Steer::To(angle)) => {
+                self.engaged = true;
+                self.sim.set_command(angle);
+            }
+            Some(Steer::Hold) => {
+                self.engaged = false;
+                self.sim.hold_wheels();
+            }
+            None => {}
         }
     }
 
@@ -196,6 +233,12 @@ impl SimNode {
 
     /// A received frame: steering commands are checked and applied.
     pub fn on_frame(&mut self, tf: &TimedFrame) {
+        if let Some(ecu) = self.steer_ready.as_mut() {
+            let lockout = self.scenario.active(FaultKind::SteeringLockout, tf.t);
+            let operator = self.scenario.active(FaultKind::OperatorOverride, tf.t);
+            let s = ecu.on_frame(tf.t, &tf.frame, lockout, operator);
+            self.steer(s);
+        }
         let Ok(d) = codec::decode(tf.frame.id, tf.frame.payload()) else {
             if codec::find(tf.frame.id).is_some_and(|(_, m)| m.name == "SteeringCommand") {
                 self.rejected += 1;
@@ -214,7 +257,10 @@ impl SimNode {
             self.sim.set_speed_target(target);
             return;
         }
-        let Some(cmd) = d.to::<SteeringCommand>() else {
+        let Some(cmd) = d
+            .to::<SteeringCommand>()
+            .filter(|_| self.steer_ready.is_none())
+        else {
             return;
         };
         if !self.checks.check(&d) {
@@ -254,7 +300,11 @@ impl SimNode {
         self.distance += (self.sim.true_state().pose.pos - before).norm();
         for o in outs.drain(..) {
             match o {
-                SimOutput::WheelAngle { t: ts, angle } => self.wheel_frames(ts, angle, out),
+                SimOutput::WheelAngle { t: ts, angle } => match self.steer_ready.as_mut() {
+                    // The steer-ready ECU reads its sensor; no proprietary frame.
+                    Some(ecu) => ecu.on_wheel_angle(angle),
+                    None => self.wheel_frames(ts, angle, out),
+                },
                 SimOutput::Attitude { t: ts, roll, pitch } => {
                     if let Ok(f) = self.imu.pack(&ImuAttitude {
                         roll: Some(roll.to_degrees().clamp(-90.0, 90.0)),
@@ -293,6 +343,12 @@ impl SimNode {
             }
         }
         self.outs = outs;
+        if let Some(ecu) = self.steer_ready.as_mut() {
+            let lockout = self.scenario.active(FaultKind::SteeringLockout, t);
+            let operator = self.scenario.active(FaultKind::OperatorOverride, t);
+            let s = ecu.advance(t, lockout, operator, out);
+            self.steer(s);
+        }
     }
 
     /// The NMEA 2000 GNSS frames of one measurement.

@@ -22,6 +22,7 @@ pub mod can_node;
 mod gnss_error;
 pub mod gnss_stream;
 mod params;
+pub mod steer_ready;
 mod vehicle;
 
 pub use params::{Disturbances, LateralDynamics, SimError, SimParams};

@@ -64,6 +64,10 @@ pub fn run(
         scenario,
     )
     .with_speed_profile(setup.speed_profile);
+    // With the ISO curvature output the tractor is a steer-ready one (ISO 11783-7 only).
+    if cfg.bus.output == agsteer::config::OutputKind::Curvature {
+        node = node.with_steer_ready();
+    }
     let gnss_sink = gnss.sink()?;
     if gnss_sink.is_some() {
         node = node.with_gnss_off_bus();
