@@ -256,6 +256,7 @@ pub fn wait_status(
 pub struct Terminal {
     iface: String,
     counter: u8,
+    direction_counter: u8,
 }
 
 impl Terminal {
@@ -263,6 +264,7 @@ impl Terminal {
         Terminal {
             iface: iface.to_string(),
             counter: 0,
+            direction_counter: 0,
         }
     }
     /// 1 engage, 2 disengage, 3 pause, 4 resume.
@@ -282,6 +284,28 @@ impl Terminal {
         self.counter = (self.counter + 1) & 0x0F;
         run_ok("cansend", &[&self.iface, frame.trim()]);
     }
+    /// The operator's direction request to the tractor (0 stop, 1 forward), from the
+    /// terminal's address.
+    pub fn direction(&mut self, direction: u8) {
+        let frame = run_ok(
+            "agsteer",
+            &[
+                "dbc",
+                "encode",
+                "DirectionRequest",
+                &format!("Direction={direction}"),
+                &format!("Counter={}", self.direction_counter),
+            ],
+        );
+        self.direction_counter = (self.direction_counter + 1) & 0x0F;
+        // agsteer's own address is the DBC's default: send it from the terminal's instead.
+        let frame = frame.trim();
+        let text = match frame.split_once('#') {
+            Some((id, data)) if id.len() == 8 => format!("{}26#{data}", &id[..6]),
+            _ => frame.to_string(),
+        };
+        run_ok("cansend", &[&self.iface, &text]);
+    }
     /// Press engage until the daemon reports engaged.
     pub fn engage(&mut self, d: Duration) -> bool {
         let end = Instant::now() + d;
@@ -295,6 +319,13 @@ impl Terminal {
         }
         false
     }
+}
+
+/// Seconds since the epoch, the clock candump -L stamps frames with.
+pub fn wall_s() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64())
 }
 
 /// (time, id, data) of candump -L lines.

@@ -6,8 +6,17 @@
 //! connections and signals. The control step itself never waits on I/O: frames are sent with a
 //! non-blocking write, and progress is handed to a writer thread through a bounded channel
 //! (a full channel skips a save rather than stall the loop; the next line change saves again).
+//!
+//! A control period runs on the timer every dt, and at once when a GNSS fix enters the node
+//! (issue 16 point 7: the command that follows a fix leaves within about a millisecond of its
+//! arrival instead of waiting up to dt for the timer); the timer then restarts from that
+//! period, so the periods stay dt apart and phase-lock to the fixes. Times given to the node
+//! are whole microseconds ([`log_time`]), so that `--bus-log` records exactly what the node
+//! saw and `agsteer replay` reproduces its decisions.
 
+use super::bus_log::{BusLog, BusLogError, BusLogParams, BusLogStats};
 use crate::can::bus::{monotonic_s, AsyncSocketCan, BusError, Filter};
+use crate::can::candump::log_time;
 use crate::can::{Frame, TimedFrame};
 use crate::config::{Config, ConfigError};
 use crate::control::node::{ControllerNode, NodeStatus};
@@ -42,6 +51,8 @@ pub enum DaemonError {
     Runtime(std::io::Error),
     #[error(transparent)]
     Gnss(#[from] crate::config::PasswordFileError),
+    #[error(transparent)]
+    BusLog(#[from] BusLogError),
 }
 
 /// Control-loop timing, for the status socket.
@@ -58,6 +69,11 @@ pub struct LoopStats {
     pub frames_in: u64,
     pub send_errors: u64,
     pub bus_up: bool,
+    /// Control periods run at once on a GNSS fix (the rest ran on the timer).
+    pub fix_ticks: u64,
+    /// A fix's receive time to its command handed to the socket: last and largest, µs.
+    pub fix_to_command_us: f64,
+    pub max_fix_to_command_us: f64,
 }
 
 #[derive(Serialize)]
@@ -71,6 +87,75 @@ struct StatusReply<'a> {
     /// The GNSS byte stream and NTRIP client, when `gnss.source` is one.
     #[serde(skip_serializing_if = "Option::is_none")]
     gnss: Option<super::gnss::GnssStatusReply>,
+    /// Every GNSS source seen and the one each input is locked on.
+    sources: SourcesReply,
+    /// `--bus-log`, when on.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    bus_log: Option<BusLogStats>,
+}
+
+/// One source seen, for the status reply.
+#[derive(Serialize)]
+struct SourceReply {
+    source: crate::input::SourceId,
+    /// Its ISO 11783-5 NAME (hex), once it claimed an address.
+    name: Option<String>,
+    /// The inputs it sends, and those it is selected for.
+    sends: Vec<crate::input::source::Kind>,
+    selected_for: Vec<crate::input::source::Kind>,
+    quality: Option<crate::input::FixQuality>,
+    inputs: u64,
+    last_s_ago: f64,
+}
+
+#[derive(Serialize)]
+struct SourcesReply {
+    /// The source each input is locked on (null: none yet).
+    position: Option<crate::input::SourceId>,
+    course_speed: Option<crate::input::SourceId>,
+    heading: Option<crate::input::SourceId>,
+    quality: Option<crate::input::SourceId>,
+    seen: Vec<SourceReply>,
+    /// Sources past the listed ones.
+    unlisted: u64,
+}
+
+fn sources_reply(sel: &crate::input::source::SourceSelector, now: f64) -> SourcesReply {
+    use crate::input::source::Kind;
+    const KINDS: [Kind; 4] = [
+        Kind::Position,
+        Kind::CourseSpeed,
+        Kind::Heading,
+        Kind::Quality,
+    ];
+    let pick = |flags: &[bool; 4]| {
+        KINDS
+            .iter()
+            .zip(flags)
+            .filter(|(_, on)| **on)
+            .map(|(k, _)| *k)
+            .collect()
+    };
+    SourcesReply {
+        position: sel.selected(Kind::Position),
+        course_speed: sel.selected(Kind::CourseSpeed),
+        heading: sel.selected(Kind::Heading),
+        quality: sel.selected(Kind::Quality),
+        seen: sel
+            .seen()
+            .iter()
+            .map(|s| SourceReply {
+                source: s.source,
+                name: s.name.map(|n| format!("{n:016X}")),
+                sends: pick(&s.kinds),
+                selected_for: pick(&s.selected),
+                quality: s.quality,
+                inputs: s.inputs,
+                last_s_ago: (now - s.last_t).max(0.0),
+            })
+            .collect(),
+        unlisted: sel.unlisted(),
+    }
 }
 
 enum BusEvent {
@@ -161,9 +246,20 @@ pub fn set_realtime_priority(priority: u8) {
     }
 }
 
-fn send_all(bus: &AsyncSocketCan, frames: &[Frame], stats: &mut LoopStats) -> bool {
+/// Send a control period's frames at `t` (each logged, sent or not: the log holds what the
+/// node decided).
+fn send_all(
+    bus: &AsyncSocketCan,
+    t: f64,
+    frames: &[Frame],
+    stats: &mut LoopStats,
+    log: Option<&BusLog>,
+) -> bool {
     let mut ok = true;
     for f in frames {
+        if let Some(l) = log {
+            l.record(t, f);
+        }
         if let Err(e) = bus.try_send(f) {
             stats.send_errors += 1;
             if stats.send_errors.is_power_of_two() {
@@ -216,16 +312,89 @@ fn apply_reload(
     );
 }
 
-/// Run the daemon until SIGTERM or SIGINT.
-pub fn run(cfg: Config, source: ConfigSource) -> Result<(), DaemonError> {
+/// Run the daemon until SIGTERM or SIGINT, logging every frame to `bus_log` when given.
+pub fn run(
+    cfg: Config,
+    source: ConfigSource,
+    bus_log: Option<BusLogParams>,
+) -> Result<(), DaemonError> {
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
         .map_err(DaemonError::Runtime)?;
-    rt.block_on(run_async(cfg, source))
+    rt.block_on(run_async(cfg, source, bus_log))
 }
 
-async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonError> {
+/// A control period's outputs: frames to the bus (and the log), the bus state, progress.
+struct Outputs {
+    bus: std::rc::Rc<AsyncSocketCan>,
+    frames: Vec<Frame>,
+    bus_up: bool,
+    iface: String,
+    progress: mpsc::SyncSender<Progress>,
+    log: Option<BusLog>,
+}
+
+impl Outputs {
+    /// One control period at `t`; true when it had guidance events (a line change).
+    fn step(&mut self, node: &mut ControllerNode, t: f64, stats: &mut LoopStats) -> bool {
+        self.frames.clear();
+        node.tick(t, &mut self.frames);
+        // A period without frames (claiming) says nothing of the link.
+        let sent = send_all(&self.bus, t, &self.frames, stats, self.log.as_ref());
+        if sent && !self.bus_up && !self.frames.is_empty() {
+            tracing::info!(
+                "CAN interface {} is back; claiming the address again",
+                self.iface
+            );
+            self.bus_up = true;
+            node.supervisor_mut().on_bus(true);
+            node.on_link_up();
+        } else if !sent && self.bus_up {
+            tracing::error!("CAN interface {} is down", self.iface);
+            self.bus_up = false;
+            node.supervisor_mut().on_bus(false);
+        }
+        stats.bus_up = self.bus_up;
+        let had_events = node.controller().guidance().has_events();
+        if had_events {
+            let p = node.controller().guidance().progress();
+            if self.progress.try_send(p).is_err() {
+                tracing::warn!("progress writer busy; this save is skipped");
+            }
+            for ev in node.controller_mut().guidance_mut().drain_events() {
+                tracing::info!("{ev}");
+            }
+        }
+        stats.ticks += 1;
+        had_events
+    }
+
+    /// A GNSS fix received at `t_fix` entered the node: its command now, the timer restarted.
+    fn on_fix(
+        &mut self,
+        node: &mut ControllerNode,
+        t_fix: f64,
+        stats: &mut LoopStats,
+        interval: &mut tokio::time::Interval,
+    ) {
+        let start = std::time::Instant::now();
+        let t = log_time(monotonic_s());
+        self.step(node, t, stats);
+        interval.reset();
+        stats.fix_ticks += 1;
+        stats.fix_to_command_us = (monotonic_s() - t_fix).max(0.0) * 1e6;
+        stats.max_fix_to_command_us = stats.max_fix_to_command_us.max(stats.fix_to_command_us);
+        stats.last_step_us = start.elapsed().as_secs_f64() * 1e6;
+        stats.max_step_us = stats.max_step_us.max(stats.last_step_us);
+    }
+}
+
+async fn run_async(
+    mut cfg: Config,
+    source: ConfigSource,
+    bus_log: Option<BusLogParams>,
+) -> Result<(), DaemonError> {
     use tokio::signal::unix::{signal, SignalKind};
     // The job is set up here (the field or map read and planned), before the bus is opened
     // and the loop starts.
@@ -243,6 +412,18 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
     // The node is built once; a SIGHUP only retunes it (apply_reload), so the plan is kept.
     let mut node = crate::job::build_node(&resolved, &job, resume.as_ref())?;
     let progress_tx = spawn_progress_writer(progress_path.clone());
+    let bus_log = match bus_log {
+        Some(p) => {
+            tracing::info!(
+                path = %p.path.display(),
+                max_bytes = p.max_bytes,
+                files = p.files,
+                "logging every frame in and out"
+            );
+            Some(BusLog::start(p)?)
+        }
+        None => None,
+    };
     // Helper threads exist now; only the control loop's thread gets real-time priority.
     set_realtime_priority(resolved.daemon.realtime_priority);
 
@@ -291,13 +472,19 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
     let mut sigterm = signal(SignalKind::terminate()).map_err(DaemonError::Runtime)?;
     let mut sigint = signal(SignalKind::interrupt()).map_err(DaemonError::Runtime)?;
     let mut sighup = signal(SignalKind::hangup()).map_err(DaemonError::Runtime)?;
-    let mut frames: Vec<Frame> = Vec::with_capacity(8);
+    let mut out = Outputs {
+        bus: bus.clone(),
+        frames: Vec::with_capacity(8),
+        bus_up: true,
+        iface: iface.clone(),
+        progress: progress_tx,
+        log: bus_log,
+    };
     let mut stats = LoopStats {
         bus_up: true,
         ..Default::default()
     };
     let mut late_sum = 0.0;
-    let mut bus_up = true;
     tracing::info!(interface = %iface, dt_s = dt, "agsteerd running");
     let mut watchdog = crate::daemon::notify::Watchdog::from_env();
     let mut reloading: Option<tokio::task::JoinHandle<Result<Config, ConfigError>>> = None;
@@ -332,33 +519,8 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                     scheduled = interval.tick() => {
                         let late = scheduled.elapsed().as_secs_f64();
                         let start = std::time::Instant::now();
-                        let t = monotonic_s();
-                        frames.clear();
-                        node.tick(t, &mut frames);
-                        // A period without frames (claiming) says nothing of the link.
-                        let sent = send_all(&bus, &frames, &mut stats);
-                        if sent && !bus_up && !frames.is_empty() {
-                            tracing::info!("CAN interface {iface} is back; claiming the address again");
-                            bus_up = true;
-                            node.supervisor_mut().on_bus(true);
-                            node.on_link_up();
-                        } else if !sent && bus_up {
-                            tracing::error!("CAN interface {iface} is down");
-                            bus_up = false;
-                            node.supervisor_mut().on_bus(false);
-                        }
-                        stats.bus_up = bus_up;
-                        let had_events = node.controller().guidance().has_events();
-                        if had_events {
-                            let p = node.controller().guidance().progress();
-                            if progress_tx.try_send(p).is_err() {
-                                tracing::warn!("progress writer busy; this save is skipped");
-                            }
-                            for ev in node.controller_mut().guidance_mut().drain_events() {
-                                tracing::info!("{ev}");
-                            }
-                        }
-                        stats.ticks += 1;
+                        let t = log_time(monotonic_s());
+                        let had_events = out.step(&mut node, t, &mut stats);
                         if late > dt {
                             stats.deadline_misses += 1;
                         }
@@ -378,14 +540,20 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                         watchdog.period(late <= dt);
                     }
                     ev = rx.recv() => match ev {
-                        Some(BusEvent::Frame(tf)) => {
+                        Some(BusEvent::Frame(mut tf)) => {
                             stats.frames_in += 1;
-                            node.on_frame(&tf);
+                            tf.t = log_time(tf.t);
+                            if let Some(l) = &out.log {
+                                l.record(tf.t, &tf.frame);
+                            }
+                            if node.on_frame(&tf) {
+                                out.on_fix(&mut node, tf.t, &mut stats, &mut interval);
+                            }
                         }
                         Some(BusEvent::Down(e)) => {
-                            if bus_up {
+                            if out.bus_up {
                                 tracing::error!("CAN interface {iface}: {e}");
-                                bus_up = false;
+                                out.bus_up = false;
                                 node.supervisor_mut().on_bus(false);
                             }
                         }
@@ -398,7 +566,9 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                         }
                     } => {
                         if let Some(i) = input {
-                            node.on_input(&i);
+                            if node.on_input(&i) {
+                                out.on_fix(&mut node, i.t(), &mut stats, &mut interval);
+                            }
                         }
                     }
                     conn = async {
@@ -414,6 +584,8 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
                                 interface: &iface,
                                 dt_s: dt,
                                 gnss: gnss.as_ref().map(|g| g.status(monotonic_s())),
+                                sources: sources_reply(node.sources(), monotonic_s()),
+                                bus_log: out.log.as_ref().map(BusLog::stats),
                             };
                             let mut text = serde_json::to_string(&reply).unwrap_or_default();
                             text.push('\n');
@@ -434,11 +606,16 @@ async fn run_async(mut cfg: Config, source: ConfigSource) -> Result<(), DaemonEr
     tracing::info!("stopping: sending a disengaged command and saving progress");
     node.supervisor_mut().request_disengage();
     for _ in 0..2 {
-        frames.clear();
-        node.tick(monotonic_s(), &mut frames);
-        send_all(&bus, &frames, &mut stats);
+        let t = log_time(monotonic_s());
+        out.frames.clear();
+        node.tick(t, &mut out.frames);
+        send_all(&out.bus, t, &out.frames, &mut stats, out.log.as_ref());
     }
-    drop(progress_tx);
+    let Outputs { progress, log, .. } = out;
+    drop(progress);
+    if let Some(l) = log {
+        l.finish(Duration::from_secs(2));
+    }
     let p = node.controller().guidance().progress();
     if let Err(e) = progress_file::save(&progress_path, &p) {
         tracing::error!("saving progress: {e}");

@@ -24,6 +24,17 @@ struct Args {
     /// Override a configuration key, e.g. `--set bus.interface=vcan0`.
     #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
     set: Vec<String>,
+    /// Log every CAN frame in and out to FILE in `candump -L` form (for `agsteer replay`,
+    /// `canplayer`, `agsteer dbc decode`). Off by default. Never slows the control loop: frames
+    /// the writer cannot keep up with are dropped and counted in `agsteer status`.
+    #[arg(long, value_name = "FILE")]
+    bus_log: Option<PathBuf>,
+    /// Rotate the bus log when a file would pass this size, MB (1..=4096).
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..=4096))]
+    bus_log_size_mb: u64,
+    /// Bus log files kept, the current one included (FILE, FILE.1, …) (1..=1000).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    bus_log_files: u32,
 }
 
 fn main() -> ExitCode {
@@ -94,7 +105,16 @@ fn main() -> ExitCode {
         path: args.config.clone(),
         overrides: args.set.clone(),
     };
-    match agsteer::daemon::run::run(cfg, source).context("agsteerd") {
+    let bus_log = args
+        .bus_log
+        .as_ref()
+        .map(|path| agsteer::daemon::bus_log::BusLogParams {
+            path: path.clone(),
+            interface: cfg.bus.interface.clone(),
+            max_bytes: args.bus_log_size_mb * 1_000_000,
+            files: args.bus_log_files,
+        });
+    match agsteer::daemon::run::run(cfg, source, bus_log).context("agsteerd") {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
