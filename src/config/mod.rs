@@ -33,6 +33,7 @@ mod progress;
 mod resolve;
 mod safety;
 mod sim;
+mod sources;
 mod track;
 mod vehicle;
 
@@ -49,6 +50,7 @@ pub use progress::ProgressConfig;
 pub use resolve::{DaemonParams, FieldPlanning, ManeuverPlanning, Planning, Resolved, SimSetup};
 pub use safety::SafetyConfig;
 pub use sim::SimConfig;
+pub use sources::SourcesConfig;
 pub use track::{TrackConfig, TrackerChoice};
 pub use vehicle::VehicleConfig;
 
@@ -105,6 +107,7 @@ pub struct Config {
     pub field: FieldConfig,
     pub maneuver: ManeuverConfig,
     pub gnss: GnssConfig,
+    pub sources: SourcesConfig,
 }
 
 /// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
@@ -242,6 +245,7 @@ impl Config {
         self.daemon.validate(&mut c);
         self.progress.validate(&mut c);
         self.gnss.validate(&mut c);
+        self.sources.validate(&mut c);
         envelope::validate(self, &mut c);
         c.problems
     }

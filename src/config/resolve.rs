@@ -287,6 +287,7 @@ impl Config {
             output: self.bus.output,
             status_period: self.bus.status_period_s,
             gnss_from_stream: self.gnss.is_stream(),
+            sources: self.sources.params(),
             iso: crate::control::isobus::IsoParams {
                 claim: self.isobus.claim_params(self.bus.source_address),
                 source_address: self.bus.source_address,

@@ -15,7 +15,7 @@ use crate::estimate::GnssFix;
 use crate::geo::wgs84::{EnuFrame, LatLon};
 use crate::geo::Direction;
 use crate::input::can::CanAdapter;
-use crate::input::source::{SourceChange, SourceParams, SourceSelector};
+use crate::input::source::{SourceChange, SourceSelector};
 use crate::input::{CheckedLink, Input, OperatorCommand, PositionInput, SensorStatus};
 use crate::safety::{
     CheckedInput, FaultCode, FixQuality, SafetyParams, SafetyState, SteeringCommand as Cmd,
@@ -147,7 +147,7 @@ impl ControllerNode {
             enu: EnuFrame::new(origin),
             packer: Packer::new(bus.source_address),
             can: CanAdapter::default(),
-            sources: SourceSelector::new(SourceParams::default()),
+            sources: SourceSelector::new(bus.sources),
             gnss_from_stream: bus.gnss_from_stream,
             output: bus.output,
             iso: IsoLink::new(bus.iso),
@@ -212,6 +212,7 @@ impl ControllerNode {
         self.ctrl.set_tuning(control);
         self.supervisor.set_params(node_safety_params(safety, bus));
         self.output = bus.output;
+        self.sources.set_params(bus.sources);
         self.status_every = status_every(bus.status_period, self.ctrl.params().dt);
     }
 

@@ -147,4 +147,6 @@ pub struct BusParams {
     pub iso: super::isobus::IsoParams,
     /// With the steer-ready loop: Guidance Machine Info older than this is stale, s.
     pub machine_info_timeout: f64,
+    /// Which source each GNSS input is taken from (`[sources]`).
+    pub sources: crate::input::source::SourceParams,
 }
