@@ -41,6 +41,10 @@ fn the_default_tracker_holds_its_figures_in_every_scenario() {
     ] {
         let r = scenario(name, TrackerChoice::Predictive, &[]);
         assert!(r.finished, "{name}: {r:?}");
+        // The supervisor's tracking checks never trip on the nominal suite.
+        for code in ["tracking_unstable", "off_line", "line_unfollowable"] {
+            assert!(!r.disengagements.contains_key(code), "{name}: {r:?}");
+        }
         assert!(
             cm(r.xte_rms_m) < rms,
             "{name}: rms {:.2} cm",

@@ -82,6 +82,23 @@ fn configurations() -> Vec<(&'static str, SafetyParams)> {
             },
         ),
         (
+            // Tracking supervision that trips on the cases' random XTE and wheel angles.
+            "tight tracking checks",
+            SafetyParams {
+                tracking: agsteer::safety::TrackingParams {
+                    off_line: 0.2,
+                    off_line_time: 0.05,
+                    off_line_acquire: 1.0,
+                    unstable_xte: 0.1,
+                    unstable_wheel: 2f64.to_radians(),
+                    unstable_swings: 2,
+                    unstable_window: 5.0,
+                    wheel_mean_tau: 0.5,
+                },
+                ..d.clone()
+            },
+        ),
+        (
             "loose engage gate",
             SafetyParams {
                 max_engage_xte: 5.0,
@@ -115,6 +132,11 @@ enum Ev {
     Bus(bool),
     /// A stop for a change of direction (a cusp) starts or ends.
     DirectionChange(bool),
+    /// The work line driven (None: a turn), with its sharpest curvature.
+    Line {
+        line: Option<u64>,
+        curvature: f64,
+    },
     Step {
         demand: f64,
         xte: f64,
@@ -150,6 +172,8 @@ fn event() -> impl Strategy<Value = Ev> {
         1 => Just(Ev::Disengage),
         1 => prop::bool::weighted(0.8).prop_map(Ev::Bus),
         1 => prop::bool::ANY.prop_map(Ev::DirectionChange),
+        1 => (prop::option::weighted(0.8, 0u64..3), special_f64())
+            .prop_map(|(line, curvature)| Ev::Line { line, curvature }),
         10 => (special_f64(), special_f64(), special_f64())
             .prop_map(|(demand, xte, heading_error)| Ev::Step { demand, xte, heading_error }),
         30 => (special_f64(), -0.6f64..0.6, prop_oneof![5 => 0.5f64..7.0, 1 => 0.0f64..0.5])
@@ -240,6 +264,7 @@ fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseEr
                 o.was_engaged = false;
             }
             Ev::Bus(up) => s.on_bus(*up),
+            Ev::Line { line, curvature } => s.set_line(*line, *curvature),
             Ev::DirectionChange(active) => {
                 s.set_direction_change(o.t, *active);
                 if !active {

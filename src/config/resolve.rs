@@ -372,6 +372,7 @@ impl Config {
             actuator_dead_time: f.actuator_dead_time_s,
             actuator_tau: f.actuator_tau_s,
             actuator_rate: f.actuator_rate_deg_s.to_radians(),
+            tracking: f.tracking_params(),
         }
     }
 }

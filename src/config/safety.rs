@@ -37,6 +37,21 @@ pub struct SafetyConfig {
     pub actuator_dead_time_s: f64,
     pub actuator_tau_s: f64,
     pub actuator_rate_deg_s: f64,
+    /// Tracking supervision on work lines: |XTE| beyond off_line_m for off_line_time_s is
+    /// `off_line`, m (0 = off) and s.
+    pub off_line_m: f64,
+    pub off_line_time_s: f64,
+    /// The line must be acquired (|XTE| below off_line_m once) within this distance, m.
+    pub off_line_acquire_m: f64,
+    /// A weave is `tracking_unstable`: unstable_swings alternate swings (0 = off) within
+    /// unstable_window_s of the XTE beyond ±unstable_xte_m (0 = not watched) or of the wheel
+    /// angle beyond ±unstable_wheel_deg (0 = not watched) about its moving mean (time
+    /// constant unstable_wheel_mean_s).
+    pub unstable_xte_m: f64,
+    pub unstable_wheel_deg: f64,
+    pub unstable_swings: u32,
+    pub unstable_window_s: f64,
+    pub unstable_wheel_mean_s: f64,
 }
 
 impl Default for SafetyConfig {
@@ -57,11 +72,33 @@ impl Default for SafetyConfig {
             actuator_dead_time_s: 0.05,
             actuator_tau_s: 0.15,
             actuator_rate_deg_s: 30.0,
+            off_line_m: 2.0,
+            off_line_time_s: 0.5,
+            off_line_acquire_m: 30.0,
+            unstable_xte_m: 0.2,
+            unstable_wheel_deg: 3.0,
+            unstable_swings: 4,
+            unstable_window_s: 40.0,
+            unstable_wheel_mean_s: 2.0,
         }
     }
 }
 
 impl SafetyConfig {
+    /// The supervisor's tracking supervision, SI.
+    pub fn tracking_params(&self) -> crate::safety::TrackingParams {
+        crate::safety::TrackingParams {
+            off_line: self.off_line_m,
+            off_line_time: self.off_line_time_s,
+            off_line_acquire: self.off_line_acquire_m,
+            unstable_xte: self.unstable_xte_m,
+            unstable_wheel: self.unstable_wheel_deg.to_radians(),
+            unstable_swings: self.unstable_swings as usize,
+            unstable_window: self.unstable_window_s,
+            wheel_mean_tau: self.unstable_wheel_mean_s,
+        }
+    }
+
     /// Range checks of `[safety]`.
     pub(crate) fn validate(&self, c: &mut Checker) {
         let f = self;
@@ -116,6 +153,36 @@ impl SafetyConfig {
             f.actuator_rate_deg_s,
             1.0,
             500.0,
+        );
+        c.range("safety.off_line_m", f.off_line_m, 0.0, 50.0);
+        c.range("safety.off_line_time_s", f.off_line_time_s, 0.0, 60.0);
+        c.range(
+            "safety.off_line_acquire_m",
+            f.off_line_acquire_m,
+            1.0,
+            1000.0,
+        );
+        c.range("safety.unstable_xte_m", f.unstable_xte_m, 0.0, 10.0);
+        c.range("safety.unstable_wheel_deg", f.unstable_wheel_deg, 0.0, 45.0);
+        c.range(
+            "safety.unstable_swings",
+            f64::from(f.unstable_swings),
+            0.0,
+            crate::safety::tracking::MAX_SWINGS as f64,
+        );
+        if f.unstable_swings == 1 {
+            c.push(
+                "safety.unstable_swings",
+                "1".to_string(),
+                "must be 0 (off) or at least 2 (one swing is a single step, not an oscillation)",
+            );
+        }
+        c.range("safety.unstable_window_s", f.unstable_window_s, 1.0, 600.0);
+        c.range(
+            "safety.unstable_wheel_mean_s",
+            f.unstable_wheel_mean_s,
+            0.1,
+            60.0,
         );
     }
 }

@@ -89,6 +89,8 @@ pub struct ControllerNode {
     approach_refused: bool,
     /// Guidance failed in the previous period (its error already logged).
     guidance_failing: bool,
+    /// The work line the supervisor watches (None: none).
+    supervised_line: Option<u64>,
     last_request: Option<DirectionRequestDirection>,
 }
 
@@ -169,6 +171,7 @@ impl ControllerNode {
             cusp: false,
             approach_refused: false,
             guidance_failing: false,
+            supervised_line: None,
             last_request: None,
             status: NodeStatus {
                 state: SafetyState::Disengaged,
@@ -406,7 +409,8 @@ impl ControllerNode {
                 self.supervisor.request_engage()
             }
             OperatorCommand::Disengage | OperatorCommand::Pause => {
-                self.supervisor.request_disengage()
+                self.supervisor.request_disengage();
+                self.supervisor.acknowledge();
             }
             // Not implemented yet (issue 16 point 5).
             OperatorCommand::None
@@ -498,6 +502,29 @@ impl ControllerNode {
         }
     }
 
+    /// Tells the supervisor which work line is driven (work lines driven forward; not turns,
+    /// approaches or reversing) and, when it changes, the line's sharpest curvature.
+    fn supervise_line(&mut self) {
+        let g = self.ctrl.guidance();
+        let line = (g.tag() == crate::geo::Tag::Work
+            && !g.is_approaching()
+            && !g.is_finished()
+            && g.direction() == Direction::Forward)
+            .then(|| g.current_line());
+        if line != self.supervised_line {
+            self.supervised_line = line;
+            let k = if line.is_some() {
+                crate::safety::tracking::sharpest_curvature(
+                    g.global_path().iter().map(|p| p.pos),
+                    1.0,
+                )
+            } else {
+                0.0
+            };
+            self.supervisor.set_line(line, k);
+        }
+    }
+
     /// One control period at `t`: appends the frames to send.
     pub fn tick(&mut self, t: f64, out: &mut Vec<Frame>) -> Cmd {
         // The address claim first: until it stands, nothing else goes out.
@@ -546,6 +573,7 @@ impl ControllerNode {
                 self.last_request = Some(r);
             }
         }
+        self.supervise_line();
         let cmd = self
             .supervisor
             .step(t, c.wheel_angle, c.xte, c.heading_error);

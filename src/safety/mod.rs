@@ -9,9 +9,15 @@
 //! States: `Disengaged` → `Ready` (all inputs fresh and good) → `Engaged` (on an operator
 //! engage) → `Fault(code)` (an engaged condition broke) → `Disengaged` once the condition has
 //! cleared. Engaging needs an operator engage received while `Ready`; nothing re-engages by
-//! itself.
+//! itself. On a work line it also watches the tracking itself ([`tracking`]): a weave is
+//! `tracking_unstable`, a persistent offset `off_line`, both held until the line changes or the
+//! operator disengages; a line the vehicle cannot follow at its speed is refused at engage
+//! (`line_unfollowable`).
+
+pub mod tracking;
 
 use serde::Serialize;
+pub use tracking::{TrackingMonitor, TrackingParams, TrackingVerdict};
 
 /// Why the supervisor will not steer. The numeric value goes on the bus.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
@@ -45,6 +51,41 @@ pub enum FaultCode {
     /// the command goes to "not intended to steer" until the request clears and the operator
     /// engages again.
     SteeringResetRequested = 17,
+    /// A sustained oscillation of the cross-track error or the wheel angle on a work line (a
+    /// limit cycle): steering is given back rather than weave.
+    TrackingUnstable = 18,
+    /// |XTE| beyond `safety.off_line_m` for `safety.off_line_time_s` on a work line.
+    OffLine = 19,
+    /// Engage refused: the line's sharpest curve cannot be followed at this speed with these
+    /// limits and this steering rate.
+    LineUnfollowable = 20,
+}
+
+impl FaultCode {
+    /// Every code, in bus order.
+    pub const ALL: [FaultCode; 21] = [
+        FaultCode::None,
+        FaultCode::GnssTimeout,
+        FaultCode::FixQuality,
+        FaultCode::WheelAngleTimeout,
+        FaultCode::WheelAngleInvalid,
+        FaultCode::SpeedOutOfRange,
+        FaultCode::OperatorOverride,
+        FaultCode::XteTooLarge,
+        FaultCode::HeadingErrorTooLarge,
+        FaultCode::NoGuidance,
+        FaultCode::BusDown,
+        FaultCode::OperatorInvalid,
+        FaultCode::ActuatorFault,
+        FaultCode::LateralAccelLimit,
+        FaultCode::AddressLost,
+        FaultCode::SteeringNotReady,
+        FaultCode::SteeringLockout,
+        FaultCode::SteeringResetRequested,
+        FaultCode::TrackingUnstable,
+        FaultCode::OffLine,
+        FaultCode::LineUnfollowable,
+    ];
 }
 
 /// Supervisor state.
@@ -120,6 +161,8 @@ pub struct SafetyParams {
     pub actuator_tau: f64,
     /// … at most this fast, rad/s), not with the raw command.
     pub actuator_rate: f64,
+    /// Tracking supervision on work lines (oscillation, offset, unfollowable lines).
+    pub tracking: TrackingParams,
 }
 
 impl Default for SafetyParams {
@@ -143,6 +186,7 @@ impl Default for SafetyParams {
             actuator_dead_time: 0.05,
             actuator_tau: 0.15,
             actuator_rate: 30f64.to_radians(),
+            tracking: TrackingParams::default(),
         }
     }
 }
@@ -193,6 +237,13 @@ pub struct Supervisor {
     history: [(f64, f64); HISTORY],
     history_len: usize,
     history_head: usize,
+    /// The work line being driven (None: a turn, an approach, reversing, nothing).
+    work_line: Option<u64>,
+    /// Its sharpest curvature, 1/m.
+    line_curvature: f64,
+    tracking: TrackingMonitor,
+    /// A tracking fault held until the line changes or the operator disengages.
+    tracking_latch: Option<FaultCode>,
 }
 
 const HISTORY: usize = 64;
@@ -224,7 +275,42 @@ impl Supervisor {
             history: [(0.0, 0.0); HISTORY],
             history_len: 0,
             history_head: 0,
+            work_line: None,
+            line_curvature: 0.0,
+            tracking: TrackingMonitor::new(),
+            tracking_latch: None,
         }
+    }
+
+    /// The line being driven: `Some(id)` on a work line, where the tracking is supervised;
+    /// `None` in a turn, an approach or reversing. A change of line restarts the supervision
+    /// and clears a held tracking fault. `max_curvature` is the line's sharpest curvature, 1/m
+    /// (the engage gate's `line_unfollowable`).
+    pub fn set_line(&mut self, line: Option<u64>, max_curvature: f64) {
+        if line != self.work_line {
+            self.work_line = line;
+            self.tracking.reset();
+            self.tracking_latch = None;
+        }
+        self.line_curvature = if max_curvature.is_finite() {
+            max_curvature.abs()
+        } else {
+            0.0
+        };
+    }
+
+    /// Would the current line be refused as unfollowable at the current speed?
+    pub fn line_unfollowable(&self) -> bool {
+        let p = &self.params;
+        tracking::line_unfollowable(
+            self.line_curvature,
+            self.speed,
+            p.wheelbase,
+            p.max_wheel_angle,
+            p.a_lat_max,
+            p.actuator_rate.min(p.max_wheel_rate),
+            p.tracking.off_line,
+        )
     }
 
     /// The command the actuator acts on at `t`: the newest one at least a dead time old.
@@ -360,6 +446,17 @@ impl Supervisor {
         }
     }
 
+    /// The operator acknowledged a held tracking fault (a disengage command while in it): the
+    /// line may be engaged again.
+    pub fn acknowledge(&mut self) {
+        self.tracking_latch = None;
+    }
+
+    /// The held tracking fault, if any.
+    pub fn tracking_fault(&self) -> Option<FaultCode> {
+        self.tracking_latch
+    }
+
     /// Is `input` currently counted as invalid?
     pub fn input_invalid(&self, input: CheckedInput) -> bool {
         self.scores[input as usize] >= self.params.invalid_threshold
@@ -443,6 +540,11 @@ impl Supervisor {
         if fault == FaultCode::None && demand.is_none() {
             fault = FaultCode::NoGuidance;
         }
+        if fault == FaultCode::None {
+            if let Some(held) = self.tracking_latch {
+                fault = held;
+            }
+        }
         // Operator override by divergence: the measured angle far, for too long, from where
         // the actuator should have taken the wheels.
         if self.state == SafetyState::Engaged {
@@ -459,6 +561,25 @@ impl Supervisor {
             }
         } else {
             self.diverged_since = None;
+        }
+        // Tracking on a work line: a weave or a persistent offset.
+        if self.state == SafetyState::Engaged
+            && fault == FaultCode::None
+            && self.work_line.is_some()
+        {
+            let p = &self.params;
+            let verdict =
+                self.tracking
+                    .update(&p.tracking, t, dt, xte, self.wheel_angle, self.speed);
+            let code = match verdict {
+                TrackingVerdict::Ok => FaultCode::None,
+                TrackingVerdict::Unstable => FaultCode::TrackingUnstable,
+                TrackingVerdict::OffLine => FaultCode::OffLine,
+            };
+            if code != FaultCode::None {
+                self.tracking_latch = Some(code);
+                fault = code;
+            }
         }
 
         match self.state {
@@ -491,6 +612,8 @@ impl Supervisor {
                 FaultCode::XteTooLarge
             } else if !heading_error.is_some_and(|h| h.abs() < p.max_engage_heading_error) {
                 FaultCode::HeadingErrorTooLarge
+            } else if self.line_unfollowable() {
+                FaultCode::LineUnfollowable
             } else {
                 FaultCode::None
             };
@@ -502,6 +625,7 @@ impl Supervisor {
                 self.history_len = 0;
                 self.remember_command(t, self.wheel_angle);
                 self.diverged_since = None;
+                self.tracking.reset();
             }
             self.last_refusal = refusal;
         }

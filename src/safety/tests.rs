@@ -195,3 +195,129 @@ fn rtk_float_tolerance() {
     let dur = out_at.expect("float disengages after the tolerance") - float_start;
     assert!(dur > 1.0 - 1e-9 && dur <= 1.0 + 2.0 * DT, "{dur}");
 }
+
+#[test]
+fn every_fault_code_fits_the_dbc_range() {
+    // The DBC is the source of truth for the bus: GuidanceStatus.Fault's range holds every code.
+    let msg = crate::can::codec::MESSAGES
+        .iter()
+        .find(|m| m.name == "GuidanceStatus")
+        .unwrap();
+    let sig = msg.signals.iter().find(|s| s.name == "Fault").unwrap();
+    for (i, code) in FaultCode::ALL.iter().enumerate() {
+        assert_eq!(*code as usize, i);
+        assert!((i as f64) <= sig.max, "fault {i} beyond the DBC range");
+    }
+}
+
+/// Engaged on work line 1, fed good inputs: the wheels follow the command exactly.
+fn engaged_on_a_line(params: SafetyParams) -> (Supervisor, f64) {
+    let mut s = Supervisor::new(params);
+    s.set_line(Some(1), 0.0);
+    let mut t = 0.0;
+    feed_good(&mut s, t);
+    s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    s.request_engage();
+    t += DT;
+    feed_good(&mut s, t);
+    assert!(s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
+    (s, t)
+}
+
+#[test]
+fn a_weave_on_a_work_line_disengages_and_is_held_until_the_next_line() {
+    let (mut s, mut t) = engaged_on_a_line(SafetyParams::default());
+    let start = t;
+    let mut fault_at = None;
+    while t < start + 60.0 {
+        t += DT;
+        feed_good(&mut s, t);
+        let x = 0.45 * (std::f64::consts::TAU * (t - start) / 8.0).sin();
+        let c = s.step(t, Some(0.0), Some(x), Some(0.0));
+        if !c.engaged {
+            assert_eq!(c.fault, FaultCode::TrackingUnstable);
+            fault_at = Some(t - start);
+            break;
+        }
+    }
+    let at = fault_at.expect("a weave must disengage");
+    assert!((10.0..15.0).contains(&at), "{at}");
+    // Held: an engage on the same line is refused with the same fault.
+    t += DT;
+    feed_good(&mut s, t);
+    s.request_engage();
+    let c = s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    assert!(!c.engaged);
+    assert_eq!(s.last_refusal(), FaultCode::TrackingUnstable);
+    assert_eq!(c.state, SafetyState::Fault(FaultCode::TrackingUnstable));
+    // The next line clears it.
+    s.set_line(Some(2), 0.0);
+    t += DT;
+    feed_good(&mut s, t);
+    s.request_engage();
+    assert!(s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
+}
+
+#[test]
+fn an_offset_on_a_work_line_is_off_line_and_the_operator_acknowledges_it() {
+    let (mut s, mut t) = engaged_on_a_line(SafetyParams::default());
+    let start = t;
+    let mut fault_at = None;
+    while t < start + 30.0 {
+        t += DT;
+        feed_good(&mut s, t);
+        let x = if t - start < 5.0 { 0.01 } else { 2.5 };
+        let c = s.step(t, Some(0.0), Some(x), Some(0.0));
+        if !c.engaged {
+            assert_eq!(c.fault, FaultCode::OffLine);
+            fault_at = Some(t - start - 5.0);
+            break;
+        }
+    }
+    let at = fault_at.expect("an offset must disengage");
+    assert!((at - 0.5).abs() <= 2.0 * DT + 1e-9, "{at}");
+    s.request_disengage();
+    s.acknowledge();
+    t += DT;
+    feed_good(&mut s, t);
+    s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    s.request_engage();
+    t += DT;
+    feed_good(&mut s, t);
+    assert!(s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
+}
+
+#[test]
+fn tracking_is_not_supervised_off_work_lines() {
+    let (mut s, mut t) = engaged_on_a_line(SafetyParams::default());
+    s.set_line(None, 0.0);
+    let start = t;
+    while t < start + 60.0 {
+        t += DT;
+        feed_good(&mut s, t);
+        let x = 0.8 * (std::f64::consts::TAU * (t - start) / 8.0).sin();
+        assert!(s.step(t, Some(0.0), Some(x), Some(0.0)).engaged, "{t}");
+    }
+}
+
+#[test]
+fn a_line_too_sharp_for_the_speed_is_refused() {
+    let mut s = Supervisor::new(SafetyParams::default());
+    // R 15 m at 25 km/h: 3.2 m/s² of lateral acceleration.
+    s.set_line(Some(1), 1.0 / 15.0);
+    let t = 0.0;
+    s.on_gnss(t, FixQuality::RtkFixed);
+    s.on_wheel_angle(t, 0.0, false, false);
+    s.on_speed(t, 24.0 / 3.6);
+    s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    s.request_engage();
+    assert!(!s.step(t + DT, Some(0.0), Some(0.0), Some(0.0)).engaged);
+    assert_eq!(s.last_refusal(), FaultCode::LineUnfollowable);
+    // At 10 km/h it is followable.
+    s.on_speed(t + DT, 10.0 / 3.6);
+    s.request_engage();
+    assert!(
+        s.step(t + 2.0 * DT, Some(0.0), Some(0.0), Some(0.0))
+            .engaged
+    );
+}

@@ -1,0 +1,106 @@
+//! A fault instead of a weave (issue 15, point 5), closed-loop: the simulator with a plant or a
+//! tuning that makes the default loop unstable, the supervisor in the loop. Each case asserts
+//! that the supervisor disengages with a tracking fault, the time from the onset (the first
+//! period the true |XTE| leaves the straight-line target of 15 cm) to the safe state, and that
+//! with the checks switched off the same run weaves on engaged — so the test fails without the
+//! detector. `tests/accuracy.rs` checks that the nominal suite never trips it.
+
+use agsteer::config::Config;
+use agsteer::demo::{run, DemoOptions, DemoRun};
+
+fn config(set: &[&str]) -> Config {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tools/scenarios/straight_10kmh.toml"
+    );
+    let mut set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    set.push("job.line_num=3".into());
+    Config::load(std::path::Path::new(path), &set).expect("valid configuration")
+}
+
+fn drive(cfg: &Config) -> DemoRun {
+    let opts = DemoOptions {
+        record_work: true,
+        no_reengage: true,
+        ..Default::default()
+    };
+    run(cfg, &opts, &mut |_| {}, &mut |_, _| {}).expect("the run")
+}
+
+/// (onset s, first tracking fault (time s, code), largest true |XTE| up to it m).
+fn weave_and_fault(r: &DemoRun) -> (Option<f64>, Option<(f64, String)>, f64) {
+    let fault = r
+        .disengage_events
+        .iter()
+        .find(|(_, c)| c == "tracking_unstable" || c == "off_line")
+        .cloned();
+    let until = fault.as_ref().map_or(f64::INFINITY, |f| f.0);
+    let mut onset = None;
+    let mut max_xte: f64 = 0.0;
+    for s in r.work.iter().flat_map(|w| w.samples.iter()) {
+        if s.t > until {
+            break;
+        }
+        max_xte = max_xte.max(s.xte_m.abs());
+        if onset.is_none() && s.xte_m.abs() > 0.15 && s.t > 5.0 {
+            onset = Some(s.t);
+        }
+    }
+    (onset, fault, max_xte)
+}
+
+fn check(name: &str, set: &[&str], bound_s: f64) {
+    let r = drive(&config(set));
+    let (onset, fault, max_xte) = weave_and_fault(&r);
+    let onset = onset.unwrap_or_else(|| panic!("{name}: never left the line: {:?}", r.report));
+    let (t, code) = fault.unwrap_or_else(|| panic!("{name}: no tracking fault: {:?}", r.report));
+    println!(
+        "TRACKING-FAULT {name}: {code} {:.2} s after the onset (true |XTE| up to {:.2} m)",
+        t - onset,
+        max_xte
+    );
+    assert!(t - onset <= bound_s, "{name}: {:.2} s", t - onset);
+    // No other disengagement before it.
+    let before: Vec<_> = r.disengage_events.iter().filter(|e| e.0 < t).collect();
+    assert!(before.is_empty(), "{name}: {before:?}");
+
+    // Without the checks the same run stays engaged and weaves.
+    let mut off: Vec<&str> = set.to_vec();
+    off.extend(["safety.off_line_m=0", "safety.unstable_swings=0"]);
+    let r = drive(&config(&off));
+    let (_, fault, max_xte) = weave_and_fault(&r);
+    assert!(fault.is_none());
+    assert!(
+        max_xte > 0.5,
+        "{name}: without the checks only {max_xte:.2} m"
+    );
+}
+
+#[test]
+fn a_slow_steering_motor_weaves_and_the_supervisor_disengages() {
+    // The issue's case: a 20 °/s motor, the supervisor's actuator model set to match.
+    check(
+        "actuator 20 deg/s",
+        &[
+            "sim.actuator_rate_deg_s=20",
+            "safety.actuator_rate_deg_s=20",
+        ],
+        10.0,
+    );
+}
+
+#[test]
+fn a_deliberately_unstable_gain_disengages() {
+    // Pure pursuit with a 1 m look-ahead behind a 0.4 s steering lag.
+    check(
+        "pure pursuit, look-ahead 1 m, lag 0.4 s",
+        &[
+            "track.kind=pure_pursuit",
+            "track.ld_min_m=1",
+            "track.ld_gain_s=0",
+            "sim.actuator_tau_s=0.4",
+            "safety.actuator_tau_s=0.4",
+        ],
+        10.0,
+    );
+}
