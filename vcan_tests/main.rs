@@ -757,7 +757,14 @@ fn h_sighup_reload() {
 /// each time: the daemon never auto-engages, no finished line is driven twice, none is
 /// skipped, and the job finishes. Lines driven are counted from the simulator's true
 /// trajectory (crossings of each line's middle), not from the daemon's own bookkeeping.
+///
+/// Ignored until issue 16 point 8 is finished: while the daemon is dead the simulator's
+/// actuator holds the last command, so a kill in a turn leaves the tractor circling out of the
+/// engage gate (3 m, 90°) before the restarted daemon can resume; the test needs a driver model
+/// in the simulator (a command timeout that releases the wheels, a driver who steers back).
+/// Run it alone with `tools/vcan-vm -- i_kill_9_resume --ignored`.
 #[test]
+#[ignore = "issue 16 point 8: the simulated tractor circles on the held command while the daemon is dead"]
 fn i_kill_9_resume() {
     let Some(iface) = vcan() else { return };
     const LINES: u64 = 5;
