@@ -368,7 +368,8 @@ fn run_job(path: GnssPath, extra: &[&str], cut: Option<Cut>, max_s: f64) -> Outc
         .build()
         .unwrap();
     let local = tokio::task::LocalSet::new();
-    let mut gnss = agsteer::daemon::gnss::spawn(&cfg, &local).unwrap();
+    let password = agsteer::config::ntrip_password(&cfg.gnss).unwrap();
+    let mut gnss = agsteer::daemon::gnss::spawn(&cfg, password, &local);
     let mut terminal = Packer::new(0x26);
     let mut out = Outcome::default();
     // (tick time, engaged, fault), and position inputs' arrival times and RTK fixed or not.

@@ -2,7 +2,7 @@
 //! `LocalSet`, the channel that brings their `Input`s to the control loop, and their state for
 //! `agsteer status`.
 
-use crate::config::{Config, PasswordFileError};
+use crate::config::Config;
 use crate::input::Input;
 use crate::io::ntrip::{run_ntrip, GgaSource, NtripPorts, NtripStatus};
 use crate::io::transport::{run_rtcm_serial, run_stream, SharedStatus, StreamPorts, StreamStatus};
@@ -58,15 +58,10 @@ impl GnssLink {
 }
 
 /// Start the configured stream (and NTRIP client) on `local`; `None` when GNSS comes from
-/// the bus. The NTRIP password file is read here, once, before the loop starts.
-pub fn spawn(
-    cfg: &Config,
-    local: &tokio::task::LocalSet,
-) -> Result<Option<GnssLink>, PasswordFileError> {
-    let Some(stream_cfg) = cfg.gnss.stream() else {
-        return Ok(None);
-    };
-    let password = crate::config::ntrip_password(&cfg.gnss)?;
+/// the bus. `password`: the NTRIP password, read once before the loop starts
+/// ([`crate::job::startup::load`]).
+pub fn spawn(cfg: &Config, password: String, local: &tokio::task::LocalSet) -> Option<GnssLink> {
+    let stream_cfg = cfg.gnss.stream()?;
     let ntrip_cfg = cfg.gnss.ntrip(password);
     let (tx, inputs) = mpsc::channel(INPUT_QUEUE);
     let stream = Arc::new(Mutex::new(StreamStatus::default()));
@@ -119,9 +114,9 @@ pub fn spawn(
             status: stream.clone(),
         },
     ));
-    Ok(Some(GnssLink {
+    Some(GnssLink {
         inputs,
         stream,
         ntrip,
-    }))
+    })
 }

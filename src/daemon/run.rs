@@ -22,7 +22,8 @@ use crate::config::{Config, ConfigError};
 use crate::control::node::{ControllerNode, NodeStatus};
 use crate::control::ControlError;
 use crate::guidance::progress::Progress;
-use crate::job::{JobDetail, JobError, PreparedJob};
+use crate::job::startup::{Startup, StartupError};
+use crate::job::{JobDetail, JobError};
 use crate::store::progress_file;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -46,11 +47,11 @@ pub enum DaemonError {
     #[error(transparent)]
     Job(#[from] JobError),
     #[error(transparent)]
+    Startup(#[from] StartupError),
+    #[error(transparent)]
     Control(#[from] ControlError),
     #[error("runtime: {0}")]
     Runtime(std::io::Error),
-    #[error(transparent)]
-    Gnss(#[from] crate::config::PasswordFileError),
     #[error(transparent)]
     BusLog(#[from] BusLogError),
 }
@@ -196,13 +197,13 @@ fn spawn_progress_writer(path: PathBuf) -> mpsc::SyncSender<Progress> {
     tx
 }
 
-/// Prepare the configured job ([`crate::job::prepare`]) and log what was planned. For
-/// `job.kind = "field"` this reads `job.field_path` and plans its coverage, for `"maneuver"`
-/// it reads the map and plans the manoeuvre: blocking work, done once at start-up, never in
-/// the control loop.
-pub fn prepare_job(planning: &crate::config::Planning) -> Result<PreparedJob, JobError> {
-    let job = crate::job::prepare(planning)?;
-    match &job.detail {
+/// Load what the daemon starts with ([`crate::job::startup::load`], shared with `agsteerd
+/// --check`) and log what was planned and what will be lost. For `job.kind = "field"` this
+/// reads `job.field_path` and plans its coverage, for `"maneuver"` it reads the map and plans
+/// the manoeuvre: blocking work, done once at start-up, never in the control loop.
+pub fn start_up(cfg: &Config) -> Result<Startup, StartupError> {
+    let startup = crate::job::startup::load(cfg)?;
+    match &startup.job.detail {
         JobDetail::Field(fj) => tracing::info!(
             field = %fj.title(),
             origin_lat_deg = fj.origin().lat_deg,
@@ -223,7 +224,10 @@ pub fn prepare_job(planning: &crate::config::Planning) -> Result<PreparedJob, Jo
         ),
         JobDetail::Lines => {}
     }
-    Ok(job)
+    for w in &startup.warnings {
+        tracing::warn!("{w}");
+    }
+    Ok(startup)
 }
 
 /// Run this thread under SCHED_FIFO at `priority` (0 = leave it alone).
@@ -396,10 +400,15 @@ async fn run_async(
     bus_log: Option<BusLogParams>,
 ) -> Result<(), DaemonError> {
     use tokio::signal::unix::{signal, SignalKind};
-    // The job is set up here (the field or map read and planned), before the bus is opened
-    // and the loop starts.
-    let resolved = cfg.resolve()?;
-    let job = prepare_job(&resolved.planning)?;
+    // The job is set up here (the field or map read and planned, the password file read, the
+    // state directory checked), before the bus is opened and the loop starts.
+    let Startup {
+        resolved,
+        job,
+        progress_path,
+        ntrip_password,
+        ..
+    } = start_up(&cfg)?;
     let iface = resolved.daemon.interface.clone();
     let bus = std::rc::Rc::new(AsyncSocketCan::open(&iface, &receive_filters()).map_err(
         |source| DaemonError::Open {
@@ -407,7 +416,6 @@ async fn run_async(
             source,
         },
     )?);
-    let progress_path = progress_file::progress_path(&resolved.daemon.state_dir);
     let resume = crate::job::resume::resume_or_start(&job, &progress_path);
     // The node is built once; a SIGHUP only retunes it (apply_reload), so the plan is kept.
     let mut node = crate::job::build_node(&resolved, &job, resume.as_ref())?;
@@ -464,7 +472,7 @@ async fn run_async(
     });
 
     // GNSS over a serial port, USB, UDP or TCP, and the NTRIP client ([gnss]).
-    let mut gnss = super::gnss::spawn(&cfg, &local)?;
+    let mut gnss = ntrip_password.and_then(|password| super::gnss::spawn(&cfg, password, &local));
 
     let dt = resolved.control.dt;
     let mut interval = tokio::time::interval(Duration::from_secs_f64(dt));

@@ -17,6 +17,7 @@ pub mod field;
 pub mod identity;
 pub mod maneuver;
 pub mod resume;
+pub mod startup;
 
 use crate::config::{Config, ConfigError, JobKind, LineOrder, Planning, Resolved};
 use crate::control::node::ControllerNode;

@@ -46,7 +46,27 @@ pub fn load_saved(job: &PreparedJob, path: &Path) -> Result<Saved, ProgressFileE
     }
 }
 
-fn summary(changes: &[String]) -> String {
+/// [`load_saved`] leaving the file as it is (`agsteerd --check`): a corrupt or impossible
+/// file is [`ProgressFileError::Invalid`], not moved.
+pub fn peek_saved(job: &PreparedJob, path: &Path) -> Result<Saved, ProgressFileError> {
+    let Some(p) = progress_file::peek(path)? else {
+        return Ok(Saved::Nothing);
+    };
+    let changes = job.definition.differences(&p.job);
+    if !changes.is_empty() {
+        return Ok(Saved::Foreign(changes));
+    }
+    match check_against_plan(&p, &job.plan) {
+        Ok(()) => Ok(Saved::Ours(p)),
+        Err(why) => Err(ProgressFileError::Invalid {
+            path: path.to_path_buf(),
+            reason: ProgressError::Content(why),
+        }),
+    }
+}
+
+/// The differences of a foreign progress, in a line.
+pub fn summary(changes: &[String]) -> String {
     const SHOWN: usize = 8;
     let mut s = changes
         .iter()

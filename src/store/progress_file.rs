@@ -44,6 +44,12 @@ pub enum ProgressFileError {
         size: u64,
         limit: u64,
     },
+    /// A corrupt file read by [`peek`], which leaves it where it is.
+    #[error("{path} is corrupt ({reason})")]
+    Invalid {
+        path: PathBuf,
+        reason: ProgressError,
+    },
 }
 
 impl ProgressFileError {
@@ -54,7 +60,8 @@ impl ProgressFileError {
             | ProgressFileError::Corrupt { path, .. }
             | ProgressFileError::NotAFile { path, .. }
             | ProgressFileError::UnsafeDir { path, .. }
-            | ProgressFileError::TooLarge { path, .. } => path,
+            | ProgressFileError::TooLarge { path, .. }
+            | ProgressFileError::Invalid { path, .. } => path,
         }
     }
 }
@@ -92,10 +99,6 @@ fn type_name(t: fs::FileType) -> &'static str {
 /// a directory owned by this process's user, not writable by every user (a group-writable
 /// one is accepted: a umask of 002 makes every directory so).
 pub fn ensure_state_dir(dir: &Path) -> Result<(), ProgressFileError> {
-    let unsafe_dir = |reason: String| ProgressFileError::UnsafeDir {
-        path: dir.to_path_buf(),
-        reason,
-    };
     match fs::metadata(dir) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             fs::DirBuilder::new()
@@ -106,25 +109,36 @@ pub fn ensure_state_dir(dir: &Path) -> Result<(), ProgressFileError> {
             Ok(())
         }
         Err(e) => Err(io(dir)(e)),
-        Ok(m) if !m.is_dir() => Err(unsafe_dir(format!("is {}", type_name(m.file_type())))),
-        Ok(m) => {
-            // SAFETY: geteuid has no preconditions and cannot fail.
-            let me = unsafe { libc::geteuid() };
-            if m.uid() != me {
-                return Err(unsafe_dir(format!(
-                    "owned by uid {}, not by this process's uid {me}",
-                    m.uid()
-                )));
-            }
-            if m.mode() & 0o002 != 0 {
-                return Err(unsafe_dir(format!(
-                    "mode {:o} lets every user write in it (chmod o-w)",
-                    m.mode() & 0o7777
-                )));
-            }
-            Ok(())
-        }
+        Ok(_) => check_state_dir(dir),
     }
+}
+
+/// Check the existing state directory `dir` as [`ensure_state_dir`] does, creating nothing
+/// (`agsteerd --check`).
+pub fn check_state_dir(dir: &Path) -> Result<(), ProgressFileError> {
+    let unsafe_dir = |reason: String| ProgressFileError::UnsafeDir {
+        path: dir.to_path_buf(),
+        reason,
+    };
+    let m = fs::metadata(dir).map_err(io(dir))?;
+    if !m.is_dir() {
+        return Err(unsafe_dir(format!("is {}", type_name(m.file_type()))));
+    }
+    // SAFETY: geteuid has no preconditions and cannot fail.
+    let me = unsafe { libc::geteuid() };
+    if m.uid() != me {
+        return Err(unsafe_dir(format!(
+            "owned by uid {}, not by this process's uid {me}",
+            m.uid()
+        )));
+    }
+    if m.mode() & 0o002 != 0 {
+        return Err(unsafe_dir(format!(
+            "mode {:o} lets every user write in it (chmod o-w)",
+            m.mode() & 0o7777
+        )));
+    }
+    Ok(())
 }
 
 /// Refuse whatever is at `path` unless it is nothing or a regular file (not followed).
@@ -252,13 +266,24 @@ pub fn move_aside(path: &Path, reason: ProgressError) -> ProgressFileError {
 /// is refused ([`ProgressFileError::NotAFile`]) and left alone.
 pub fn load(path: &Path) -> Result<Option<Progress>, ProgressFileError> {
     remove_stale_temps(path);
+    match peek(path) {
+        Err(ProgressFileError::Invalid { path, reason }) => Err(move_aside(&path, reason)),
+        other => other,
+    }
+}
+
+/// Read a progress file and leave it as it is (`agsteerd --check`): `Ok(None)` when there is
+/// none, [`ProgressFileError::Invalid`] when it is corrupt; refused as [`load`] refuses.
+pub fn peek(path: &Path) -> Result<Option<Progress>, ProgressFileError> {
     let Some(bytes) = read_state_file(path)? else {
         return Ok(None);
     };
-    match Progress::decode(&bytes) {
-        Ok(p) => Ok(Some(p)),
-        Err(reason) => Err(move_aside(path, reason)),
-    }
+    Progress::decode(&bytes)
+        .map(Some)
+        .map_err(|reason| ProgressFileError::Invalid {
+            path: path.to_path_buf(),
+            reason,
+        })
 }
 
 #[cfg(test)]
@@ -427,5 +452,22 @@ mod tests {
         fs::write(&file, "x").unwrap();
         let e = ensure_state_dir(&file).unwrap_err();
         assert!(e.to_string().contains("plain"), "{e}");
+    }
+
+    #[test]
+    fn peek_reports_a_corrupt_file_and_leaves_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = progress_path(dir.path());
+        assert!(peek(&path).unwrap().is_none());
+        save(&path, &sample()).unwrap();
+        assert_eq!(peek(&path).unwrap(), Some(sample()));
+        let enc = sample().encode();
+        fs::write(&path, &enc[..enc.len() / 2]).unwrap();
+        assert!(matches!(
+            peek(&path),
+            Err(ProgressFileError::Invalid { .. })
+        ));
+        assert!(path.exists(), "peek moved the file");
+        assert_eq!(fs::read_to_string(&path).unwrap(), &enc[..enc.len() / 2]);
     }
 }

@@ -1,7 +1,6 @@
 //! `agsteerd`: the steering daemon on SocketCAN.
 
 use agsteer::config::Config;
-use agsteer::job::JobDetail;
 use anyhow::Context;
 use clap::Parser;
 use std::path::PathBuf;
@@ -17,8 +16,11 @@ struct Args {
     /// Configuration file.
     #[arg(long, default_value = "/etc/agsteer/agsteer.toml")]
     config: PathBuf,
-    /// Validate the configuration and everything it names (a field is read and planned, a
-    /// manoeuvre map read and the manoeuvre planned), then exit (0 valid, 2 invalid).
+    /// Load everything the daemon loads at start-up, as it loads it (the configuration; a field
+    /// or TASKDATA file read and planned; a manoeuvre map read and the manoeuvre planned; the
+    /// NTRIP password file; the state directory, the saved progress and the status socket's
+    /// path looked at, nothing written), say what the daemon would do, then exit (0 valid, 2
+    /// invalid). Warnings (progress that could not be saved) do not fail the check.
     #[arg(long)]
     check: bool,
     /// Override a configuration key, e.g. `--set bus.interface=vcan0`.
@@ -54,39 +56,7 @@ fn main() -> ExitCode {
         }
     };
     if args.check {
-        // Everything the daemon loads at start-up, set up as it sets it up: the field or the
-        // manoeuvre map read and planned too, or the daemon would not start.
-        let prepared = cfg
-            .resolve()
-            .map_err(anyhow::Error::new)
-            .and_then(|r| agsteer::job::prepare(&r.planning).map_err(anyhow::Error::new));
-        match prepared {
-            Ok(job) => match &job.detail {
-                JobDetail::Field(fj) => println!(
-                    "{}: field {} plans into {} segments (checksum {:08x})",
-                    args.config.display(),
-                    fj.path.display(),
-                    fj.job.len(),
-                    fj.job.checksum()
-                ),
-                JobDetail::Maneuver(mj, map) => println!(
-                    "{}: manoeuvre on {} plans into {} segments ({:.1} m, {} cusps, checksum {:08x})",
-                    args.config.display(),
-                    if map.is_some() { "its map" } else { "free space" },
-                    mj.job.len(),
-                    mj.path.length(),
-                    mj.path.cusps(),
-                    mj.job.checksum()
-                ),
-                JobDetail::Lines => {}
-            },
-            Err(e) => {
-                eprintln!("{}: {e:#}", args.config.display());
-                return ExitCode::from(2);
-            }
-        }
-        println!("{}: valid", args.config.display());
-        return ExitCode::SUCCESS;
+        return check(&args, &cfg);
     }
     let filter = tracing_subscriber::EnvFilter::try_from_default_env()
         .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(&cfg.daemon.log_level));
@@ -121,4 +91,29 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// `--check`: [`agsteer::job::startup::load`], the daemon's own start-up, then what it would
+/// do with the saved progress.
+fn check(args: &Args, cfg: &Config) -> ExitCode {
+    let name = args.config.display();
+    let startup = match agsteer::job::startup::load(cfg) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("{name}: {:#}", anyhow::Error::new(e));
+            return ExitCode::from(2);
+        }
+    };
+    if let Some(planned) = agsteer::job::startup::planned(&startup.job) {
+        println!("{name}: {planned}");
+    }
+    match agsteer::job::startup::progress_outlook(&startup) {
+        Ok(outlook) => println!("{name}: progress: {outlook}"),
+        Err(warning) => println!("{name}: warning: {warning}"),
+    }
+    for w in &startup.warnings {
+        println!("{name}: warning: {w}");
+    }
+    println!("{name}: valid");
+    ExitCode::SUCCESS
 }
