@@ -568,9 +568,19 @@ impl Supervisor {
             && self.work_line.is_some()
         {
             let p = &self.params;
-            let verdict =
-                self.tracking
-                    .update(&p.tracking, t, dt, xte, self.wheel_angle, self.speed);
+            // The wheels' swings tell a weave on a straight line only: a line whose sharpest
+            // bend asks for half the band or more moves them by design.
+            let bend_wheel_angle = (p.wheelbase * self.line_curvature).atan();
+            let watch_wheel = bend_wheel_angle < 0.5 * p.tracking.unstable_wheel;
+            let verdict = self.tracking.update(
+                &p.tracking,
+                t,
+                dt,
+                xte,
+                self.wheel_angle,
+                watch_wheel,
+                self.speed,
+            );
             let code = match verdict {
                 TrackingVerdict::Ok => FaultCode::None,
                 TrackingVerdict::Unstable => FaultCode::TrackingUnstable,

@@ -186,7 +186,11 @@ impl TrackingMonitor {
     }
 
     /// One engaged period on a work line at `t`, `dt` after the previous one: the cross-track
-    /// error (m, when known), the measured wheel angle (rad) and the speed (m/s).
+    /// error (m, when known), the measured wheel angle (rad) and the speed (m/s). The wheel
+    /// angle's swings are counted only when `watch_wheel` (a straight line: on a curved one,
+    /// a headland pass round a field's corners, the wheels leave their mean at every bend by
+    /// design, and only the cross-track error tells a weave).
+    #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         p: &TrackingParams,
@@ -194,6 +198,7 @@ impl TrackingMonitor {
         dt: f64,
         xte: Option<f64>,
         wheel_angle: f64,
+        watch_wheel: bool,
         speed: f64,
     ) -> TrackingVerdict {
         let mean = match self.wheel_mean {
@@ -205,13 +210,15 @@ impl TrackingMonitor {
         };
         self.wheel_mean = Some(mean);
         let mut verdict = TrackingVerdict::Ok;
-        if self.wheel_swings.update(
-            t,
-            wheel_angle - mean,
-            p.unstable_wheel,
-            p.unstable_swings,
-            p.unstable_window,
-        ) {
+        if watch_wheel
+            && self.wheel_swings.update(
+                t,
+                wheel_angle - mean,
+                p.unstable_wheel,
+                p.unstable_swings,
+                p.unstable_window,
+            )
+        {
             verdict = TrackingVerdict::Unstable;
         }
         let Some(x) = xte.filter(|x| x.is_finite()) else {
@@ -322,7 +329,7 @@ mod tests {
         let mut t = 0.0;
         while t < secs {
             let (x, w) = f(t);
-            let v = m.update(p, t, DT, Some(x), w, 2.5);
+            let v = m.update(p, t, DT, Some(x), w, true, 2.5);
             if v != TrackingVerdict::Ok {
                 return Some((t, v));
             }
