@@ -51,14 +51,8 @@ fn run(
 fn name(self_configurable: bool, identity: u32) -> Name {
     Name::new(&NameFields {
         self_configurable,
-        industry_group: 2,
-        device_class_instance: 0,
-        device_class: 0,
-        function: 23,
-        function_instance: 0,
-        ecu_instance: 0,
-        manufacturer_code: 0,
         identity_number: identity,
+        ..NameFields::GUIDANCE_CONTROLLER
     })
 }
 

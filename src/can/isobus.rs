@@ -79,6 +79,21 @@ pub struct NameFields {
 }
 
 impl NameFields {
+    /// agsteer's default NAME: a self-configurable vehicle-navigation controller (function 23)
+    /// of the agricultural industry group, manufacturer code 0 until the integrator sets the
+    /// SAE-assigned one, identity number 1 (the `[isobus]` keys' defaults).
+    pub const GUIDANCE_CONTROLLER: NameFields = NameFields {
+        self_configurable: true,
+        industry_group: 2,
+        device_class_instance: 0,
+        device_class: 0,
+        function: 23,
+        function_instance: 0,
+        ecu_instance: 0,
+        manufacturer_code: 0,
+        identity_number: 1,
+    };
+
     /// The largest value of each field (for range checks at the edges).
     pub const MAX_INDUSTRY_GROUP: u8 = 7;
     pub const MAX_DEVICE_CLASS_INSTANCE: u8 = 15;

@@ -47,18 +47,19 @@ pub struct IsobusConfig {
 
 impl Default for IsobusConfig {
     fn default() -> Self {
+        const NAME: NameFields = NameFields::GUIDANCE_CONTROLLER;
         IsobusConfig {
             address_claim: true,
             address_range: [128, 235],
-            self_configurable: true,
-            industry_group: 2,
-            device_class: 0,
-            device_class_instance: 0,
-            function: 23,
-            function_instance: 0,
-            ecu_instance: 0,
-            manufacturer_code: 0,
-            identity_number: 1,
+            self_configurable: NAME.self_configurable,
+            industry_group: NAME.industry_group,
+            device_class: NAME.device_class,
+            device_class_instance: NAME.device_class_instance,
+            function: NAME.function,
+            function_instance: NAME.function_instance,
+            ecu_instance: NAME.ecu_instance,
+            manufacturer_code: NAME.manufacturer_code,
+            identity_number: NAME.identity_number,
             steering_address: 255,
             steering_function: 16,
             machine_info_timeout_s: 0.3,
