@@ -104,7 +104,7 @@ fn percentiles(kind: &str) {
     let q = |p: f64| {
         samples[((samples.len() as f64 * p) as usize).min(samples.len() - 1)] as f64 / 1000.0
     };
-    println!(
+    eprintln!(
         "control_step/{kind}: median {:.2} µs, p99 {:.2} µs, max {:.1} µs over {} steps",
         q(0.5),
         q(0.99),

@@ -57,7 +57,7 @@ fn peak_heap(line_num: u64, lines: u64) -> usize {
 fn bench(c: &mut Criterion) {
     let small = peak_heap(100, 4);
     let huge = peak_heap(100_000, 4);
-    println!("peak heap, first 4 lines: line_num=100: {small} B; line_num=100000: {huge} B");
+    eprintln!("peak heap, first 4 lines: line_num=100: {small} B; line_num=100000: {huge} B");
     // The job's identity (saved with its progress) records every planning key as text, so the
     // heap follows the values' text by a few bytes, not the count of lines (measured: line_num
     // 100 → 179 291 B, 999 → 179 221 B, 100 000 → 179 303 B, 999 999 → 179 233 B). A job that
