@@ -1,4 +1,4 @@
-//! Manoeuvre planning (SPEC §4): the whole seed-004 planner on each scenario of
+//! Manoeuvre planning (docs/METHODS.md, Search): the whole seed-004 planner on each scenario of
 //! tools/maneuvers/ with the default configuration plus the scenario's overlay, continuous
 //! curvature. Target: < 100 ms each.
 

@@ -1,6 +1,6 @@
-//! Manoeuvre curves (SPEC §4): one plain Reeds-Shepp query, one CC Reeds-Shepp query (length
-//! only and full path) and one CC turn, averaged over a fixed set of 256 random pose pairs in
-//! ±20 m (κ_max 0.2 /m, σ_max 0.1 /m²). Targets: RS < 2 µs, CC < 10 µs per query.
+//! Manoeuvre curves (docs/METHODS.md, Curves): one plain Reeds-Shepp query, one CC Reeds-Shepp
+//! query (length only and full path) and one CC turn, averaged over a fixed set of 256 random pose
+//! pairs in ±20 m (κ_max 0.2 /m, σ_max 0.1 /m²). Targets: RS < 2 µs, CC < 10 µs per query.
 //!
 //! Run: cargo bench --bench maneuver_curves -- --warm-up-time 1 --measurement-time 3
 

@@ -1,6 +1,6 @@
-//! Continuous-curvature Reeds-Shepp paths over seeded random pose pairs (SPEC §4): every path
-//! sampled at 1 cm reaches the goal, respects κ_max and σ_max, and has continuous curvature,
-//! zero at the start, the goal and every cusp. Also reports the CC / RS length ratio.
+//! Continuous-curvature Reeds-Shepp paths over seeded random pose pairs (docs/METHODS.md, Curves):
+//! every path sampled at 1 cm reaches the goal, respects κ_max and σ_max, and has continuous
+//! curvature, zero at the start, the goal and every cusp. Also reports the CC / RS length ratio.
 //!
 //! Run: cargo test --release --test cc_paths -- --nocapture
 

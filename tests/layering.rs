@@ -18,6 +18,11 @@
 //! The size rule covers `src/`, `tests/` and `benches/`: a file over [`MAX_LINES`] lines fails,
 //! except the ones in [`OVERSIZE_PENDING`] (being split by another change); an entry there that
 //! is no longer oversized fails too, so the list only shrinks.
+//!
+//! The design documents: no file cites the old specification (it is not in the repository; the
+//! citations point at `docs/` now), and every pointer into `docs/*.md` names a section that
+//! exists: "docs/METHODS.md, Local path" (the text after the comma starts with a heading of
+//! that file), a `docs/CONVENTIONS.md#heading` anchor, and the links between the documents.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -552,4 +557,207 @@ fn the_path_parser_resolves_use_trees() {
     );
     assert!(!code.contains("demo"));
     assert_eq!(files, ["more"]);
+}
+
+// ---- The design documents: no citations of the old specification, and every pointer into
+// docs/*.md names a section that exists. ----
+
+/// Every file under `dir` (recursively), or `dir` itself when it is a file.
+fn all_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    if dir.is_file() {
+        out.push(dir.to_path_buf());
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            all_files(&p, out);
+        } else {
+            out.push(p);
+        }
+    }
+}
+
+/// The places that may point into docs/: the code, the tools, the configuration, the READMEs
+/// and the documents themselves.
+fn doc_citing_files() -> Vec<PathBuf> {
+    let root = root();
+    let mut files = Vec::new();
+    for p in [
+        "src",
+        "tests",
+        "benches",
+        "build.rs",
+        "tools",
+        "config",
+        "docs",
+        "README.md",
+    ] {
+        all_files(&root.join(p), &mut files);
+    }
+    files.sort();
+    files
+}
+
+/// GitHub's anchor of a Markdown heading: lower case, spaces to hyphens, other punctuation
+/// dropped.
+fn slug(heading: &str) -> String {
+    heading
+        .to_lowercase()
+        .chars()
+        .filter_map(|c| match c {
+            ' ' => Some('-'),
+            c if c.is_alphanumeric() || c == '-' || c == '_' => Some(c),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The headings of a Markdown file (outside code fences), without their `#`s.
+fn headings(text: &str) -> Vec<String> {
+    let mut fenced = false;
+    let mut out = Vec::new();
+    for line in text.lines() {
+        if line.starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced && line.starts_with('#') {
+            out.push(line.trim_start_matches('#').trim().to_string());
+        }
+    }
+    out
+}
+
+/// A file's text with each line's indentation and comment marker dropped and the lines joined
+/// by spaces, so that a pointer wrapped over two comment lines reads as one.
+fn joined_text(text: &str) -> String {
+    let mut out = String::new();
+    for line in text.lines() {
+        let t = line.trim_start();
+        let t = ["//!", "///", "//", "#"]
+            .iter()
+            .find_map(|m| t.strip_prefix(m))
+            .unwrap_or(t);
+        out.push_str(t.trim());
+        out.push(' ');
+    }
+    out
+}
+
+#[test]
+fn no_comment_cites_the_old_spec() {
+    // The needle is built so that this file does not contain it.
+    let needle = format!("SPEC {}", '§');
+    let root = root();
+    let mut found = Vec::new();
+    for file in doc_citing_files() {
+        let Ok(text) = std::fs::read(&file) else {
+            continue;
+        };
+        let text = String::from_utf8_lossy(&text);
+        for (i, line) in text.lines().enumerate() {
+            if line.contains(&needle) {
+                let rel = file.strip_prefix(&root).unwrap_or(&file);
+                found.push(format!("{}:{}: {}", rel.display(), i + 1, line.trim()));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "point at a section of docs/ARCHITECTURE.md or docs/CONVENTIONS.md or docs/METHODS.md (\"see \
+         docs/METHODS.md, Local path\") instead of the specification, which is not in the \
+         repository:\n{}",
+        found.join("\n")
+    );
+}
+
+#[test]
+fn pointers_into_docs_name_existing_sections() {
+    let root = root();
+    let mut problems = Vec::new();
+    let mut checked = 0;
+    for file in doc_citing_files() {
+        let Ok(bytes) = std::fs::read(&file) else {
+            continue;
+        };
+        let Ok(text) = String::from_utf8(bytes) else {
+            continue;
+        };
+        let rel = file.strip_prefix(&root).unwrap_or(&file).to_path_buf();
+        let in_docs = rel.starts_with("docs");
+        let text = joined_text(&text);
+        // `docs/<name>.md` anywhere; `](<name>.md` and `](#` links inside docs/ too.
+        let mut refs: Vec<(String, &str)> = Vec::new();
+        for (i, _) in text.match_indices("docs/") {
+            let rest = &text[i + 5..];
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '-')
+                .collect();
+            if let Some(after) = rest[name.len()..].strip_prefix(".md") {
+                refs.push((name, after));
+            }
+        }
+        if in_docs {
+            let own = rel
+                .file_stem()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_default();
+            for (i, _) in text.match_indices("](") {
+                let rest = &text[i + 2..];
+                if rest.starts_with('#') {
+                    refs.push((own.clone(), rest));
+                    continue;
+                }
+                let name: String = rest
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '-')
+                    .collect();
+                if let Some(after) = rest[name.len()..].strip_prefix(".md") {
+                    refs.push((name, after));
+                }
+            }
+        }
+        for (name, after) in refs {
+            let target = root.join("docs").join(format!("{name}.md"));
+            let Ok(doc) = std::fs::read_to_string(&target) else {
+                problems.push(format!("{}: docs/{name}.md does not exist", rel.display()));
+                continue;
+            };
+            let heads = headings(&doc);
+            if let Some(anchor) = after.strip_prefix('#') {
+                let anchor: String = anchor
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '-' || *c == '_')
+                    .collect();
+                checked += 1;
+                if !heads.iter().any(|h| slug(h) == anchor) {
+                    problems.push(format!(
+                        "{}: docs/{name}.md has no section #{anchor}",
+                        rel.display()
+                    ));
+                }
+            } else if let Some(section) = after.strip_prefix(", ") {
+                checked += 1;
+                let names = |h: &&String| {
+                    section.starts_with(h.as_str())
+                        && !section[h.len()..].starts_with(|c: char| c.is_alphanumeric())
+                };
+                if !heads.iter().any(|h| names(&h)) {
+                    let shown: String = section.chars().take(40).collect();
+                    problems.push(format!(
+                        "{}: \"docs/{name}.md, {shown}…\" names no section of docs/{name}.md \
+                         (its sections: {})",
+                        rel.display(),
+                        heads.join(" | ")
+                    ));
+                }
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    // The pointers that replaced the old citations are all checked here.
+    assert!(checked >= 30, "only {checked} pointers into docs/ found");
 }

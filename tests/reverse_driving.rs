@@ -1,7 +1,7 @@
-//! Reverse driving closed-loop (SPEC §4 output, issue 6 part 5c): a segment job with two cusps
-//! — forward, reverse on a curve, forward again — through the real frames. The node requests
-//! stop before each cusp, waits for the speed frame to show the vehicle stopped and turned,
-//! and steers the reverse segment about the rear axle; the simulator obeys the requests.
+//! Reverse driving closed-loop (docs/METHODS.md, Manoeuvres at work; issue 6 part 5c): a segment
+//! job with two cusps — forward, reverse on a curve, forward again — through the real frames. The
+//! node requests stop before each cusp, waits for the speed frame to show the vehicle stopped and
+//! turned, and steers the reverse segment about the rear axle; the simulator obeys the requests.
 
 use agsteer::config::Config;
 use agsteer::demo::{run, DemoOptions};

@@ -10,17 +10,19 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum JobKind {
-    /// Parallel AB lines (SPEC §2).
+    /// Parallel AB lines (docs/METHODS.md, AB-line work).
     #[default]
     Ab,
-    /// A field coverage plan (SPEC §3) made from the field at `job.field_path`.
+    /// A field coverage plan (docs/METHODS.md, Coverage of a field) made from the field at
+    /// `job.field_path`.
     Field,
     /// Concentric circular work lines about `job.point_a_m` (the curved lines of the accuracy
     /// suite): `job.line_num` arcs from radius `job.arc_radius_m` outwards, `job.line_width_m`
     /// apart, each sweeping `job.arc_sweep_deg`, joined by headland turns.
     Arcs,
-    /// A manoeuvre with reversing (SPEC §4) from `job.maneuver_from` to `job.maneuver_to` on
-    /// the map at `job.maneuver_map_path`, planned at start-up with `[maneuver]`.
+    /// A manoeuvre with reversing (docs/METHODS.md, Manoeuvres with reversing) from
+    /// `job.maneuver_from` to `job.maneuver_to` on the map at `job.maneuver_map_path`, planned at
+    /// start-up with `[maneuver]`.
     Maneuver,
 }
 
@@ -29,7 +31,8 @@ pub enum JobKind {
 #[serde(rename_all = "snake_case")]
 pub enum LineOrder {
     /// The seed-000 order: blocks of `N = 2·ceil(2·r_min/line_width) + a` lines driven in a
-    /// skip order so that every turn is a forward pi turn (SPEC §2).
+    /// skip order so that every turn is a forward pi turn (docs/METHODS.md, Blocks and the skip
+    /// order).
     #[default]
     Blocks,
     /// Adjacent lines in turn. Lines closer than `2·r_min` are joined by a fishtail turn with

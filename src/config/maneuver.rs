@@ -18,7 +18,8 @@ pub enum CurveChoice {
     Rs,
 }
 
-/// `[maneuver]`: manoeuvres with reversing in tight spaces (`agsteer maneuver`, SPEC §4). The
+/// `[maneuver]`: manoeuvres with reversing in tight spaces (`agsteer maneuver`; docs/METHODS.md,
+/// Manoeuvres with reversing). The
 /// vehicle rectangle is `vehicle.length_m` × `vehicle.width_m` with the rear axle
 /// `vehicle.rear_axle_from_rear_m` ahead of its rear edge; the largest curvature is
 /// 1 / `vehicle.r_min_m`.

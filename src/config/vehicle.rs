@@ -20,9 +20,9 @@ pub struct VehicleConfig {
     /// Largest front-wheel angle either way, degrees.
     pub max_wheel_angle_deg: f64,
     /// Largest rate of change of the steering curvature per metre driven, 1/m² (σ_max of
-    /// the continuous-curvature turns and manoeuvres, SPEC §4). It comes from the steering
-    /// speed: about max wheel rate (rad/s) / (wheelbase (m) · speed in turns (m/s)); 30°/s,
-    /// 3 m and 6 km/h give 0.10. 0 = turns of arcs only (curvature steps at their ends; and
+    /// the continuous-curvature turns and manoeuvres, docs/METHODS.md, Curves). It comes from the
+    /// steering speed: about max wheel rate (rad/s) / (wheelbase (m) · speed in turns (m/s));
+    /// 30°/s, 3 m and 6 km/h give 0.10. 0 = turns of arcs only (curvature steps at their ends; and
     /// manoeuvres only with `maneuver.curve = "rs"`).
     pub max_curvature_rate_per_m2: f64,
     /// GNSS antenna position ahead of the rear-axle centre, m.

@@ -94,8 +94,9 @@ pub struct ControllerNode {
     last_request: Option<DirectionRequestDirection>,
 }
 
-/// How the node handles a change of driving direction (SPEC §4: the daemon asks for it on the
-/// bus before each cusp, waits until the vehicle has stopped and turned, then steers on).
+/// How the node handles a change of driving direction (docs/METHODS.md, Manoeuvres at work: the
+/// daemon asks for it on the bus before each cusp, waits until the vehicle has stopped and turned,
+/// then steers on).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct CuspParams {
     decel: f64,

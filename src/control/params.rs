@@ -63,8 +63,9 @@ pub struct ApproachParams {
     pub max_heading_error: f64,
 }
 
-/// How a change of driving direction is handled (SPEC §4: the node asks for it on the bus
-/// before each cusp, waits until the vehicle has stopped and turned, then steers on).
+/// How a change of driving direction is handled (docs/METHODS.md, Manoeuvres at work: the node asks
+/// for it on the bus before each cusp, waits until the vehicle has stopped and turned, then steers
+/// on).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CuspParams {
     /// Stop when within the stopping distance at this deceleration, m/s².

@@ -1,5 +1,5 @@
-//! Pose estimation (SPEC §1): GNSS antenna → rear-axle reference point, latency compensation
-//! and dead reckoning between fixes.
+//! Pose estimation (docs/METHODS.md, Estimation; docs/CONVENTIONS.md, Reference point): GNSS
+//! antenna → rear-axle reference point, latency compensation and dead reckoning between fixes.
 //!
 //! A fix describes the antenna `gnss_latency` before it arrived, or the latency its own time
 //! stamp gives ([`GnssFix::latency`], NMEA 0183 and UBX with a disciplined host clock), when

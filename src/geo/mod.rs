@@ -1,8 +1,8 @@
 //! Geometry shared by every stage: local ENU vectors, poses, angles and path points.
 //!
-//! Conventions (SPEC §1): metres and radians inside; the local frame is ENU (x = East,
-//! y = North); heading is counter-clockwise from East in (-π, π]; positive curvature and
-//! positive front-wheel angle turn left.
+//! Conventions (docs/CONVENTIONS.md, Units, Frames, Heading and Signs): metres and radians inside;
+//! the local frame is ENU (x = East, y = North); heading is counter-clockwise from East in (-π, π];
+//! positive curvature and positive front-wheel angle turn left.
 
 pub mod polygon;
 pub mod svg;

@@ -1,4 +1,5 @@
-//! The seed-000 job state machine (SPEC §2, steps 1–4), run every control period.
+//! The seed-000 job state machine (docs/METHODS.md, The job state machine), run every control
+//! period.
 //!
 //! It owns the current global path (one work line or one turn, regenerated lazily at each
 //! change) and the local B-spline path, and keeps `index_block`, `index_rank`,
@@ -78,8 +79,9 @@ pub struct Guidance {
     index_global: usize,
     local: LocalPath,
     events: Vec<Event>,
-    /// An approach path driven before the current line (SPEC §4, issue 6 part 5b): segments
-    /// split at cusps, from the vehicle to the line start. Not part of the job: never saved.
+    /// An approach path driven before the current line (docs/METHODS.md, Manoeuvres at work; issue
+    /// 6 part 5b): segments split at cusps, from the vehicle to the line start. Not part of the
+    /// job: never saved.
     approach: Vec<JobSegment>,
     /// The approach segment being driven, while approaching.
     approach_index: Option<usize>,

@@ -1,4 +1,4 @@
-//! The seed-000 AB-line planner (SPEC §2).
+//! The seed-000 AB-line planner (docs/METHODS.md, AB-line work).
 //!
 //! Work line `k` is line A→B shifted `k·line_width` to the configured side. Lines are
 //! generated lazily: the plan stores only the parameters and the driving order of one block

@@ -1,6 +1,6 @@
-//! The seed-000 skip order (SPEC §2): in which order a run of parallel lines is driven so that
-//! no turn joins lines closer than `2·r_min`, used by AB jobs ([`crate::plan::abline`]) and
-//! by field swaths ([`crate::plan::coverage`]).
+//! The seed-000 skip order (docs/METHODS.md, Blocks and the skip order): in which order a run of
+//! parallel lines is driven so that no turn joins lines closer than `2·r_min`, used by AB jobs
+//! ([`crate::plan::abline`]) and by field swaths ([`crate::plan::coverage`]).
 //!
 //! Contract: pure functions of line counts. One tolerance and one block rule:
 //! * [`min_gap_lines`]: two lines `k` apart are far enough for a pi turn when

@@ -1,6 +1,6 @@
-//! The vehicle simulator (SPEC §6), in process: the true vehicle at a fine internal step, a
-//! steering actuator with dead time, first-order lag, rate and angle limits, GNSS with noise,
-//! rate and latency, and a noisy wheel-angle sensor. Deterministic for a given seed.
+//! The vehicle simulator (docs/METHODS.md, The simulator), in process: the true vehicle at a fine
+//! internal step, a steering actuator with dead time, first-order lag, rate and angle limits, GNSS
+//! with noise, rate and latency, and a noisy wheel-angle sensor. Deterministic for a given seed.
 //!
 //! The plant is not the controller's model: the true wheelbase, antenna position and
 //! wheel-angle sensor gain and offset are the simulator's own ([`SimParams`]), and the body is

@@ -1,5 +1,5 @@
-//! The local path (SPEC §2): a uniform cubic B-spline through the global points around the
-//! vehicle, sampled finely, rebuilt only when `index_global` changes.
+//! The local path (docs/METHODS.md, Local path): a uniform cubic B-spline through the global points
+//! around the vehicle, sampled finely, rebuilt only when `index_global` changes.
 //!
 //! Nodes are the global points `n − nodes_before ..= n + nodes_after`. Each node K is flanked
 //! by control points `K − t` and `K + t`, where t is the node's tangent (next − current at the

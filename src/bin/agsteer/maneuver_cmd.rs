@@ -1,6 +1,6 @@
-//! `agsteer maneuver`: plan a manoeuvre with reversing between two poses (SPEC §4) on a map in
-//! local metres, print the result (text or JSON), optionally draw it as SVG; or plan a batch
-//! of pose pairs from a JSON-lines file.
+//! `agsteer maneuver`: plan a manoeuvre with reversing between two poses (docs/METHODS.md,
+//! Manoeuvres with reversing) on a map in local metres, print the result (text or JSON), optionally
+//! draw it as SVG; or plan a batch of pose pairs from a JSON-lines file.
 
 use agsteer::config::{Config, CurveChoice};
 use agsteer::envelope;

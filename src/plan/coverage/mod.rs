@@ -1,6 +1,6 @@
-//! Coverage of a polygon field (SPEC §3, seeds 003 and 001), as a pipeline of pure stages in
-//! the manner of Fields2Cover: headland → swath angle → decomposition → swaths → obstacles →
-//! route → turns → one ordered list of [`PlanSegment`]s.
+//! Coverage of a polygon field (docs/METHODS.md, Coverage of a field; seeds 003 and 001), as a
+//! pipeline of pure stages in the manner of Fields2Cover: headland → swath angle → decomposition →
+//! swaths → obstacles → route → turns → one ordered list of [`PlanSegment`]s.
 //!
 //! Input is a [`Field`] in the local ENU frame (see [`crate::field`] for reading GeoJSON and
 //! ISO 11783-10 TASKDATA into one). Every stage is a pure function of its inputs.

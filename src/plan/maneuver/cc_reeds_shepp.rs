@@ -1,7 +1,7 @@
 //! Continuous-curvature Reeds-Shepp paths: zero curvature at the start, the goal and every
-//! cusp, |κ| ≤ κ_max, |dκ/ds| ≤ σ_max (SPEC §4; Fraichard & Scheuer, "From Reeds and Shepp's to
-//! continuous-curvature paths", IEEE T-RO 2004; the CC00-RS families of Banzhaf et al.,
-//! `steering_functions`, were used to learn the circle geometry — own formulation and code).
+//! cusp, |κ| ≤ κ_max, |dκ/ds| ≤ σ_max (docs/METHODS.md, Curves; Fraichard & Scheuer, "From Reeds
+//! and Shepp's to continuous-curvature paths", IEEE T-RO 2004; the CC00-RS families of Banzhaf et
+//! al., `steering_functions`, were used to learn the circle geometry — own formulation and code).
 //!
 //! # Geometry
 //!

@@ -1,4 +1,5 @@
-//! Continuous-curvature (CC) turns (SPEC §4, seed 004 formulas 1–4; Fraichard & Scheuer,
+//! Continuous-curvature (CC) turns (docs/METHODS.md, Curves; seed 004 formulas 1–4;
+//! Fraichard & Scheuer,
 //! "From Reeds and Shepp's to continuous-curvature paths", IEEE T-RO 2004).
 //!
 //! A CC turn starts and ends at zero curvature. For a heading change |δ| ≥ δ_min = κ_max²/σ_max

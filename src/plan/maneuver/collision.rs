@@ -1,10 +1,11 @@
-//! Collision checks of the vehicle rectangle against a map (SPEC §4, seed 004 ¶41–42).
+//! Collision checks of the vehicle rectangle against a map (docs/METHODS.md, Collision check;
+//! seed 004 ¶41–42).
 //!
 //! The vehicle is a rectangle placed at its reference point, the centre of the rear axle
-//! (SPEC §1), optionally followed by an implement rectangle. The implement is taken as
-//! **rigidly** attached (three-point linkage): it keeps the tractor's heading, its front edge
-//! `hitch_offset_m` behind the rear axle. A trailed implement would swing in on turns; that is
-//! not modelled.
+//! (docs/CONVENTIONS.md, Reference point), optionally followed by an implement rectangle. The
+//! implement is taken as **rigidly** attached (three-point linkage): it keeps the tractor's
+//! heading, its front edge `hitch_offset_m` behind the rear axle. A trailed implement would swing
+//! in on turns; that is not modelled.
 //!
 //! A [`CollisionMap`] holds a boundary polygon (or none: free space) and obstacle polygons.
 //! The broad phase is a uniform grid: every map edge is listed in each cell its bounding box

@@ -1,5 +1,5 @@
 //! Fresnel integrals C(x) = ∫₀ˣ cos(πt²/2) dt and S(x) = ∫₀ˣ sin(πt²/2) dt, used to place
-//! clothoid points exactly (SPEC §4, seed 004 formula 5).
+//! clothoid points exactly (docs/METHODS.md, Curves; seed 004 formula 5).
 //!
 //! Method (as in Press et al., *Numerical Recipes*, §6.9): the power series for |x| ≤ 1.5 and
 //! the modified Lentz continued fraction of the complementary error function beyond. Absolute

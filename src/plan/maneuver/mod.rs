@@ -1,6 +1,6 @@
-//! Manoeuvres with reversing (SPEC §4, seed 004): continuous-curvature (clothoid) paths with
-//! cusps, plain and CC Reeds-Shepp connections, vehicle collision checks and a hybrid-A*-style
-//! search with analytic connection.
+//! Manoeuvres with reversing (docs/METHODS.md, Manoeuvres with reversing; seed 004):
+//! continuous-curvature (clothoid) paths with cusps, plain and CC Reeds-Shepp connections, vehicle
+//! collision checks and a hybrid-A*-style search with analytic connection.
 //!
 //! Paths are lists of [`CurveSegment`](path::CurveSegment)s from a start
 //! [`Pose`](crate::geo::Pose); they can be sampled at any spacing.

@@ -21,8 +21,9 @@ pub enum CurveKind {
 /// One segment of a path. Curvature varies linearly along it:
 /// κ(s) = `kappa_start` + `sharpness`·s for s in [0, `length`], with s the distance driven.
 /// Curvature is the steering curvature tan(δ)/wheelbase (positive = wheels turned left,
-/// SPEC §1), whatever the driving direction: along a segment the heading changes by κ·ds with
-/// ds the signed displacement (negative in reverse), as in the kinematic bicycle model.
+/// docs/CONVENTIONS.md, Signs), whatever the driving direction: along a segment the heading changes
+/// by κ·ds with ds the signed displacement (negative in reverse), as in the kinematic bicycle
+/// model.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CurveSegment {
     pub kind: CurveKind,

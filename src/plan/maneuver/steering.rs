@@ -1,5 +1,5 @@
 //! The curve family the manoeuvre search steers with: continuous-curvature (clothoid) turns and
-//! CC Reeds-Shepp connections (SPEC §4), or plain arcs and Reeds-Shepp connections.
+//! CC Reeds-Shepp connections (docs/METHODS.md, Curves), or plain arcs and Reeds-Shepp connections.
 
 use super::cc_reeds_shepp::cc_reeds_shepp_shortest;
 use super::cc_turn::cc_turn;

@@ -82,11 +82,11 @@ pub fn canonical_turn(g: f64, left: bool, p: &TurnParams) -> Result<Vec<TurnPart
     })
 }
 
-/// The continuous-curvature fishtail to the left (SPEC §4): a forward CC quarter turn
-/// (clothoid + arc + clothoid at κ_max = 1/r_min and σ_max) from the origin heading +x ends at
-/// (d, d) heading +y (a symmetric quarter turn ends as far along as across); reverse straight
-/// down x = d to (d, g − d); a second forward CC quarter turn ends at (0, g) heading −x.
-/// Curvature is zero at both cusps and both ends, so the steering never has to jump.
+/// The continuous-curvature fishtail to the left (docs/METHODS.md, Curves): a forward CC quarter
+/// turn (clothoid + arc + clothoid at κ_max = 1/r_min and σ_max) from the origin heading +x ends at
+/// (d, d) heading +y (a symmetric quarter turn ends as far along as across); reverse straight down
+/// x = d to (d, g − d); a second forward CC quarter turn ends at (0, g) heading −x. Curvature is
+/// zero at both cusps and both ends, so the steering never has to jump.
 fn cc_fishtail(g: f64, p: &TurnParams) -> Vec<TurnPart> {
     use crate::geo::Pose;
     use crate::plan::maneuver::drive::split_at_cusps;

@@ -1,6 +1,6 @@
-//! The seed-004 manoeuvre planner (SPEC §4): endpoint checks, straight-line expansion to a
-//! rough route, a reversing pattern at the goal chosen from the side the route arrives from,
-//! and a hybrid-A* search with curve primitives and analytic connection for the rest.
+//! The seed-004 manoeuvre planner (docs/METHODS.md, Search): endpoint checks, straight-line
+//! expansion to a rough route, a reversing pattern at the goal chosen from the side the route
+//! arrives from, and a hybrid-A* search with curve primitives and analytic connection for the rest.
 //!
 //! Stages, in order (each later one only when the earlier ones found nothing):
 //! 1. **Endpoints.** The footprint at the start and at the goal must be clear; otherwise
