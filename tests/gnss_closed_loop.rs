@@ -368,7 +368,7 @@ fn run_job(path: GnssPath, extra: &[&str], cut: Option<Cut>, max_s: f64) -> Outc
         .build()
         .unwrap();
     let local = tokio::task::LocalSet::new();
-    let password = agsteer::config::ntrip_password(&cfg.gnss).unwrap();
+    let password = agsteer::job::startup::ntrip_password(&cfg.gnss).unwrap();
     let mut gnss = agsteer::daemon::gnss::spawn(&cfg, password, &local);
     let mut terminal = Packer::new(0x26);
     let mut out = Outcome::default();

@@ -360,41 +360,6 @@ impl GnssConfig {
     }
 }
 
-/// Errors reading the NTRIP password file.
-#[derive(Debug, thiserror::Error)]
-pub enum PasswordFileError {
-    #[error("gnss.ntrip_password_file = {path:?}: cannot read it: {source}")]
-    Read {
-        path: String,
-        source: std::io::Error,
-    },
-    #[error("gnss.ntrip_password_file = {path:?}: mode {mode:o} lets others read it; it must be readable only by the daemon's user (chmod 600)")]
-    Mode { path: String, mode: u32 },
-}
-
-/// The NTRIP password: `ntrip_password`, or the first line of `ntrip_password_file`, which
-/// must not be readable by group or others.
-pub fn ntrip_password(g: &GnssConfig) -> Result<String, PasswordFileError> {
-    if g.ntrip_password_file.is_empty() {
-        return Ok(g.ntrip_password.clone());
-    }
-    use std::os::unix::fs::PermissionsExt;
-    let path = g.ntrip_password_file.clone();
-    let meta = std::fs::metadata(&path).map_err(|source| PasswordFileError::Read {
-        path: path.clone(),
-        source,
-    })?;
-    let mode = meta.permissions().mode() & 0o777;
-    if mode & 0o077 != 0 {
-        return Err(PasswordFileError::Mode { path, mode });
-    }
-    let text = std::fs::read_to_string(&path).map_err(|source| PasswordFileError::Read {
-        path: path.clone(),
-        source,
-    })?;
-    Ok(text.lines().next().unwrap_or("").trim_end().to_string())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -477,25 +442,5 @@ mod tests {
         })
         .unwrap();
         assert!(!printed.contains("hunter2"), "{printed}");
-    }
-
-    #[test]
-    fn password_file_must_be_private() {
-        use std::os::unix::fs::PermissionsExt;
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("ntrip");
-        std::fs::write(&path, "s3cret\n").unwrap();
-        let g = GnssConfig {
-            ntrip_password_file: path.display().to_string(),
-            ..GnssConfig::default()
-        };
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o644)).unwrap();
-        let e = ntrip_password(&g).unwrap_err().to_string();
-        assert!(
-            e.contains("gnss.ntrip_password_file") && e.contains("644"),
-            "{e}"
-        );
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).unwrap();
-        assert_eq!(ntrip_password(&g).unwrap(), "s3cret");
     }
 }

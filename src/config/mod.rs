@@ -41,7 +41,7 @@ pub use bus::{BusConfig, OutputKind};
 pub use control::ControlConfig;
 pub use daemon::DaemonConfig;
 pub use field::{FieldConfig, FieldOrigin, SwathAngleChoice};
-pub use gnss::{ntrip_password, GnssConfig, GnssSource, PasswordFileError, TransportKind};
+pub use gnss::{GnssConfig, GnssSource, TransportKind};
 pub use guidance::GuidanceConfig;
 pub use isobus::IsobusConfig;
 pub use job::{JobConfig, JobKind, LineOrder, LineSide};

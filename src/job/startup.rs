@@ -6,13 +6,12 @@
 //! read and judged as the daemon's resume judges it ([`progress_outlook`]), without moving a
 //! corrupt file aside.
 //!
-//! Contract: blocking, done once before the loop; file access goes through [`crate::store`]
-//! (and the configuration's password-file reader).
+//! Contract: blocking, done once before the loop; file access goes through [`crate::store`].
 
 use super::resume::{peek_saved, summary, Saved};
 use super::{prepare, JobDetail, JobError, PreparedJob};
-use crate::config::{Config, ConfigError, PasswordFileError, Resolved};
-use crate::store::{progress_file, DirProblem};
+use crate::config::{Config, ConfigError, GnssConfig, Resolved};
+use crate::store::{progress_file, DirProblem, PrivateFileError};
 use std::path::PathBuf;
 
 /// What the daemon starts with.
@@ -43,6 +42,31 @@ pub enum StartupError {
     StateDir { path: PathBuf, problem: DirProblem },
     #[error("bus.status_socket: {problem}")]
     StatusSocket { path: PathBuf, problem: DirProblem },
+}
+
+/// Errors reading the NTRIP password file.
+#[derive(Debug, thiserror::Error)]
+pub enum PasswordFileError {
+    #[error("gnss.ntrip_password_file = {path:?}: cannot read it: {source}")]
+    Read {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("gnss.ntrip_password_file = {path:?}: mode {mode:o} lets others read it; it must be readable only by the daemon's user (chmod 600)")]
+    Mode { path: String, mode: u32 },
+}
+
+/// The NTRIP password: `gnss.ntrip_password`, or the first line of
+/// `gnss.ntrip_password_file`, which must not be readable by group or others.
+pub fn ntrip_password(g: &GnssConfig) -> Result<String, PasswordFileError> {
+    if g.ntrip_password_file.is_empty() {
+        return Ok(g.ntrip_password.clone());
+    }
+    let path = g.ntrip_password_file.clone();
+    crate::store::read_private_line(std::path::Path::new(&path)).map_err(|e| match e {
+        PrivateFileError::Read(source) => PasswordFileError::Read { path, source },
+        PrivateFileError::Mode(mode) => PasswordFileError::Mode { path, mode },
+    })
 }
 
 /// Load what the daemon starts with, as it starts with it; nothing is written.
@@ -89,7 +113,7 @@ pub fn load(cfg: &Config) -> Result<Startup, StartupError> {
         }
     }
     let ntrip_password = match cfg.gnss.stream() {
-        Some(_) => Some(crate::config::ntrip_password(&cfg.gnss)?),
+        Some(_) => Some(ntrip_password(&cfg.gnss)?),
         None => None,
     };
     Ok(Startup {
@@ -153,5 +177,44 @@ pub fn planned(job: &PreparedJob) -> Option<String> {
             mj.job.checksum()
         )),
         JobDetail::Lines => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn password_file_must_be_private() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("ntrip");
+        std::fs::write(&path, "s3cret\n").unwrap();
+        let g = GnssConfig {
+            ntrip_password_file: path.display().to_string(),
+            ..GnssConfig::default()
+        };
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o644)).unwrap();
+        let e = ntrip_password(&g).unwrap_err().to_string();
+        assert!(
+            e.contains("gnss.ntrip_password_file") && e.contains("644"),
+            "{e}"
+        );
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).unwrap();
+        assert_eq!(ntrip_password(&g).unwrap(), "s3cret");
+        let missing = GnssConfig {
+            ntrip_password_file: dir.path().join("none").display().to_string(),
+            ..GnssConfig::default()
+        };
+        let e = ntrip_password(&missing).unwrap_err().to_string();
+        assert!(
+            e.contains("gnss.ntrip_password_file") && e.contains("cannot read"),
+            "{e}"
+        );
+        let inline = GnssConfig {
+            ntrip_password: "hunter2".into(),
+            ..GnssConfig::default()
+        };
+        assert_eq!(ntrip_password(&inline).unwrap(), "hunter2");
     }
 }

@@ -1,6 +1,7 @@
 //! The files agsteer reads and writes besides its configuration: the progress file (atomic,
-//! checksummed; a corrupt one is moved aside) and the job's input files (a field, a manoeuvre
-//! map, a TASKDATA file), and whether the directories it writes into can be written.
+//! checksummed; a corrupt one is moved aside), the job's input files (a field, a manoeuvre
+//! map, a TASKDATA file), private files (the NTRIP password), and whether the directories it
+//! writes into can be written.
 //!
 //! Contract: file I/O only, blocking, done at start-up or on a writer thread, never in the
 //! control loop. What the bytes mean is decided elsewhere ([`crate::guidance::progress`]
@@ -16,6 +17,29 @@ use std::path::{Path, PathBuf};
 /// the input envelope (a directory, FIFO, device or over-size file is refused at once).
 pub fn read_input(path: &Path, kind: FileKind) -> Result<String, FileError> {
     crate::envelope::read_text(path, kind)
+}
+
+/// Why a private file (one only its owner may read) cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum PrivateFileError {
+    #[error("cannot read it: {0}")]
+    Read(#[source] std::io::Error),
+    /// Its permission bits (the low nine) let the group or others read or write it.
+    #[error("mode {0:o} lets others read it")]
+    Mode(u32),
+}
+
+/// The first line of a file that only its owner may read or write (a secret such as the
+/// NTRIP password), without its line end; "" for an empty file.
+pub fn read_private_line(path: &Path) -> Result<String, PrivateFileError> {
+    use std::os::unix::fs::PermissionsExt;
+    let meta = std::fs::metadata(path).map_err(PrivateFileError::Read)?;
+    let mode = meta.permissions().mode() & 0o777;
+    if mode & 0o077 != 0 {
+        return Err(PrivateFileError::Mode(mode));
+    }
+    let text = std::fs::read_to_string(path).map_err(PrivateFileError::Read)?;
+    Ok(text.lines().next().unwrap_or("").trim_end().to_string())
 }
 
 /// Why a directory agsteer writes into (the state directory, the status socket's) cannot
