@@ -1,11 +1,12 @@
 //! agsteer: automatic steering for tractors.
 //!
-//! Data flows one way through the control cycle:
-//! `can` (bus + DBC codec) → [`estimate`] (lat/lon → ENU, antenna offset, latency
-//! compensation) → [`guidance`] (job state machine, progress) → [`plan`] (global paths) →
-//! [`track`] (local B-spline, pure pursuit) → `safety` (engage gating, limits, timeouts) →
-//! `can`. [`control`] glues one cycle together; [`demo`] runs it closed-loop against the
-//! [`sim`]ulator.
+//! Data flows one way through the control cycle: `can` (bus + DBC codec) or `io` (a GNSS
+//! receiver's byte stream) → [`input`] (the seam: `Input` events) → [`control::node`] (source
+//! selection, lat/lon → ENU) → [`estimate`] (antenna offset, latency compensation) →
+//! [`guidance`] (job state machine, progress) → [`plan`] (global paths) → [`track`] (local
+//! B-spline, steering laws) → `safety` (engage gating, limits, timeouts) → `can`. [`control`]
+//! glues one cycle together; [`demo`] runs it closed-loop against the [`sim`]ulator. The design
+//! is written down in docs/ARCHITECTURE.md, Layers (and One control cycle, Where I/O lives).
 //!
 //! Planning modules are pure functions of their inputs (no I/O, clocks or globals). The
 //! configuration is read once and resolved into each consumer's parameters ([`config`]); the
