@@ -17,6 +17,7 @@
 //! change is reported in [`CleanupReport`].
 
 mod clean;
+pub mod findings;
 mod geojson;
 pub mod output;
 mod taskdata;

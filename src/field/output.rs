@@ -1,12 +1,14 @@
 //! Plan writers (pure, return strings): `plan.geojson` in WGS-84 and `plan.svg`; the plan
 //! summary of `metrics.json` and of the demo report.
 
+use super::findings::{violation_phrases, PlanFindings, PlanGround};
 use super::{CleanupReport, LoadedField};
 use crate::geo::svg::SvgCanvas;
 use crate::geo::wgs84::{EnuFrame, LatLon};
 use crate::geo::{Direction, Vec2};
 use crate::plan::coverage::metrics::PlanMetrics;
 use crate::plan::coverage::{Field, FieldPlan, SegmentKind};
+use geo::MultiPolygon;
 use serde::Serialize;
 use serde_json::{json, Value};
 use std::time::Duration;
@@ -42,6 +44,9 @@ pub struct PlanSummary {
     pub turn_points_outside: usize,
     pub plan_time_ms: f64,
     pub metrics_time_ms: f64,
+    /// Violations, unreachable ground and warnings.
+    #[serde(flatten)]
+    pub findings: PlanFindings,
 }
 
 impl PlanSummary {
@@ -49,6 +54,7 @@ impl PlanSummary {
         loaded: &LoadedField,
         plan: &FieldPlan,
         m: &PlanMetrics,
+        findings: &PlanFindings,
         plan_time: Duration,
         metrics_time: Duration,
     ) -> PlanSummary {
@@ -78,8 +84,45 @@ impl PlanSummary {
             turn_points_outside: m.turn_points_outside,
             plan_time_ms: plan_time.as_secs_f64() * 1e3,
             metrics_time_ms: metrics_time.as_secs_f64() * 1e3,
+            findings: findings.clone(),
         }
     }
+}
+
+/// Colour of unworked ground in the SVG.
+pub const UNWORKED: &str = "#e41a1c";
+/// Colour of the hatching of unreachable ground in the SVG, and of its background.
+pub const UNREACHABLE: &str = "#222222";
+const UNREACHABLE_BG: &str = "#fdd0a2";
+/// Characters per footer line of the SVG.
+const FOOTER_CHARS: usize = 150;
+
+/// The rings of a multipolygon (outer rings and holes), local metres.
+fn rings(mp: &MultiPolygon<f64>) -> Vec<Vec<Vec2>> {
+    mp.0.iter()
+        .flat_map(|p| std::iter::once(p.exterior()).chain(p.interiors()))
+        .map(|r| r.coords().map(|c| Vec2::new(c.x, c.y)).collect())
+        .collect()
+}
+
+/// `text` cut at spaces into lines of at most `width` characters (a longer word stays whole);
+/// the continuation lines indented.
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    for word in text.split(' ') {
+        if !line.is_empty() && line.chars().count() + 1 + word.chars().count() > width {
+            lines.push(std::mem::take(&mut line));
+            line.push_str("    ");
+        } else if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    if !line.trim().is_empty() {
+        lines.push(line);
+    }
+    lines
 }
 
 fn kind_name(k: SegmentKind) -> &'static str {
@@ -299,13 +342,40 @@ pub fn plan_svg(
     plan: &FieldPlan,
     origin: LatLon,
     metrics: Option<&PlanMetrics>,
+    checked: Option<(&PlanFindings, &PlanGround)>,
     title: &str,
 ) -> String {
     let extent = field
         .boundary
         .iter()
         .chain(plan.segments.iter().flat_map(|s| s.points.iter()));
-    let mut c = SvgCanvas::fit(extent, 1000.0);
+    // Footer lines below the figures: the violations and every warning, wrapped.
+    let notes: Vec<(String, &str)> = checked
+        .map(|(f, _)| {
+            let mut lines = vec![if f.violations.is_empty() {
+                ("violations: none".to_string(), "#000")
+            } else {
+                (
+                    format!(
+                        "VIOLATIONS {} (must not be driven): {}",
+                        f.violations.len(),
+                        violation_phrases(&f.violations).join("; ")
+                    ),
+                    "#b00",
+                )
+            }];
+            lines.extend(f.warnings.iter().map(|w| (format!("warning: {w}"), "#a50")));
+            lines
+                .iter()
+                .flat_map(|(l, colour)| wrap(l, FOOTER_CHARS).into_iter().map(|l| (l, *colour)))
+                .collect()
+        })
+        .unwrap_or_default();
+    let mut c = SvgCanvas::fit(extent, 1000.0).with_taller_footer(if notes.is_empty() {
+        0.0
+    } else {
+        16.0 * notes.len() as f64 + 20.0
+    });
     c.polygon(
         &field.boundary,
         r##"fill="#f3efe0" stroke="#333" stroke-width="1.5""##,
@@ -321,6 +391,23 @@ pub fn plan_svg(
     }
     for o in &field.obstacles {
         c.polygon(o, r##"fill="#8c6d46" stroke="#333" stroke-width="1""##);
+    }
+    if let Some((_, ground)) = checked {
+        // Unworked ground red (stroked too, so thin strips show at any scale); unreachable
+        // ground hatched over it.
+        c.area(
+            rings(&ground.unworked).iter(),
+            &format!(
+                r#"fill="{UNWORKED}" fill-opacity="0.6" stroke="{UNWORKED}" stroke-width="1""#
+            ),
+        );
+        c.raw(&format!(
+            r#"<defs><pattern id="unreachable" width="6" height="6" patternUnits="userSpaceOnUse" patternTransform="rotate(45)"><rect width="6" height="6" fill="{UNREACHABLE_BG}"/><line x1="0" y1="0" x2="0" y2="6" stroke="{UNREACHABLE}" stroke-width="2.5"/></pattern></defs>"#
+        ));
+        c.area(
+            rings(&ground.unreachable).iter(),
+            &format!(r#"fill="url(#unreachable)" stroke="{UNREACHABLE}" stroke-width="1""#),
+        );
     }
     let label_every = (plan.segments.len() / 150).max(1);
     for s in &plan.segments {
@@ -358,6 +445,20 @@ pub fn plan_svg(
             kind_name(*k),
         );
     }
+    if checked.is_some() {
+        c.footer_swatch(
+            10.0 + 110.0 * kinds.len() as f64,
+            20.0,
+            UNWORKED,
+            "unworked",
+        );
+        c.footer_swatch(
+            10.0 + 110.0 * (kinds.len() + 1) as f64,
+            20.0,
+            UNREACHABLE,
+            "unreachable (hatched)",
+        );
+    }
     c.footer_text(
         10.0,
         42.0,
@@ -367,11 +468,12 @@ pub fn plan_svg(
     );
     let figures = match metrics {
         Some(m) => format!(
-            "{} cells, {} swaths, field worked {:.2} % (working area {:.2} %), overlap {:.2} %, outside {:.3} m², total {:.0} m; origin {:.7}°, {:.7}°",
+            "{} cells, {} swaths, field worked {:.2} % (working area {:.2} %), unworked {:.0} m², overlap {:.2} %, outside {:.3} m², total {:.0} m; origin {:.7}°, {:.7}°",
             plan.cells,
             plan.swaths,
             100.0 * m.covered_fraction,
             100.0 * m.working_area_covered_fraction,
+            m.unworked_area_m2,
             100.0 * m.overlap_fraction,
             m.outside_area_m2,
             m.total_length_m,
@@ -384,6 +486,9 @@ pub fn plan_svg(
         ),
     };
     c.footer_text(10.0, 62.0, &figures, 12.0, "#000");
+    for (i, (line, colour)) in notes.iter().enumerate() {
+        c.footer_text(10.0, 80.0 + 16.0 * i as f64, line, 11.0, colour);
+    }
     c.scale_bar_and_north();
     c.finish(title)
 }
@@ -483,9 +588,49 @@ mod tests {
     }
 
     #[test]
+    fn svg_draws_unworked_ground_red_unreachable_hatched_and_names_each_finding() {
+        let (field, plan, origin) = sample();
+        let loaded = LoadedField {
+            name: None,
+            origin,
+            field: field.clone(),
+            cleanup: CleanupReport::default(),
+            guidance: vec![],
+            warnings: vec!["LSG 1 of type 7 (fence) skipped".into()],
+        };
+        let m = crate::plan::coverage::metrics::plan_metrics(&field, &plan, 6.0);
+        let (f, ground) = crate::field::findings::plan_findings(&loaded, &plan, &m, 6.0, 5.0, &[]);
+        let svg = plan_svg(&field, &plan, origin, Some(&m), Some((&f, &ground)), "t");
+        // The turn (95, 5) → (95, 15) is 2.7 m from the edge: no violation; one swath of a
+        // 6 m implement leaves most of the field unworked.
+        assert!(f.violations.is_empty(), "{:?}", f.violations);
+        let red = format!(r#"fill="{UNWORKED}" fill-opacity"#);
+        assert_eq!(svg.matches(&red).count(), 1, "one unworked area");
+        assert!(svg.contains(r#"fill="url(#unreachable)""#));
+        assert!(svg.contains("<pattern id=\"unreachable\""));
+        assert!(svg.contains(">unworked</text>") && svg.contains(">unreachable (hatched)</text>"));
+        assert!(svg.contains(">violations: none</text>"), "{svg}");
+        assert!(svg.contains("warning: LSG 1 of type 7 (fence) skipped"));
+        assert!(svg.contains("warning: field worked"));
+        assert!(svg.contains("cannot be reached turning at r_min 5 m"));
+        // Without findings, none of it.
+        let bare = plan_svg(&field, &plan, origin, Some(&m), None, "t");
+        assert!(!bare.contains(&red) && !bare.contains("unreachable"));
+    }
+
+    #[test]
+    fn long_footer_lines_are_wrapped_at_spaces() {
+        let text = "a ".repeat(100) + "end";
+        let lines = wrap(&text, 50);
+        assert!(lines.iter().all(|l| l.chars().count() <= 50), "{lines:?}");
+        assert_eq!(lines.concat().split_whitespace().count(), 101);
+        assert!(lines[1].starts_with("    "));
+    }
+
+    #[test]
     fn svg_has_every_kind_colour_and_labels() {
         let (field, plan, origin) = sample();
-        let svg = plan_svg(&field, &plan, origin, None, "t");
+        let svg = plan_svg(&field, &plan, origin, None, None, "t");
         assert!(svg.starts_with("<svg"));
         assert!(svg.contains(kind_colour(SegmentKind::Work)));
         assert!(svg.contains(kind_colour(SegmentKind::Turn)));

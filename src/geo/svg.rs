@@ -55,6 +55,47 @@ impl SvgCanvas {
         }
     }
 
+    /// The canvas with its footer `extra_px` taller (for more lines of text).
+    pub fn with_taller_footer(mut self, extra_px: f64) -> SvgCanvas {
+        let extra = extra_px.max(0.0);
+        self.footer += extra;
+        self.height += extra;
+        self
+    }
+
+    /// Raw SVG (for example `<defs>` with a fill pattern), added as is.
+    pub fn raw(&mut self, svg: &str) {
+        self.body.push_str(svg);
+        self.body.push('\n');
+    }
+
+    /// An area of several rings in metres (an outer ring and its holes, or several polygons),
+    /// filled by the even-odd rule so holes stay open.
+    pub fn area<'a, R>(&mut self, rings: impl IntoIterator<Item = R>, style: &str)
+    where
+        R: IntoIterator<Item = &'a Vec2>,
+    {
+        let mut d = String::new();
+        for ring in rings {
+            let mut first = true;
+            for p in ring {
+                let (x, y) = self.px(p);
+                let _ = write!(d, "{}{x:.1},{y:.1} ", if first { "M" } else { "L" });
+                first = false;
+            }
+            if !first {
+                d.push_str("Z ");
+            }
+        }
+        if !d.is_empty() {
+            let _ = writeln!(
+                self.body,
+                r#"<path fill-rule="evenodd" {style} d="{}"/>"#,
+                d.trim_end()
+            );
+        }
+    }
+
     /// Pixels per metre.
     pub fn scale(&self) -> f64 {
         self.scale

@@ -493,11 +493,23 @@ fn prepare_demo_job(
     let job = job?;
     let summary = match &job.detail {
         JobDetail::Field(fj) => {
-            let (metrics, metrics_time) = plan_cmd::timed("metrics", || fj.metrics());
+            let ((metrics, (findings, _)), metrics_time) = plan_cmd::timed("metrics", || {
+                let m = fj.metrics();
+                let f = agsteer::field::findings::plan_findings(
+                    &fj.loaded,
+                    &fj.plan,
+                    &m,
+                    fj.params.line_width,
+                    fj.params.r_min,
+                    &[],
+                );
+                (m, f)
+            });
             Some(PlanSummary::new(
                 &fj.loaded,
                 &fj.plan,
                 &metrics,
+                &findings,
                 fj.plan_time,
                 metrics_time,
             ))

@@ -4,12 +4,13 @@
 //! the independent metrics of each plan.
 
 use agsteer::config::Config;
+use agsteer::field::findings::{plan_findings, unreachable, MIN_PIECE_M2};
 use agsteer::field::output::{plan_geojson, plan_svg, plan_taskdata, PlanSummary};
 use agsteer::field::{
     decode_text, external_partfield_files, list_fields, load_field_with, GuidanceKind, LoadedField,
 };
 use agsteer::plan::coverage::metrics::checks::{check_plan, ViolationKind};
-use agsteer::plan::coverage::metrics::{area_and_pieces, plan_metrics, unreachable_ground};
+use agsteer::plan::coverage::metrics::{area_and_pieces, plan_metrics};
 use agsteer::plan::coverage::{headland, CoverageParams, Field, FieldPlan};
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -220,8 +221,10 @@ where
         eprintln!("error: {}: {reason}", field_path.display());
         return Ok(5);
     }
-    let (metrics, metrics_time) = timed("metrics", || {
-        plan_metrics(&loaded.field, &plan, params.line_width)
+    let ((metrics, (findings, ground)), metrics_time) = timed("metrics", || {
+        let m = plan_metrics(&loaded.field, &plan, params.line_width);
+        let f = plan_findings(&loaded, &plan, &m, params.line_width, params.r_min, &[]);
+        (m, f)
     });
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let title = loaded
@@ -242,25 +245,36 @@ where
     )?;
     write(
         "plan.svg",
-        plan_svg(&loaded.field, &plan, loaded.origin, Some(&metrics), &title),
+        plan_svg(
+            &loaded.field,
+            &plan,
+            loaded.origin,
+            Some(&metrics),
+            Some((&findings, &ground)),
+            &title,
+        ),
     )?;
-    let violations = check_plan(&loaded.field, &plan, params.line_width, params.r_min);
-    let s = PlanSummary::new(&loaded, &plan, &metrics, plan_time, metrics_time);
+    let s = PlanSummary::new(&loaded, &plan, &metrics, &findings, plan_time, metrics_time);
     let summary_json = serde_json::to_string_pretty(&s)?;
     write("metrics.json", format!("{summary_json}\n"))?;
     if json {
         println!("{summary_json}");
     } else {
         println!(
-            "{title}: {} cells, {} swaths, {} turns, {:.0} m total; field worked {:.2} % (working area {:.2} %); outside {:.3} m²; {:.0} ms",
+            "{title}: {} cells, {} swaths, {} turns, {:.0} m total; field worked {:.2} % (working area {:.2} %), unworked {:.0} m², unreachable {:.0} m² in {} place(s), overlap {:.2} %; outside {:.3} m²; {:.0} ms; {}",
             s.cells,
             s.swaths,
             s.turns,
             s.total_length_m,
             100.0 * s.covered_fraction,
             100.0 * s.working_area_covered_fraction,
+            s.unworked_area_m2,
+            findings.unreachable_area_m2,
+            findings.unreachable_pieces,
+            100.0 * s.overlap_fraction,
             s.outside_area_m2,
-            s.plan_time_ms
+            s.plan_time_ms,
+            findings.summary()
         );
         println!(
             "boundary clean-up: {} → {} vertices, area {:.1} → {:.1} m² (error {:.2} m², {:.4} %)",
@@ -276,13 +290,13 @@ where
             out.display()
         );
     }
-    if !violations.is_empty() {
-        for v in &violations {
+    if !findings.violations.is_empty() {
+        for v in &findings.violations {
             eprintln!("violation: {v}");
         }
         eprintln!(
             "error: the plan breaks its guarantees in {} places (listed above); it was written for inspection but must not be driven",
-            violations.len()
+            findings.violations.len()
         );
         return Ok(4);
     }
@@ -423,7 +437,7 @@ where
                     plan_time_ms,
                 };
                 let (unreachable_m2, unreachable_pieces) =
-                    area_and_pieces(&unreachable_ground(&loaded.field, w, r), 1.0);
+                    area_and_pieces(&unreachable(&loaded.field, w, r), MIN_PIECE_M2);
                 row.unreachable_m2 = unreachable_m2;
                 row.unreachable_pieces = unreachable_pieces;
                 match plan {
