@@ -237,6 +237,7 @@ impl Config {
         self.track.validate(&mut c);
         self.sim.validate(&mut c);
         self.sim.validate_plant(self.vehicle.wheelbase_m, &mut c);
+        self.sim.validate_command_timeout(self.control.dt_s, &mut c);
         self.bus.validate(&mut c);
         self.isobus.validate(&mut c);
         self.safety.validate(&mut c);

@@ -101,6 +101,8 @@ pub struct SimSetup {
     pub start_heading: f64,
     /// Simulated time limit, s (0 = from the job's length).
     pub max_time: f64,
+    /// The steering controller's command timeout, s (`None` = off).
+    pub command_timeout: Option<f64>,
 }
 
 /// The agsteerd process.
@@ -320,6 +322,8 @@ impl Config {
             start_offset: self.sim.start_offset_m,
             start_heading: self.sim.start_heading_deg.to_radians(),
             max_time: self.sim.max_time_s,
+            command_timeout: (self.sim.command_timeout_s > 0.0)
+                .then_some(self.sim.command_timeout_s),
         }
     }
 }

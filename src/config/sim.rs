@@ -83,6 +83,10 @@ pub struct SimConfig {
     pub speed_min_kmh: f64,
     pub speed_max_kmh: f64,
     pub speed_turn_angle_deg: f64,
+    /// The steering controller's command timeout, s: with no valid steering command for this
+    /// long it leaves automatic steering, and the simulated driver centres the wheels and
+    /// keeps straight (0 = off: the last command is held for ever, as no real ECU does).
+    pub command_timeout_s: f64,
     // The true vehicle where it differs from the controller's model (`[vehicle]`).
     /// True wheelbase − `vehicle.wheelbase_m`, m.
     pub wheelbase_error_m: f64,
@@ -151,6 +155,7 @@ impl Default for SimConfig {
             speed_min_kmh: 4.0,
             speed_max_kmh: 0.0,
             speed_turn_angle_deg: 5.0,
+            command_timeout_s: 0.25,
             wheelbase_error_m: 0.0,
             antenna_error_forward_m: 0.0,
             antenna_error_left_m: 0.0,
@@ -277,6 +282,7 @@ impl SimConfig {
         );
         c.range("sim.antenna_error_up_m", s.antenna_error_up_m, -2.0, 2.0);
         c.range("sim.was_gain", s.was_gain, 0.7, 1.3);
+        c.range("sim.command_timeout_s", s.command_timeout_s, 0.0, 10.0);
         c.range("sim.mass_kg", s.mass_kg, 300.0, 60_000.0);
         c.range(
             "sim.yaw_inertia_kg_m2",
@@ -317,6 +323,22 @@ impl SimConfig {
 
     /// Checks of `[sim]` against `[vehicle]`: the true wheelbase stays physical, the centre of
     /// gravity between the axles.
+    /// A command timeout (when on) must outlast two control periods: the steering controller
+    /// would otherwise drop out between two commands.
+    pub(crate) fn validate_command_timeout(&self, dt_s: f64, c: &mut Checker) {
+        let t = self.command_timeout_s;
+        if t > 0.0 && dt_s.is_finite() && t < 2.0 * dt_s {
+            c.push(
+                "sim.command_timeout_s",
+                super::check::fmt_num(t),
+                &format!(
+                    "must be 0 (off) or at least two control periods (control.dt_s = {})",
+                    super::check::fmt_num(dt_s)
+                ),
+            );
+        }
+    }
+
     pub(crate) fn validate_plant(&self, wheelbase_m: f64, c: &mut Checker) {
         let s = self;
         let true_wheelbase = wheelbase_m + s.wheelbase_error_m;
@@ -414,5 +436,28 @@ impl super::Config {
             max: s.speed_max_kmh / 3.6,
             turn_angle: s.speed_turn_angle_deg.to_radians(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::config::Config;
+
+    #[test]
+    fn command_timeout_outlasts_two_control_periods() {
+        let problems = |t: f64, dt: f64| {
+            let mut cfg = Config::default();
+            cfg.sim.command_timeout_s = t;
+            cfg.control.dt_s = dt;
+            cfg.validate()
+                .into_iter()
+                .filter(|p| p.key == "sim.command_timeout_s")
+                .count()
+        };
+        assert_eq!(problems(0.25, 0.02), 0);
+        assert_eq!(problems(0.0, 0.2), 0, "0 is off");
+        assert_eq!(problems(0.25, 0.2), 1, "shorter than two periods");
+        assert_eq!(problems(-1.0, 0.02), 1);
+        assert_eq!(problems(f64::NAN, 0.02), 1);
     }
 }

@@ -136,9 +136,9 @@ impl Controller {
         }
     }
 
-    /// On an engage request at time `t`: when the job has not finished a line yet and the
-    /// vehicle is too far from the first line to engage, plan an approach path to the line
-    /// start and drive it first. `None` when no approach is needed (or approaches are off);
+    /// On an engage request at time `t`: when the vehicle is too far from the path to engage
+    /// (at the job's start, or resumed after a restart or a manual drive), plan an approach
+    /// path to the start of the current line (in a turn: the next line) and drive it first. `None` when no approach is needed (or approaches are off);
     /// else the number of parts (1 + cusps) or why none could be planned. Runs the analytic
     /// connection and the field check only (well under a millisecond).
     pub fn plan_approach(
@@ -155,7 +155,7 @@ impl Controller {
         if xte.abs() < a.params.max_xte && heading_error.abs() < a.params.max_heading_error {
             return None;
         }
-        let to = self.path_start_pose()?;
+        let to = g.approach_target()?;
         let always = |_: &crate::plan::maneuver::path::CurvePath| true;
         let clear: &dyn Fn(&crate::plan::maneuver::path::CurvePath) -> bool = match &a.clear {
             Some(c) => c.as_ref(),

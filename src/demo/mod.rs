@@ -428,7 +428,8 @@ pub fn run(
         SimAddresses::default(),
         opts.scenario.clone(),
     )
-    .with_speed_profile(sim_setup.speed_profile);
+    .with_speed_profile(sim_setup.speed_profile)
+    .with_command_timeout(sim_setup.command_timeout);
     // With the ISO curvature output the tractor is a steer-ready one (ISO 11783-7 only).
     if cfg.bus.output == crate::config::OutputKind::Curvature {
         sim = sim.with_steer_ready();

@@ -494,10 +494,12 @@ impl Guidance {
         }
     }
 
-    /// Drive `segments` (an approach path from the vehicle to the start of the current line,
-    /// split at its cusps) before the line, which is then driven from its start. Only on a
-    /// work line before any line is done, and not while approaching; `false` when refused. An
-    /// empty list is accepted and changes nothing.
+    /// Drive `segments` (an approach path from the vehicle to [`Guidance::approach_target`],
+    /// split at its cusps) before the line, which is then driven from its start. Not once
+    /// finished nor while approaching; `false` when refused. An empty list is accepted and
+    /// changes nothing. In a turn of an AB job the approach replaces the rest of the turn
+    /// (a turn is no work); on a work line the line is driven again from its start (it is
+    /// not finished, so it counts once).
     pub fn set_approach(&mut self, segments: Vec<JobSegment>) -> bool {
         if !self.approach_allowed() {
             return false;
@@ -510,10 +512,29 @@ impl Guidance {
         true
     }
 
-    /// Whether [`Guidance::set_approach`] would accept an approach now: on a work line before
-    /// any line is done, not finished and not already approaching.
+    /// Whether [`Guidance::set_approach`] would accept an approach now: not finished and not
+    /// already approaching. At the job's start, and when the job is resumed (after a restart,
+    /// a pause or a manual drive) away from where it stopped: the approach re-acquires the
+    /// line (issue 16 point 8).
     pub fn approach_allowed(&self) -> bool {
-        self.approach_index.is_none() && self.phase == Phase::Work && self.lines_done == 0
+        self.approach_index.is_none() && self.phase != Phase::Finished && self.path.len() >= 2
+    }
+
+    /// Where an approach path leads: the start of the current work line — in a turn of an AB
+    /// job, of the line the turn leads to — or of the current segment of a segment job.
+    /// Allocates (once per engage request, never per cycle).
+    pub fn approach_target(&self) -> Option<Pose> {
+        let mut line = Vec::new();
+        let points: &[PathPoint] = match (&self.plan, self.phase) {
+            (JobPlan::Ab(plan), Phase::Turn) => {
+                plan.work_line_points(self.index_block, self.index_rank, &mut line);
+                &line
+            }
+            _ => &self.path,
+        };
+        let (a, b) = (points.first()?.pos, points.get(1)?.pos);
+        let d = b - a;
+        Some(Pose::new(a.x, a.y, d.y.atan2(d.x)))
     }
 
     /// Whether an approach path is being driven.

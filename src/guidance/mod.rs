@@ -12,6 +12,8 @@
 
 pub mod machine;
 pub mod progress;
+#[cfg(test)]
+mod tests_approach;
 
 pub use crate::plan::job::JobPlan;
 pub use machine::{Event, Guidance, GuidanceError, GuidanceParams};

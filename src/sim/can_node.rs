@@ -4,7 +4,11 @@
 //! RTK fixed or float) at the GNSS rate with its latency, the wheel angle at its rate with
 //! counter and CRC, and the wheel-based speed. It receives steering commands and checks their
 //! CRC and counter as a real actuator would, ignoring bad ones; while not engaged (or without
-//! valid commands) the "driver" holds the wheels where they are. A scenario scripts faults.
+//! valid commands) the "driver" holds the wheels where they are. With a command timeout
+//! ([`SimNode::with_command_timeout`], `sim.command_timeout_s`) the steering controller leaves
+//! automatic steering when valid commands stop for that long, as a real steering ECU does
+//! (ISO 11783-7's remote command timeout), and the driver centres the wheels and keeps
+//! straight instead of the tractor circling on the last command. A scenario scripts faults.
 //! With an IMU configured it sends the roll and pitch (0xFF30) at the IMU rate with counter
 //! and CRC; during the simulator's RTK-float windows 129029 reports method 5 (RTK float).
 
@@ -135,6 +139,12 @@ pub struct SimNode {
     gnss_out: Vec<GnssMeasurement>,
     /// The steer-ready tractor ([`SimNode::with_steer_ready`]).
     steer_ready: Option<SteerReadyEcu>,
+    /// Valid commands older than this end automatic steering, s (`None`: never).
+    command_timeout: Option<f64>,
+    /// Time of the last valid steering command, s.
+    last_command_t: f64,
+    /// Times automatic steering ended on the command timeout.
+    timeouts: u64,
 }
 
 impl SimNode {
@@ -162,17 +172,33 @@ impl SimNode {
             gnss_off_bus: false,
             gnss_out: Vec::new(),
             steer_ready: None,
+            command_timeout: None,
+            last_command_t: 0.0,
+            timeouts: 0,
         }
+    }
+
+    /// The steering controller leaves automatic steering when valid commands stop for
+    /// `timeout` s, and the driver centres the wheels (`None`: the last command is held). Set
+    /// it before [`SimNode::with_steer_ready`] for the steer-ready ECU to use it too.
+    pub fn with_command_timeout(mut self, timeout: Option<f64>) -> Self {
+        self.command_timeout = timeout.filter(|t| *t > 0.0 && t.is_finite());
+        self
+    }
+
+    /// Times automatic steering ended because the commands stopped.
+    pub fn command_timeouts(&self) -> u64 {
+        self.timeouts
     }
 
     /// A steer-ready tractor: its steering ECU (at the tractor's address) speaks ISO 11783-7
     /// only — Guidance System Command in, Guidance Machine Info out, no wheel-angle frame
     /// (see [`steer_ready`](super::steer_ready)).
     pub fn with_steer_ready(mut self) -> Self {
-        self.steer_ready = Some(SteerReadyEcu::new(
-            self.tractor.source(),
-            self.sim.params().wheelbase,
-        ));
+        self.steer_ready = Some(
+            SteerReadyEcu::new(self.tractor.source(), self.sim.params().wheelbase)
+                .with_command_timeout(self.command_timeout),
+        );
         self
     }
 
@@ -190,6 +216,11 @@ impl SimNode {
             Some(Steer::Hold) => {
                 self.engaged = false;
                 self.sim.hold_wheels();
+            }
+            Some(Steer::Centre) => {
+                self.engaged = false;
+                self.timeouts += 1;
+                self.sim.centre_wheels();
             }
             None => {}
         }
@@ -267,6 +298,7 @@ impl SimNode {
             self.rejected += 1;
             return;
         }
+        self.last_command_t = tf.t;
         // An engaged command without an angle is no command: the driver holds the wheels.
         let angle = cmd
             .angle
@@ -282,6 +314,15 @@ impl SimNode {
 
     /// Advance to `t`, appending (send time, frame) pairs in time order.
     pub fn advance_to(&mut self, t: f64, out: &mut Vec<(f64, Frame)>) {
+        if let Some(timeout) = self.command_timeout.filter(|_| self.steer_ready.is_none()) {
+            if self.engaged && t - self.last_command_t > timeout {
+                // The steering controller leaves automatic steering; the driver takes the
+                // wheel and keeps straight.
+                self.engaged = false;
+                self.timeouts += 1;
+                self.sim.centre_wheels();
+            }
+        }
         let before = self.sim.true_state().pose.pos;
         let float = self.scenario.active(FaultKind::RtkFloat, t);
         self.sim.set_fix(if float {
@@ -566,5 +607,49 @@ mod tests {
         let mut n = node(Disturbances::default());
         n.advance_to(10.0, &mut frames);
         assert_eq!(n.sim().true_state().speed, 3.0);
+    }
+
+    /// Without commands for `sim.command_timeout_s` the steering controller leaves automatic
+    /// steering and the driver centres the wheels; without a timeout the last command is held
+    /// (the tractor circles).
+    #[test]
+    fn command_timeout_centres_the_wheels() {
+        for timeout in [Some(0.25), None] {
+            let mut n = node(Disturbances::default()).with_command_timeout(timeout);
+            let mut daemon = Packer::new(0x1E);
+            let mut frames = Vec::new();
+            // Engaged at 20° left, a command every 10 ms for 2 s, then none.
+            let mut t = 0.0;
+            while t < 2.0 {
+                let f = daemon
+                    .pack(&SteeringCommand {
+                        angle: Some(20.0),
+                        mode: Some(SteeringCommandMode::Engaged),
+                    })
+                    .unwrap();
+                n.on_frame(&TimedFrame { t, frame: f });
+                t += 0.01;
+                n.advance_to(t, &mut frames);
+            }
+            assert!(n.engaged());
+            let steered = n.sim().true_state().wheel_angle;
+            assert!((steered - 20f64.to_radians()).abs() < 0.01, "{steered}");
+            n.advance_to(2.2, &mut frames);
+            assert!(n.engaged(), "{timeout:?}: still within the timeout");
+            n.advance_to(5.0, &mut frames);
+            let wheel = n.sim().true_state().wheel_angle;
+            match timeout {
+                Some(_) => {
+                    assert!(!n.engaged());
+                    assert_eq!(n.command_timeouts(), 1);
+                    assert!(wheel.abs() < 1e-6, "centred: {wheel}");
+                }
+                None => {
+                    assert!(n.engaged());
+                    assert_eq!(n.command_timeouts(), 0);
+                    assert!((wheel - 20f64.to_radians()).abs() < 1e-3, "held: {wheel}");
+                }
+            }
+        }
     }
 }

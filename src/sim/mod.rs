@@ -205,6 +205,12 @@ impl Simulator {
         self.actuator.hold(&self.p);
     }
 
+    /// The driver centres the wheels and keeps straight: the actuator goes, at its rate, to
+    /// where the sensor reads a true angle of zero.
+    pub fn centre_wheels(&mut self) {
+        self.actuator.set_command(self.p.dist.was_bias);
+    }
+
     /// Set the speed (m/s, negative reverses).
     pub fn set_speed(&mut self, speed: f64) {
         if speed.is_finite() {

@@ -24,7 +24,7 @@ use crate::can::Frame;
 
 /// ISO 11783-7's guidance message period, s.
 const INFO_PERIOD: f64 = 0.1;
-/// Commands older than this end automatic steering, s.
+/// Commands older than this end automatic steering, s (the default of `sim.command_timeout_s`).
 const COMMAND_TIMEOUT: f64 = 0.25;
 /// ISO 11783-7 exit reason codes (AgIsoStack++'s `GuidanceSystemCommandExitReasonCode`).
 const EXIT_OPERATOR_OVERRIDE: u8 = 3;
@@ -52,6 +52,8 @@ pub enum Steer {
     To(f64),
     /// Leave the wheels to the driver.
     Hold,
+    /// The commands stopped: the driver takes the wheel, centres it and keeps straight.
+    Centre,
 }
 
 /// The steer-ready tractor's steering ECU.
@@ -69,6 +71,8 @@ pub struct SteerReadyEcu {
     measured: f64,
     /// Commands refused (not ready, locked out or a reset pending).
     refused: u64,
+    /// Commands older than this end automatic steering, s (infinite: never).
+    command_timeout: f64,
 }
 
 impl SteerReadyEcu {
@@ -89,7 +93,14 @@ impl SteerReadyEcu {
             next_info: 0.0,
             measured: 0.0,
             refused: 0,
+            command_timeout: COMMAND_TIMEOUT,
         }
+    }
+
+    /// End automatic steering when commands stop for `timeout` s (`None`: never).
+    pub fn with_command_timeout(mut self, timeout: Option<f64>) -> Self {
+        self.command_timeout = timeout.unwrap_or(f64::INFINITY);
+        self
     }
 
     /// Steering by the guidance system's commands.
@@ -176,12 +187,20 @@ impl SteerReadyEcu {
         if lockout {
             self.engaged = false;
         }
-        if self.last_command.is_none_or(|l| t - l > COMMAND_TIMEOUT) {
+        let timed_out = self
+            .last_command
+            .is_none_or(|l| t - l > self.command_timeout);
+        if timed_out {
             self.leave(EXIT_REMOTE_COMMAND_TIMEOUT);
         }
+        let ended = if timed_out {
+            Steer::Centre
+        } else {
+            Steer::Hold
+        };
         let Some(address) = self.claimer.address(t) else {
             self.engaged = false;
-            return (was && !self.engaged).then_some(Steer::Hold);
+            return (was && !self.engaged).then_some(ended);
         };
         self.packer.set_source(address);
         if t + 1e-9 >= self.next_info {
@@ -215,6 +234,6 @@ impl SteerReadyEcu {
                 out.push((t, f));
             }
         }
-        (was && !self.engaged).then_some(Steer::Hold)
+        (was && !self.engaged).then_some(ended)
     }
 }

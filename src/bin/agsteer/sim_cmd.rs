@@ -63,7 +63,8 @@ pub fn run(
         SimAddresses::default(),
         scenario,
     )
-    .with_speed_profile(setup.speed_profile);
+    .with_speed_profile(setup.speed_profile)
+    .with_command_timeout(setup.command_timeout);
     // With the ISO curvature output the tractor is a steer-ready one (ISO 11783-7 only).
     if cfg.bus.output == agsteer::config::OutputKind::Curvature {
         node = node.with_steer_ready();

@@ -1,0 +1,181 @@
+//! kill -9 of the daemon under way, restarted each time (issue 16 point 8).
+
+use super::support::*;
+use std::time::{Duration, Instant};
+
+/// kill -9 at random moments of a job (including during progress writes), restarting
+/// each time: the daemon never auto-engages, no finished line is driven twice, none is
+/// skipped, and the job finishes. Lines driven are counted from the simulator's true
+/// trajectory (crossings of each line's middle), not from the daemon's own bookkeeping.
+///
+/// As on a real tractor (issue 16 point 8): when the commands stop, the simulated steering
+/// controller leaves automatic steering after `sim.command_timeout_s` (250 ms) and the driver
+/// centres the wheels; the operator stops the tractor. After the restart the operator drives
+/// on and engages; where the tractor is out of the engage gate (a kill in a turn leaves it
+/// heading off the turn) the daemon re-acquires the line with an approach path, at the default
+/// engage gate. Also prints the restart time, exec → first command frame on the bus.
+#[test]
+fn i_kill_9_resume() {
+    kill_9_resume(2, 4);
+}
+
+/// The full run (issue 16 point 8): 20 kills on a 7-line job, about 2 minutes on an idle host
+/// (longer loaded), so not in the suite's default run:
+/// `tools/vcan-vm -- i_kill_9_resume_20 --ignored`.
+#[test]
+#[ignore = "2 minutes or more; the suite runs i_kill_9_resume (4 kills)"]
+fn i_kill_9_resume_20() {
+    kill_9_resume(7, 20);
+}
+
+/// `kills` kill -9s at random moments of a job of `lines` lines.
+fn kill_9_resume(lines: u64, kill_count: u32) {
+    let Some(iface) = vcan() else { return };
+    let set = format!("job.line_num={lines}");
+    let _ = std::fs::remove_dir_all("/tmp/agsteer");
+    let start = || {
+        let p = Proc::spawn_logging("agsteerd", &["--config", CONFIG, "--set", &set], true);
+        let end = Instant::now() + Duration::from_secs(10);
+        while Instant::now() < end && status().is_none() {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        p
+    };
+    let probe = StallProbe::start();
+    let dump = Candump::start(&iface);
+    let mut daemon = start();
+    let traj = "/tmp/agsteer-kill9.csv";
+    let _sim = start_sim(&iface, &["--set", &set, "--trajectory", traj]);
+    let mut term = Terminal::new(&iface);
+    assert!(term.engage(Duration::from_secs(10)));
+    let mut x: u64 = 0x9E37_79B9;
+    let mut kills = 0;
+    // Wall-clock times (as candump stamps frames) of each restart's exec.
+    let mut execs: Vec<f64> = Vec::new();
+    let t0 = Instant::now();
+    while kills < kill_count && t0.elapsed() < Duration::from_secs(240) {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        std::thread::sleep(Duration::from_millis(200 + x % 1000));
+        if status().is_some_and(|s| s["finished"] == true) {
+            break;
+        }
+        daemon.signal(libc::SIGKILL);
+        // The steering controller drops out 250 ms later and the driver keeps straight; the
+        // operator notices and stops the tractor.
+        term.direction(0);
+        let _ = daemon.wait_for(Duration::from_secs(2));
+        kills += 1;
+        execs.push(wall_s());
+        daemon = start();
+        let st = status().expect("restarted daemon answers");
+        assert_eq!(st["engaged"], false, "never auto-engages after a restart");
+        // The daemon answers: the operator drives on and engages (ready needs the minimum
+        // speed).
+        term.direction(1);
+        if !term.engage(Duration::from_secs(10)) {
+            let log = std::fs::read_to_string("/tmp/agsteerd.log").unwrap_or_default();
+            let tail: Vec<&str> = log.lines().rev().take(15).collect();
+            panic!(
+                "not re-engaged after kill {kills}: status {:?}\nlog tail: {tail:#?}",
+                status()
+            );
+        }
+    }
+    // The operator re-engages whenever something disengaged the system (a frozen guest can
+    // make inputs stale) until the job is done, as in the closed-loop job test.
+    let mut reengaged = 0;
+    let end = Instant::now() + Duration::from_secs(180);
+    let mut finished = false;
+    while Instant::now() < end {
+        match status() {
+            Some(s) if s["finished"] == true => {
+                finished = true;
+                break;
+            }
+            Some(s) if s["state"] == "ready" && s["engaged"] == false => {
+                reengaged += 1;
+                term.send(1);
+            }
+            _ => {}
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    let cap = parse_candump(&dump.stop());
+    let stalls = probe.stop();
+    let cmds = steering_frames(&cap);
+    // Restart time: exec of the new daemon → its first command frame on the bus.
+    let mut restart: Vec<f64> = Vec::new();
+    let mut restart_net: Vec<f64> = Vec::new();
+    for &e in &execs {
+        if let Some(&(t, _)) = cmds.iter().find(|(t, _)| *t >= e) {
+            restart.push(t - e);
+            restart_net.push(gap_less_stalls(e, t, &stalls));
+        }
+    }
+    restart.sort_by(|a, b| a.total_cmp(b));
+    restart_net.sort_by(|a, b| a.total_cmp(b));
+    println!(
+        "VCAN-KILL9-RESTART exec_to_first_command: median_ms={:.1} max_ms={:.1} less_stalls: median_ms={:.1} max_ms={:.1} over {} restarts; guest frozen {:.0} ms in all",
+        pct(&restart, 0.5) * 1e3,
+        restart.last().copied().unwrap_or(f64::NAN) * 1e3,
+        pct(&restart_net, 0.5) * 1e3,
+        restart_net.last().copied().unwrap_or(f64::NAN) * 1e3,
+        restart.len(),
+        stalls.iter().map(|s| s.to_s - s.from_s).sum::<f64>() * 1e3
+    );
+    let crossings = line_crossings(traj, &set);
+    println!("VCAN-KILL9 kills={kills} finished={finished} reengaged_after={reengaged} crossings_per_line={crossings:?}");
+    assert!(
+        kills >= kill_count,
+        "only {kills} kills before the job ended"
+    );
+    assert!(finished, "job finishes");
+    assert_eq!(
+        crossings,
+        vec![1; lines as usize],
+        "every line driven exactly once"
+    );
+}
+
+/// How often the vehicle crossed the middle of each work line (attributed to the nearest line
+/// within half a line width).
+fn line_crossings(path: &str, set: &str) -> Vec<u32> {
+    use agsteer::config::Config;
+    use agsteer::plan::abline::AbPlan;
+    let cfg = Config::load(std::path::Path::new(CONFIG), &[set.to_string()]).unwrap();
+    let plan = AbPlan::new(cfg.ab_params()).unwrap();
+    let (a, b) = plan.line_endpoints(0, false);
+    let dir = (b - a).normalize();
+    let half = plan.line_length() / 2.0;
+    let mut counts = vec![0u32; cfg.job.line_num as usize];
+    let mut prev: Option<f64> = None;
+    let text = std::fs::read_to_string(path).unwrap();
+    for l in text.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').filter_map(|x| x.parse().ok()).collect();
+        if v.len() < 3 {
+            continue;
+        }
+        let p = agsteer::geo::v2(v[1], v[2]);
+        let along = (p - a).dot(&dir) - half;
+        if let Some(pa) = prev {
+            if pa.signum() != along.signum() {
+                // The crossing belongs to the nearest line, if within half a line width.
+                let nearest = (0..counts.len())
+                    .map(|k| {
+                        let s = plan.line_endpoints(k as u64, false).0;
+                        (k, agsteer::geo::signed_offset(&p, &s, &dir).abs())
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1));
+                if let Some((k, d)) = nearest {
+                    if d < cfg.job.line_width_m / 2.0 {
+                        counts[k] += 1;
+                    }
+                }
+            }
+        }
+        prev = Some(along);
+    }
+    counts
+}
