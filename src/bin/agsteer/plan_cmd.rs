@@ -528,3 +528,53 @@ where
     println!("wrote {}", path.display());
     Ok(0)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use agsteer::plan::coverage::{plan_field, PlanSegment, SegmentKind};
+
+    /// Never exit 0 with a violation: a plan with a transit out of the field is written for
+    /// inspection, named in metrics.json, and exits 4; the same plan without it exits 0.
+    #[test]
+    fn a_plan_breaking_a_guarantee_is_written_and_exits_4() {
+        let dir = tempfile::tempdir().unwrap();
+        let field = dir.path().join("f.geojson");
+        std::fs::write(
+            &field,
+            r#"{"type":"Polygon","coordinates":[[[5.0,52.0],[5.003,52.0],[5.003,52.001],[5.0,52.001],[5.0,52.0]]]}"#,
+        )
+        .unwrap();
+        let mut cfg = Config::default();
+        cfg.job.line_width_m = 12.0;
+        let out = dir.path().join("out");
+        let options = PlanOptions::default();
+        let stray = |f: &Field, p: &CoverageParams| {
+            let mut plan = plan_field(f, p)?;
+            let last = plan.segments.last().cloned().unwrap();
+            let end = *last.points.last().unwrap();
+            plan.segments.push(PlanSegment {
+                kind: SegmentKind::Transit,
+                index: last.index + 1,
+                points: (0..=300)
+                    .map(|k| end + agsteer::geo::v2(k as f64, 0.0))
+                    .collect(),
+                ..last
+            });
+            Ok::<_, agsteer::plan::types::PlanError>(plan)
+        };
+        assert_eq!(run(&field, &cfg, &out, false, &options, stray).unwrap(), 4);
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap())
+                .unwrap();
+        assert!(m["violation_counts"]["outside_boundary"].as_u64().unwrap() >= 1);
+        assert_eq!(m["violations"][0]["kind"], "outside_boundary", "{m}");
+        assert!(std::fs::read_to_string(out.join("plan.svg"))
+            .unwrap()
+            .contains("VIOLATIONS"));
+        assert_eq!(
+            run(&field, &cfg, &out, false, &options, plan_field).unwrap(),
+            0
+        );
+    }
+}
