@@ -21,6 +21,7 @@ pub mod daemon;
 pub mod demo;
 pub mod envelope;
 pub mod estimate;
+pub mod exit;
 pub mod field;
 pub mod geo;
 pub mod guidance;

@@ -186,4 +186,16 @@ fn a_logged_run_replays_to_the_same_commands() {
         other["summary"]["differing"].as_u64().unwrap() > 0,
         "{other}"
     );
+    // --strict says so in its exit status (src/exit.rs: 9).
+    let strict = Command::new(env!("CARGO_BIN_EXE_agsteer"))
+        .arg("replay")
+        .args(&files)
+        .args(["--config", CONFIG, "--json", "--strict"])
+        .args(["--set", "track.ld_min_m=5.5"])
+        .output()
+        .unwrap();
+    assert_eq!(
+        strict.status.code(),
+        Some(i32::from(agsteer::exit::Exit::ReplayDiffers.code()))
+    );
 }

@@ -8,7 +8,7 @@
 //!
 //! One file per section (`job.rs`, `guidance.rs`, `vehicle.rs`, `control.rs`, `track.rs`,
 //! `sim.rs`, `bus.rs`, `isobus.rs`, `safety.rs`, `daemon.rs`, `progress.rs`, `field.rs`, `maneuver.rs`,
-//! `gnss.rs`), each
+//! `gnss.rs`, `sources.rs`, `acceptance.rs`), each
 //! holding the section's struct, its defaults and its validation; [`check`] holds the
 //! range-check helpers. This module holds the whole [`Config`], loading, `--set` overrides and
 //! the errors. It does no I/O but reading the file named to [`Config::load`].
@@ -17,6 +17,7 @@
 //! its `Default`, a check to the section's `validate` (every float finite and in range, the
 //! message naming the key), and document it in `config/demo.toml`.
 
+mod acceptance;
 mod bus;
 pub(crate) mod check;
 mod control;
@@ -37,6 +38,7 @@ mod sources;
 mod track;
 mod vehicle;
 
+pub use acceptance::{AcceptanceConfig, AccuracyMiss};
 pub use bus::{BusConfig, OutputKind};
 pub use control::ControlConfig;
 pub use daemon::DaemonConfig;
@@ -108,6 +110,7 @@ pub struct Config {
     pub maneuver: ManeuverConfig,
     pub gnss: GnssConfig,
     pub sources: SourcesConfig,
+    pub acceptance: AcceptanceConfig,
 }
 
 /// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
@@ -197,6 +200,54 @@ fn suggest_nearest(msg: String) -> String {
     }
 }
 
+/// The range of each integer type a key can have, as a technician reads it.
+const INTEGER_RANGES: [(&str, &str); 10] = [
+    ("u8", "0..=255"),
+    ("u16", "0..=65535"),
+    ("u32", "0..=4294967295"),
+    ("u64", "0..=18446744073709551615"),
+    ("usize", "0..=18446744073709551615"),
+    ("i8", "-128..=127"),
+    ("i16", "-32768..=32767"),
+    ("i32", "-2147483648..=2147483647"),
+    ("i64", "-9223372036854775808..=9223372036854775807"),
+    ("isize", "-9223372036854775808..=9223372036854775807"),
+];
+
+/// serde's message for an integer that does not fit its key's type ("invalid value: integer
+/// `4294967297`, expected u32 in `gnss.baud`"; a number beyond TOML's 64 bits arrives from
+/// `--set` as a string) becomes `key = value: must be an integer in lo..=hi`. The section's
+/// own range check, which may be narrower, runs once the value fits.
+fn integer_range(msg: String) -> String {
+    let between = |text: &str, open: &str, close: char| -> Option<String> {
+        let start = text.find(open)? + open.len();
+        let len = text[start..].find(close)?;
+        Some(text[start..start + len].to_string())
+    };
+    let value = between(&msg, "integer `", '`').or_else(|| {
+        between(&msg, "string \"", '"').filter(|v| {
+            !v.is_empty()
+                && v.trim_start_matches('-')
+                    .bytes()
+                    .all(|b| b.is_ascii_digit())
+        })
+    });
+    let range = between(&msg, "expected ", '\n')
+        .or_else(|| msg.split("expected ").nth(1).map(|t| t.trim().to_string()))
+        .and_then(|ty| {
+            INTEGER_RANGES
+                .iter()
+                .find(|(name, _)| ty.trim() == *name)
+                .map(|(_, r)| *r)
+        });
+    match (between(&msg, "in `", '`'), value, range) {
+        (Some(key), Some(value), Some(range)) => {
+            format!("{key} = {value}: must be an integer in {range}")
+        }
+        _ => msg,
+    }
+}
+
 impl Config {
     /// Parse TOML text with overrides, without validating.
     pub fn parse_with(text: &str, overrides: &[String]) -> Result<Config, ConfigError> {
@@ -204,7 +255,8 @@ impl Config {
             .parse()
             .map_err(|e: toml::de::Error| ConfigError::Parse(e.to_string()))?;
         apply_overrides(&mut root, overrides)?;
-        Config::deserialize(root).map_err(|e| ConfigError::Parse(suggest_nearest(e.to_string())))
+        Config::deserialize(root)
+            .map_err(|e| ConfigError::Parse(integer_range(suggest_nearest(e.to_string()))))
     }
 
     /// Read, override and validate a configuration file.
@@ -247,6 +299,7 @@ impl Config {
         self.progress.validate(&mut c);
         self.gnss.validate(&mut c);
         self.sources.validate(&mut c);
+        self.acceptance.validate(&mut c);
         envelope::validate(self, &mut c);
         c.problems
     }

@@ -217,3 +217,101 @@ fn r_min_must_be_steerable() {
     let cfg = Config::parse_with("[vehicle]\nr_min_m = 1.0\n", &[]).unwrap();
     assert!(cfg.validate().iter().any(|p| p.key == "vehicle.r_min_m"));
 }
+
+/// Every integer key of the configuration (from the default's TOML tree, not a list kept by
+/// hand): (`--set` path, index within an array).
+fn integer_keys() -> Vec<(String, Option<usize>)> {
+    fn collect(key: &str, v: &toml::Value, keys: &mut Vec<(String, Option<usize>)>) {
+        match v {
+            toml::Value::Integer(_) => keys.push((key.to_string(), None)),
+            toml::Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    if x.is_integer() {
+                        keys.push((key.to_string(), Some(i)));
+                    }
+                }
+            }
+            toml::Value::Table(t) => {
+                for (k, x) in t {
+                    collect(&format!("{key}.{k}"), x, keys);
+                }
+            }
+            _ => {}
+        }
+    }
+    let tree = toml::Table::try_from(Config::default()).unwrap();
+    let mut keys = Vec::new();
+    for (s, v) in &tree {
+        collect(s, v, &mut keys);
+    }
+    keys
+}
+
+fn value_at<'a>(tree: &'a toml::Table, key: &str) -> &'a toml::Value {
+    let mut parts = key.split('.');
+    let mut node = tree.get(parts.next().unwrap()).unwrap();
+    for p in parts {
+        node = node.get(p).unwrap();
+    }
+    node
+}
+
+#[test]
+fn every_integer_key_refuses_what_does_not_fit_and_never_wraps() {
+    let keys = integer_keys();
+    assert!(keys.len() >= 30, "{keys:?}");
+    let tree = toml::Table::try_from(Config::default()).unwrap();
+    for (key, index) in &keys {
+        for v in [
+            "4294967297",
+            "-1",
+            "256",
+            "65537",
+            "9223372036854775807",
+            "18446744073709551617",
+        ] {
+            // The value at `key` (at `index` of an array, the rest as the default has it).
+            let set = match index {
+                None => format!("{key}={v}"),
+                Some(i) => {
+                    let mut arr: Vec<String> = value_at(&tree, key)
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .map(|x| x.to_string())
+                        .collect();
+                    arr[*i] = v.to_string();
+                    format!("{key}=[{}]", arr.join(", "))
+                }
+            };
+            match Config::parse_with("", std::slice::from_ref(&set)) {
+                // Beyond TOML's 64 bits inside an array, the whole `--set` value is a
+                // string: the message then names the key and quotes the value.
+                Err(ConfigError::Parse(msg)) => assert!(
+                    msg.starts_with(&format!("{key} = {v}: must be an integer in "))
+                        || (index.is_some() && msg.contains(key.as_str()) && msg.contains(v)),
+                    "{set}: {msg}"
+                ),
+                Err(e) => panic!("{set}: {e}"),
+                Ok(cfg) => {
+                    // Accepted by the type: either a range check names the key, or the value is
+                    // kept exactly as given (never wrapped or truncated).
+                    if cfg
+                        .validate()
+                        .iter()
+                        .any(|p| p.key.starts_with(key.as_str()))
+                    {
+                        continue;
+                    }
+                    let back = toml::Table::try_from(&cfg).unwrap();
+                    let node = value_at(&back, key);
+                    let got = match index {
+                        None => node.to_string(),
+                        Some(i) => node.as_array().unwrap()[*i].to_string(),
+                    };
+                    assert_eq!(got, v, "{set} was taken as {got}");
+                }
+            }
+        }
+    }
+}

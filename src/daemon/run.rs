@@ -54,6 +54,10 @@ pub enum DaemonError {
     Runtime(std::io::Error),
     #[error(transparent)]
     BusLog(#[from] BusLogError),
+    /// The progress could not be saved at shutdown: a restart would resume from an older
+    /// position (`agsteerd` exits with status 8).
+    #[error("progress not saved at shutdown: {0}")]
+    ProgressNotSaved(#[source] progress_file::ProgressFileError),
 }
 
 /// Control-loop timing, for the status socket.
@@ -625,13 +629,11 @@ async fn run_async(
         l.finish(Duration::from_secs(2));
     }
     let p = node.controller().guidance().progress();
-    if let Err(e) = progress_file::save(&progress_path, &p) {
-        tracing::error!("saving progress: {e}");
-    }
+    let saved = progress_file::save(&progress_path, &p);
     if let Some(path) = &status_socket {
         remove_stale_socket(path);
     }
-    Ok(())
+    saved.map_err(DaemonError::ProgressNotSaved)
 }
 
 /// Remove the status socket left by an earlier run: only a socket, never another file that

@@ -5,6 +5,7 @@ use agsteer::config::{Config, TrackerChoice};
 use agsteer::demo::accuracy::{
     evaluate, markdown_table, xte_svg, ScenarioResult, XteSeries, TRACKERS,
 };
+use agsteer::exit::Exit;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 
@@ -139,7 +140,58 @@ pub fn run(
         }
         eprintln!("SVGs and accuracy.json in {}", out.display());
     }
-    Ok(0)
+    Ok(verdict(&cfgs, &results, tracker).code())
+}
+
+/// Hold the runs of the tracker under test to their scenario's `[acceptance]` limits: the named
+/// tracker, or with "all" each scenario's `track.kind` (the others are references, shown for
+/// comparison). Prints every shortfall on stderr; the status is the first of not finished,
+/// accuracy not met.
+fn verdict(cfgs: &[(String, Config)], results: &[ScenarioResult], tracker: &str) -> Exit {
+    let mut not_finished = Vec::new();
+    let mut misses = Vec::new();
+    let mut held = 0;
+    for r in results {
+        let Some((_, cfg)) = cfgs.iter().find(|(name, _)| *name == r.scenario) else {
+            continue;
+        };
+        let held_name = if tracker == "all" {
+            agsteer::demo::accuracy::tracker_name(cfg.track.kind)
+        } else {
+            tracker
+        };
+        if r.tracker != held_name {
+            continue;
+        }
+        held += 1;
+        if !r.finished {
+            not_finished.push(format!(
+                "{} / {}: the job did not finish (disengagements: {:?})",
+                r.scenario, r.tracker, r.disengagements
+            ));
+        }
+        for m in cfg.acceptance.misses(r.xte_rms_m, r.xte_p95_m, r.xte_max_m) {
+            misses.push(format!(
+                "{} / {}: accuracy not met: {m}",
+                r.scenario, r.tracker
+            ));
+        }
+    }
+    for m in not_finished.iter().chain(&misses) {
+        eprintln!("error: {m}");
+    }
+    if not_finished.is_empty() && misses.is_empty() {
+        eprintln!(
+            "accuracy: {held} run(s) held to their [acceptance] limits, all finished within them"
+        );
+    }
+    if !not_finished.is_empty() {
+        Exit::NotFinished
+    } else if !misses.is_empty() {
+        Exit::AccuracyNotMet
+    } else {
+        Exit::Success
+    }
 }
 
 /// `agsteer accuracy --envelope` arguments.

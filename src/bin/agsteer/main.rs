@@ -2,6 +2,7 @@
 
 mod accuracy_cmd;
 mod dbc_cmd;
+mod demo_cmd;
 mod maneuver_cmd;
 mod plan_cmd;
 mod replay_cmd;
@@ -9,12 +10,8 @@ mod sim_cmd;
 mod sim_gnss;
 mod status_cmd;
 
-use agsteer::config::{Config, JobKind};
-use agsteer::demo::{self, DemoOptions};
-use agsteer::field::output::PlanSummary;
-use agsteer::guidance::Event;
-use agsteer::job::{JobDetail, PreparedJob};
-use agsteer::store::progress_file;
+use agsteer::config::Config;
+use agsteer::exit::Exit;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -24,7 +21,8 @@ use std::process::ExitCode;
 #[command(
     name = "agsteer",
     version,
-    about = "agsteer: automatic steering for tractors"
+    about = "agsteer: automatic steering for tractors",
+    after_help = agsteer::exit::help_table()
 )]
 struct Cli {
     #[command(subcommand)]
@@ -41,7 +39,10 @@ struct ConfigArgs {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a whole job closed-loop against the simulator, faster than real time.
+    /// Run a whole job closed-loop against the simulator, faster than real time. Exit status 6
+    /// when the job does not finish (not when --stop-after stops it), 7 when the true XTE on
+    /// work lines is beyond an [acceptance] limit, 8 when progress could not be saved.
+    #[command(after_help = agsteer::exit::help_table())]
     Demo {
         /// Configuration file.
         #[arg(long, default_value = "config/demo.toml")]
@@ -64,7 +65,10 @@ enum Command {
     /// The accuracy report: every scenario in tools/scenarios/ (or the given files) with the
     /// default tracker, pure pursuit and Stanley; XTE, 95 % class, pass-to-pass after
     /// ISO 12188-2, acquisition after turns, RTK-float behaviour; OUT/<scenario>.svg of XTE
-    /// over distance and OUT/accuracy.json.
+    /// over distance and OUT/accuracy.json. Exit status 6 when a run of the tracker held to
+    /// the limits (the one named, or each scenario's track.kind with "all") does not finish, 7
+    /// when its true XTE on work lines is beyond an [acceptance] limit of its scenario.
+    #[command(after_help = agsteer::exit::help_table())]
     Accuracy {
         /// Tracker: predictive, pure_pursuit, stanley or all.
         #[arg(long, default_value = "all")]
@@ -142,7 +146,7 @@ enum Command {
     /// Run the controller offline on a recorded bus log (`agsteerd --bus-log`, or any candump
     /// log), faster than real time: prints its status track (CSV) on stdout and, for a log of
     /// agsteerd's, how many control periods send the same frames as the daemon did. Exit
-    /// status 4 with --strict when one differs.
+    /// status 9 with --strict when one differs.
     Replay {
         /// Log files in time order (rotated ones first: FILE.2 FILE.1 FILE).
         #[arg(required = true)]
@@ -165,7 +169,7 @@ enum Command {
         /// Print only a JSON summary.
         #[arg(long)]
         json: bool,
-        /// Exit status 4 when a control period differs from the log.
+        /// Exit status 9 when a control period differs from the log.
         #[arg(long)]
         strict: bool,
         #[command(flatten)]
@@ -190,7 +194,8 @@ enum Command {
         cmd: dbc_cmd::DbcCommand,
     },
     /// Plan coverage of a field (GeoJSON or ISO 11783-10 TASKDATA.XML): writes OUT/plan.geojson,
-    /// OUT/plan.svg and OUT/metrics.json.
+    /// OUT/plan.svg and OUT/metrics.json. Exit status 4 when the plan breaks a guarantee, 5 when
+    /// no swath fits.
     Plan {
         /// Field boundary: GeoJSON (WGS-84) or TASKDATA.XML.
         #[arg(long)]
@@ -299,7 +304,7 @@ fn main() -> ExitCode {
             resume,
             stop_after,
             cfg,
-        } => run_demo(&config, &out, json, resume, stop_after, &cfg.set),
+        } => demo_cmd::run_demo(&config, &out, json, resume, stop_after, &cfg.set),
         Command::CheckConfig { file, cfg } => check_config(&file, &cfg.set),
         Command::Plan {
             field,
@@ -407,8 +412,25 @@ fn main() -> ExitCode {
         Ok(code) => ExitCode::from(code),
         Err(e) => {
             eprintln!("error: {e:#}");
-            ExitCode::from(1)
+            exit_for_error(&e).into()
         }
+    }
+}
+
+/// The status of a failed command: [`Exit::Invalid`] when an invalid configuration (or
+/// `--set`) caused it, [`Exit::Error`] otherwise (a file that cannot be read included).
+fn exit_for_error(e: &anyhow::Error) -> Exit {
+    use agsteer::config::ConfigError;
+    let invalid = e.chain().any(|c| {
+        matches!(
+            c.downcast_ref::<ConfigError>(),
+            Some(ConfigError::Invalid(_) | ConfigError::Parse(_) | ConfigError::BadOverride(_))
+        )
+    });
+    if invalid {
+        Exit::Invalid
+    } else {
+        Exit::Error
     }
 }
 
@@ -460,215 +482,18 @@ fn check_config(path: &Path, set: &[String]) -> Result<u8> {
     match Config::load(path, set) {
         Ok(cfg) => {
             print!("{}", cfg.to_toml());
-            Ok(0)
+            Ok(Exit::Success.code())
         }
         Err(agsteer::config::ConfigError::Invalid(problems)) => {
             eprintln!("{}: {} problem(s)", path.display(), problems.len());
             for p in problems {
                 eprintln!("  {p}");
             }
-            Ok(2)
+            Ok(Exit::Invalid.code())
         }
         Err(e) => {
             eprintln!("{}: {e}", path.display());
-            Ok(2)
+            Ok(Exit::Invalid.code())
         }
     }
-}
-
-fn log_event(t: f64, ev: &Event) {
-    tracing::info!(t_s = format_args!("{t:.2}"), "{ev}");
-}
-
-/// The configured job set up as agsteerd sets it up (timed, with progress on stderr), and for
-/// a field job the plan's summary for the report.
-fn prepare_demo_job(
-    resolved: &agsteer::config::Resolved,
-) -> Result<(PreparedJob, Option<PlanSummary>)> {
-    let what = match resolved.planning.kind {
-        JobKind::Maneuver => "planning the manoeuvre",
-        JobKind::Ab | JobKind::Arcs | JobKind::Field => "planning",
-    };
-    let (job, ms) = plan_cmd::timed(what, || agsteer::job::prepare(&resolved.planning));
-    let job = job?;
-    let summary = match &job.detail {
-        JobDetail::Field(fj) => {
-            let ((metrics, (findings, _)), metrics_time) = plan_cmd::timed("metrics", || {
-                let m = fj.metrics();
-                let f = agsteer::field::findings::plan_findings(
-                    &fj.loaded,
-                    &fj.plan,
-                    &m,
-                    fj.params.line_width,
-                    fj.params.r_min,
-                    &[],
-                );
-                (m, f)
-            });
-            Some(PlanSummary::new(
-                &fj.loaded,
-                &fj.plan,
-                &metrics,
-                &findings,
-                fj.plan_time,
-                metrics_time,
-            ))
-        }
-        JobDetail::Maneuver(mj, _) => {
-            tracing::info!(
-                "manoeuvre: {:.1} m, {} cusps, {:.1} m in reverse, {} segments, planned in {:.0} ms",
-                mj.path.length(),
-                mj.path.cusps(),
-                mj.path.reverse_length(),
-                mj.job.len(),
-                ms.as_secs_f64() * 1e3
-            );
-            None
-        }
-        JobDetail::Lines => None,
-    };
-    Ok((job, summary))
-}
-
-fn run_demo(
-    config: &Path,
-    out: &Path,
-    json: bool,
-    resume: bool,
-    stop_after: Option<u64>,
-    set: &[String],
-) -> Result<u8> {
-    let cfg = load_config(config, set)?;
-    let resolved = cfg.resolve()?;
-    let (job, summary) = prepare_demo_job(&resolved)
-        .with_context(|| format!("setting up the job of {}", config.display()))?;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let progress_path = out.join(progress_file::PROGRESS_FILE_NAME);
-    let resume_from = if resume {
-        Some(agsteer::job::resume::require_resume(
-            &job,
-            &progress_path,
-            config,
-        )?)
-    } else {
-        None
-    };
-    let field = match &job.detail {
-        JobDetail::Field(fj) => Some(fj.as_ref()),
-        _ => None,
-    };
-    let opts = DemoOptions {
-        resume: resume_from,
-        stop_after_lines: stop_after,
-        record_trace: true,
-        outlines: match &job.detail {
-            JobDetail::Field(fj) => fj.outlines(),
-            JobDetail::Maneuver(_, Some(map)) => std::iter::once(map.boundary.clone())
-                .chain(map.obstacles.iter().cloned())
-                .collect(),
-            _ => Vec::new(),
-        },
-        prepared: Some(job.clone()),
-        ..Default::default()
-    };
-    let mut save_error = None;
-    let mut on_progress = |p: &agsteer::guidance::progress::Progress| {
-        if let Err(e) = progress_file::save(&progress_path, p) {
-            save_error.get_or_insert(e);
-        }
-    };
-    let mut run =
-        demo::run(&cfg, &opts, &mut on_progress, &mut log_event).context("running the demo job")?;
-    if let Some(e) = save_error {
-        tracing::error!("could not save progress: {e}");
-    }
-    run.report.plan = summary.clone();
-    let report_json = serde_json::to_string_pretty(&run.report)?;
-    std::fs::write(out.join("report.json"), format!("{report_json}\n"))
-        .with_context(|| format!("writing {}/report.json", out.display()))?;
-    std::fs::write(
-        out.join("trace.svg"),
-        demo::svg::demo_svg(&run.trace, &run.report),
-    )
-    .with_context(|| format!("writing {}/trace.svg", out.display()))?;
-    if json {
-        println!("{report_json}");
-    } else {
-        let r = &run.report;
-        if let (Some(fj), Some(p)) = (field, &summary) {
-            println!(
-                "plan of {}: {} cells, {} swaths, {} segments, {:.0} m ({:.0} m work, {:.0} m turns, {:.0} m transit); field worked {:.2} %, outside {:.3} m²; planned in {:.0} ms",
-                fj.title(),
-                p.cells,
-                p.swaths,
-                fj.job.len(),
-                p.total_length_m,
-                p.work_length_m,
-                p.turn_length_m,
-                p.transit_length_m,
-                100.0 * p.covered_fraction,
-                p.outside_area_m2,
-                p.plan_time_ms
-            );
-        }
-        println!(
-            "{}: {}/{} lines, {} turns, {:.0} m in {:.0} s simulated ({:.2} s wall)",
-            if r.finished {
-                "finished"
-            } else {
-                "NOT finished"
-            },
-            r.lines_completed,
-            r.lines_planned
-                .map(|n| n.to_string())
-                .unwrap_or_else(|| "unlimited".into()),
-            r.turns,
-            r.distance_m,
-            r.sim_time_s,
-            r.wall_time_s
-        );
-        println!(
-            "true XTE on work lines: RMS {:.1} cm, p95 {:.1} cm, max {:.1} cm; acquisition max {:.1} cm (tracker {})",
-            r.xte_rms_m * 100.0,
-            r.xte_p95_m * 100.0,
-            r.xte_max_m * 100.0,
-            r.acquisition_xte_max_m * 100.0,
-            r.tracker
-        );
-        let worst = |by: fn(&demo::SegmentReport) -> f64| {
-            r.segments
-                .iter()
-                .max_by(|a, b| by(a).total_cmp(&by(b)))
-                .map(|s| {
-                    format!(
-                        "segment {} ({:?}, {:?}, {:.0} m): RMS {:.1} cm, max {:.1} cm",
-                        s.index,
-                        s.kind,
-                        s.direction,
-                        s.length_m,
-                        s.xte_rms_m * 100.0,
-                        s.xte_max_m * 100.0
-                    )
-                })
-        };
-        if matches!(job.detail, JobDetail::Maneuver(..)) {
-            for s in &r.segments {
-                println!(
-                    "segment {} ({:?}, {:.1} m): XTE RMS {:.1} cm, max {:.1} cm",
-                    s.index,
-                    s.direction,
-                    s.length_m,
-                    s.xte_rms_m * 100.0,
-                    s.xte_max_m * 100.0
-                );
-            }
-        } else if let (Some(rms), Some(max)) = (worst(|s| s.xte_rms_m), worst(|s| s.xte_max_m)) {
-            println!("worst RMS on {rms}; worst max on {max}");
-        }
-        if let (Some(pos), Some(hdg)) = (r.goal_position_error_m, r.goal_heading_error_deg) {
-            println!("goal error: {:.1} cm, {:.2}°", pos * 100.0, hdg);
-        }
-        println!("wrote {}/trace.svg and report.json", out.display());
-    }
-    Ok(0)
 }

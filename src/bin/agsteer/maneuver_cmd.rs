@@ -245,7 +245,12 @@ pub fn run(cfg: &Config, a: &ManeuverArgs) -> Result<u8> {
             out.plan_time_ms
         ))?;
     }
-    Ok(if out.found { 0 } else { 3 })
+    Ok(if out.found {
+        agsteer::exit::Exit::Success
+    } else {
+        agsteer::exit::Exit::NoPath
+    }
+    .code())
 }
 
 /// Print a line on stdout. `Ok(false)` when the reader has gone (broken pipe, e.g. `| head`):

@@ -219,7 +219,7 @@ where
                 )
             });
         eprintln!("error: {}: {reason}", field_path.display());
-        return Ok(5);
+        return Ok(agsteer::exit::Exit::NoSwath.code());
     }
     let ((metrics, (findings, ground)), metrics_time) = timed("metrics", || {
         let m = plan_metrics(&loaded.field, &plan, params.line_width);
@@ -298,7 +298,7 @@ where
             "error: the plan breaks its guarantees in {} places (listed above); it was written for inspection but must not be driven",
             findings.violations.len()
         );
-        return Ok(4);
+        return Ok(agsteer::exit::Exit::PlanViolation.code());
     }
     Ok(0)
 }

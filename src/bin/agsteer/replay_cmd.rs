@@ -23,7 +23,7 @@ pub struct ReplayArgs<'a> {
     pub json: bool,
     /// Status track: one line every this many periods (0: none).
     pub every: u64,
-    /// Exit status 4 when a period differs from the log.
+    /// Exit status 9 when a period differs from the log.
     pub strict: bool,
 }
 
@@ -203,8 +203,8 @@ pub fn run(cfg: &Config, args: &ReplayArgs) -> Result<u8> {
         }
     }
     Ok(if args.strict && summary.differing > 0 {
-        4
+        agsteer::exit::Exit::ReplayDiffers.code()
     } else {
-        0
+        agsteer::exit::Exit::Success.code()
     })
 }

@@ -1,7 +1,8 @@
 //! `agsteerd`: the steering daemon on SocketCAN.
 
 use agsteer::config::Config;
-use anyhow::Context;
+use agsteer::daemon::run::DaemonError;
+use agsteer::exit::Exit;
 use clap::Parser;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -10,7 +11,8 @@ use std::process::ExitCode;
 #[command(
     name = "agsteerd",
     version,
-    about = "agsteer steering daemon (SocketCAN)"
+    about = "agsteer steering daemon (SocketCAN)",
+    after_help = agsteer::exit::help_table()
 )]
 struct Args {
     /// Configuration file.
@@ -48,11 +50,11 @@ fn main() -> ExitCode {
             for p in problems {
                 eprintln!("  {p}");
             }
-            return ExitCode::from(2);
+            return Exit::Invalid.into();
         }
         Err(e) => {
             eprintln!("{}: {e}", args.config.display());
-            return ExitCode::from(2);
+            return Exit::Invalid.into();
         }
     };
     if args.check {
@@ -84,12 +86,23 @@ fn main() -> ExitCode {
             max_bytes: args.bus_log_size_mb * 1_000_000,
             files: args.bus_log_files,
         });
-    match agsteer::daemon::run::run(cfg, source, bus_log).context("agsteerd") {
-        Ok(()) => ExitCode::SUCCESS,
+    match agsteer::daemon::run::run(cfg, source, bus_log) {
+        Ok(()) => Exit::Success.into(),
         Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(1)
+            let exit = exit_for(&e);
+            eprintln!("error: {:#}", anyhow::Error::new(e).context("agsteerd"));
+            exit.into()
         }
+    }
+}
+
+/// The exit status of a daemon that stopped on `e`: what `--check` would have refused (the
+/// configuration and what it names) is [`Exit::Invalid`], as there.
+fn exit_for(e: &DaemonError) -> Exit {
+    match e {
+        DaemonError::Config(_) | DaemonError::Job(_) | DaemonError::Startup(_) => Exit::Invalid,
+        DaemonError::ProgressNotSaved(_) => Exit::ProgressNotSaved,
+        _ => Exit::Error,
     }
 }
 
@@ -101,7 +114,7 @@ fn check(args: &Args, cfg: &Config) -> ExitCode {
         Ok(s) => s,
         Err(e) => {
             eprintln!("{name}: {:#}", anyhow::Error::new(e));
-            return ExitCode::from(2);
+            return Exit::Invalid.into();
         }
     };
     if let Some(planned) = agsteer::job::startup::planned(&startup.job) {
@@ -115,5 +128,5 @@ fn check(args: &Args, cfg: &Config) -> ExitCode {
         println!("{name}: warning: {w}");
     }
     println!("{name}: valid");
-    ExitCode::SUCCESS
+    Exit::Success.into()
 }

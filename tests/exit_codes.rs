@@ -1,0 +1,202 @@
+//! The exit statuses of the real binaries (`src/exit.rs`): each one `agsteer` can give from a
+//! situation made here, agsteerd's configuration status, the `--help` tables and README.md's.
+//! (4, a plan breaking its guarantees, needs a faulty planner: `agsteer plan` maps it in
+//! `src/bin/agsteer/plan_cmd.rs`; 9 is checked in `tests/replay.rs`; agsteerd's 1 and 8 need a
+//! CAN interface: the VM suite.)
+
+use agsteer::exit::Exit;
+use std::path::Path;
+use std::process::Command;
+
+struct Run {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+fn run(bin: &str, args: &[&str]) -> Run {
+    let out = Command::new(bin)
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the binary runs");
+    Run {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+fn agsteer(args: &[&str]) -> Run {
+    run(env!("CARGO_BIN_EXE_agsteer"), args)
+}
+
+impl Run {
+    /// The status is `e` and stderr names every needle.
+    fn is(&self, e: Exit, needles: &[&str]) {
+        assert_eq!(
+            self.code,
+            i32::from(e.code()),
+            "expected {e:?}\nstdout: {}\nstderr: {}",
+            self.stdout,
+            self.stderr
+        );
+        for n in needles {
+            assert!(self.stderr.contains(n), "{n:?} not in {}", self.stderr);
+        }
+    }
+}
+
+/// `agsteer demo` of two lines into `out`, with `set` on top of config/demo.toml.
+fn demo(out: &Path, set: &[&str]) -> Run {
+    let out = out.display().to_string();
+    let mut args = vec!["demo", "--out", &out, "--set", "job.line_num=2"];
+    for s in set {
+        args.extend(["--set", s]);
+    }
+    agsteer(&args)
+}
+
+#[test]
+fn the_demo_exits_with_what_happened_to_its_job() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("d");
+    demo(&out, &[]).is(Exit::Success, &[]);
+    // The time budget ends the job half-way: not finished, named with the lines done.
+    demo(&out, &["sim.max_time_s=30"]).is(Exit::NotFinished, &["did not finish", "/2 lines"]);
+    // Finished, but a limit tighter than the tracking: the figure and the limit named.
+    demo(&out, &["acceptance.xte_max_limit_m=0.001"]).is(
+        Exit::AccuracyNotMet,
+        &[
+            "true max |XTE| on work lines",
+            "0.10 cm",
+            "acceptance.xte_max_limit_m",
+        ],
+    );
+    // A stop asked for with --stop-after is not a failure.
+    let r = agsteer(&[
+        "demo",
+        "--out",
+        &out.display().to_string(),
+        "--stop-after",
+        "1",
+    ]);
+    r.is(Exit::Success, &["stopped after 1 line(s) as asked"]);
+    // Progress cannot be saved (a directory where the file goes): 8, before accuracy.
+    let blocked = dir.path().join("blocked");
+    std::fs::create_dir_all(blocked.join("progress.json")).unwrap();
+    demo(&blocked, &["acceptance.xte_max_limit_m=0.001"]).is(
+        Exit::ProgressNotSaved,
+        &["progress not saved", "progress.json", "accuracy not met"],
+    );
+}
+
+#[test]
+fn the_accuracy_suite_holds_the_tracker_under_test_to_the_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().display().to_string();
+    let suite = |tracker: &str, set: &[&str]| {
+        let mut args = vec![
+            "accuracy",
+            "--config",
+            "tools/scenarios/straight_4kmh.toml",
+            "--tracker",
+            tracker,
+            "--out",
+            &out,
+            "--set",
+            "job.line_num=2",
+        ];
+        for s in set {
+            args.extend(["--set", s]);
+        }
+        agsteer(&args)
+    };
+    suite("predictive", &[]).is(Exit::Success, &["1 run(s) held"]);
+    suite("predictive", &["acceptance.xte_rms_limit_m=0.001"]).is(
+        Exit::AccuracyNotMet,
+        &["straight_4kmh / predictive: accuracy not met: true XTE RMS"],
+    );
+    suite("stanley", &["sim.max_time_s=30"]).is(
+        Exit::NotFinished,
+        &["straight_4kmh / stanley: the job did not finish"],
+    );
+}
+
+#[test]
+fn configuration_and_usage_errors_exit_2_and_unreadable_files_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("d");
+    demo(&out, &["guidance.a=0"]).is(Exit::Invalid, &["guidance.a = 0"]);
+    demo(&out, &["gnss.baud=4294967297"]).is(
+        Exit::Invalid,
+        &["gnss.baud = 4294967297: must be an integer in 0..=4294967295"],
+    );
+    agsteer(&["demo", "--no-such-flag"]).is(Exit::Invalid, &["--no-such-flag"]);
+    let missing = dir.path().join("missing.toml").display().to_string();
+    agsteer(&["demo", "--config", &missing]).is(Exit::Error, &["missing.toml"]);
+    let r = run(
+        env!("CARGO_BIN_EXE_agsteerd"),
+        &[
+            "--config",
+            "config/demo.toml",
+            "--set",
+            "isobus.function=256",
+        ],
+    );
+    r.is(
+        Exit::Invalid,
+        &["isobus.function = 256: must be an integer in 0..=255"],
+    );
+}
+
+#[test]
+fn planning_commands_exit_with_their_own_statuses() {
+    let dir = tempfile::tempdir().unwrap();
+    // A corridor 4 m wide: no room to turn round.
+    let map = dir.path().join("corridor.geojson");
+    std::fs::write(
+        &map,
+        r#"{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[-20,-2],[20,-2],[20,2],[-20,2],[-20,-2]]]}}"#,
+    )
+    .unwrap();
+    let map = map.display().to_string();
+    let r = agsteer(&[
+        "maneuver", "--map", &map, "--from", "0,0,0", "--to", "5,0,180",
+    ]);
+    assert!(r.stdout.contains("no path"), "{}", r.stdout);
+    r.is(Exit::NoPath, &[]);
+    // A strip 3.3 m wide: no swath fits.
+    let field = dir.path().join("strip.geojson");
+    std::fs::write(
+        &field,
+        r#"{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[5.0,52.0],[5.0015,52.0],[5.0015,52.00003],[5.0,52.00003],[5.0,52.0]]]}}"#,
+    )
+    .unwrap();
+    let field = field.display().to_string();
+    let out = dir.path().join("plan").display().to_string();
+    agsteer(&["plan", "--field", &field, "--out", &out]).is(Exit::NoSwath, &["no swath fits"]);
+}
+
+#[test]
+fn the_tables_in_the_help_and_the_readme_are_the_code() {
+    let help = agsteer::exit::help_table();
+    for args in [
+        &["--help"][..],
+        &["demo", "--help"],
+        &["accuracy", "--help"],
+    ] {
+        let r = agsteer(args);
+        assert_eq!(r.code, 0);
+        assert!(r.stdout.contains(&help), "{args:?}: {}", r.stdout);
+    }
+    let r = run(env!("CARGO_BIN_EXE_agsteerd"), &["--help"]);
+    assert!(r.stdout.contains(&help), "{}", r.stdout);
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    assert!(
+        readme.contains(&agsteer::exit::markdown_table()),
+        "README.md's exit-status table differs from src/exit.rs:\n{}",
+        agsteer::exit::markdown_table()
+    );
+}
