@@ -14,6 +14,7 @@
 //! tools. I/O lives only in the adapters (`can`, `io`), [`store`], [`daemon`] and the
 //! binaries. `docs/layers.txt` declares the layer order, which `tests/layering.rs` enforces.
 
+pub mod calibrate;
 pub mod can;
 pub mod config;
 pub mod control;

@@ -252,6 +252,7 @@ impl Config {
                 threshold: t.lost_motion_threshold_deg.to_radians(),
                 limit: t.lost_motion_limit_deg.to_radians(),
                 settle: t.lost_motion_settle_s,
+                initial: t.lost_motion_initial_deg.to_radians(),
             },
             approach: (g.approach_paths && v.max_curvature_rate_per_m2 > 0.0).then(|| {
                 ApproachParams {
@@ -298,6 +299,8 @@ impl Config {
                 steer_ready_loop: self.bus.output == super::OutputKind::Curvature,
             },
             machine_info_timeout: self.isobus.machine_info_timeout_s,
+            was_gain: self.vehicle.was_gain,
+            was_offset: self.vehicle.was_offset_deg.to_radians(),
         }
     }
 

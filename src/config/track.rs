@@ -79,6 +79,9 @@ pub struct TrackConfig {
     pub lost_motion_threshold_deg: f64,
     /// Largest lost motion the compensation may learn, degrees.
     pub lost_motion_limit_deg: f64,
+    /// The lost motion the compensation starts from, degrees (`agsteer calibrate` measures it:
+    /// the deadband plus half the backlash); it learns on from there.
+    pub lost_motion_initial_deg: f64,
     /// The estimate learns only this long after the push direction changed, with a steady
     /// demand, s (about the actuator's settling time).
     pub lost_motion_settle_s: f64,
@@ -115,6 +118,7 @@ impl Default for TrackConfig {
             lost_motion_tau_s: 5.0,
             lost_motion_threshold_deg: 0.1,
             lost_motion_limit_deg: 1.0,
+            lost_motion_initial_deg: 0.0,
             lost_motion_settle_s: 0.5,
         }
     }
@@ -224,6 +228,12 @@ impl TrackConfig {
         c.range(
             "track.lost_motion_limit_deg",
             t.lost_motion_limit_deg,
+            0.0,
+            5.0,
+        );
+        c.range(
+            "track.lost_motion_initial_deg",
+            t.lost_motion_initial_deg,
             0.0,
             5.0,
         );

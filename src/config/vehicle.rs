@@ -37,6 +37,12 @@ pub struct VehicleConfig {
     pub width_m: f64,
     /// Distance of the rear axle ahead of the vehicle's rear edge, m.
     pub rear_axle_from_rear_m: f64,
+    /// Wheel-angle sensor gain: it reads `was_gain` × the true angle + `was_offset_deg`
+    /// (measured by `agsteer calibrate`). Angles from the bus are corrected, commands sent in
+    /// the sensor's terms.
+    pub was_gain: f64,
+    /// Wheel-angle sensor reading of straight-ahead wheels, degrees (`agsteer calibrate`).
+    pub was_offset_deg: f64,
 }
 
 impl Default for VehicleConfig {
@@ -52,6 +58,8 @@ impl Default for VehicleConfig {
             length_m: 4.5,
             width_m: 2.5,
             rear_axle_from_rear_m: 1.0,
+            was_gain: 1.0,
+            was_offset_deg: 0.0,
         }
     }
 }
@@ -82,6 +90,8 @@ impl VehicleConfig {
         );
         c.range("vehicle.antenna_left_m", v.antenna_left_m, -10.0, 10.0);
         c.range("vehicle.antenna_up_m", v.antenna_up_m, 0.0, 10.0);
+        c.range("vehicle.was_gain", v.was_gain, 0.5, 2.0);
+        c.range("vehicle.was_offset_deg", v.was_offset_deg, -10.0, 10.0);
         if v.wheelbase_m.is_finite() && v.max_wheel_angle_deg.is_finite() && v.r_min_m.is_finite() {
             let r_steer = v.wheelbase_m / v.max_wheel_angle_deg.to_radians().tan();
             if v.r_min_m + 1e-9 < r_steer {

@@ -117,7 +117,7 @@ impl Controller {
                 params,
                 clear: None,
             }),
-            lost_motion: LostMotion::new(params.lost_motion_for(needs), 0.0),
+            lost_motion: LostMotion::new(params.lost_motion_for(needs), params.lost_motion.initial),
             engaged: false,
             law,
             params: params.clone(),

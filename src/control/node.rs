@@ -92,6 +92,9 @@ pub struct ControllerNode {
     /// The work line the supervisor watches (None: none).
     supervised_line: Option<u64>,
     last_request: Option<DirectionRequestDirection>,
+    /// The wheel-angle sensor: gain and offset (rad), see [`BusParams::was_gain`].
+    was_gain: f64,
+    was_offset: f64,
 }
 
 /// How the node handles a change of driving direction (docs/METHODS.md, Manoeuvres at work: the
@@ -174,6 +177,16 @@ impl ControllerNode {
             guidance_failing: false,
             supervised_line: None,
             last_request: None,
+            was_gain: if bus.was_gain.is_finite() && bus.was_gain > 0.0 {
+                bus.was_gain
+            } else {
+                1.0
+            },
+            was_offset: if bus.was_offset.is_finite() {
+                bus.was_offset
+            } else {
+                0.0
+            },
             status: NodeStatus {
                 state: SafetyState::Disengaged,
                 fault: FaultCode::None,
@@ -301,7 +314,8 @@ impl ControllerNode {
                 }
             }
             Input::WheelAngle(w) => {
-                if let Some(a) = w.angle {
+                // The sensor's reading to the true angle (calibration's gain and offset).
+                if let Some(a) = w.angle.map(|a| (a - self.was_offset) / self.was_gain) {
                     self.supervisor.on_wheel_angle(
                         w.t,
                         a,
@@ -580,10 +594,14 @@ impl ControllerNode {
             .step(t, c.wheel_angle, c.xte, c.heading_error);
         self.ctrl.set_engaged(cmd.engaged);
         let angle_deg = cmd.wheel_angle.to_degrees().clamp(-90.0, 90.0);
+        // The steering servos the sensor's reading: command in its terms.
+        let sensed_deg = (self.was_gain * cmd.wheel_angle + self.was_offset)
+            .to_degrees()
+            .clamp(-90.0, 90.0);
 
         if matches!(self.output, OutputKind::Angle | OutputKind::Both) {
             if let Ok(f) = self.packer.pack(&SteeringCommand {
-                angle: Some(angle_deg),
+                angle: Some(sensed_deg),
                 mode: Some(if cmd.engaged {
                     SteeringCommandMode::Engaged
                 } else {

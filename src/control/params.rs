@@ -150,4 +150,8 @@ pub struct BusParams {
     pub machine_info_timeout: f64,
     /// Which source each GNSS input is taken from (`[sources]`).
     pub sources: crate::input::source::SourceParams,
+    /// The wheel-angle sensor reads `was_gain` × the true angle + `was_offset` (rad): angles
+    /// received are corrected, commands sent in the sensor's terms.
+    pub was_gain: f64,
+    pub was_offset: f64,
 }

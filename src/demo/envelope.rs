@@ -263,6 +263,11 @@ pub fn apply_calibration(cfg: &mut Config, calibration: Calibration) {
             cfg.safety.actuator_tau_s = s.actuator_tau_s;
             cfg.safety.actuator_rate_deg_s = s.actuator_rate_deg_s;
             cfg.track.lead_time_s = s.actuator_dead_time_s.min(1.0);
+            cfg.vehicle.was_gain = s.was_gain;
+            cfg.vehicle.was_offset_deg = s.was_bias_deg;
+            cfg.track.lost_motion_initial_deg = (s.actuator_deadband_deg
+                + 0.5 * s.actuator_backlash_deg)
+                .min(cfg.track.lost_motion_limit_deg);
         }
     }
 }

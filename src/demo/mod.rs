@@ -5,6 +5,7 @@
 //! the SVG is recorded only on request.
 
 pub mod accuracy;
+pub mod calibrate;
 pub mod envelope;
 pub mod svg;
 

@@ -200,6 +200,14 @@ impl Simulator {
         }
     }
 
+    /// Change the steering actuator's lag (s, ≥ 0) from now on: a steering whose behaviour
+    /// changes (hydraulic oil warming, a fault), for the calibration's consistency checks.
+    pub fn set_actuator_tau(&mut self, tau: f64) {
+        if tau.is_finite() && tau >= 0.0 {
+            self.p.tau = tau;
+        }
+    }
+
     /// The driver holds the wheels: the actuator stays where it is.
     pub fn hold_wheels(&mut self) {
         self.actuator.hold(&self.p);

@@ -31,6 +31,8 @@ pub struct LostMotionParams {
     /// The estimate learns only this long after the push direction changed and while the
     /// demand is steady, s: the actuator has settled.
     pub settle: f64,
+    /// The estimate a new job starts from, rad (calibration's measured lost motion).
+    pub initial: f64,
 }
 
 /// Time constant of the demand's low-pass filter, s: about the actuator's dead time and lag,
@@ -144,6 +146,7 @@ mod tests {
             threshold: 0.1f64.to_radians(),
             limit: 1f64.to_radians(),
             settle: 0.5,
+            initial: 0.0,
         }
     }
 

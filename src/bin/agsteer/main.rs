@@ -1,6 +1,7 @@
 //! `agsteer`: the technician's and developer's tool.
 
 mod accuracy_cmd;
+mod calibrate_cmd;
 mod dbc_cmd;
 mod demo_cmd;
 mod maneuver_cmd;
@@ -246,6 +247,20 @@ enum Command {
         #[command(flatten)]
         cfg: ConfigArgs,
     },
+    /// Identify the steering (dead time, lag, rate limit, deadband/backlash) and the
+    /// wheel-angle sensor (gain, offset) on the simulated tractor of the configuration's
+    /// [sim] over the in-memory bus; prints them with their uncertainty and writes the TOML
+    /// fragment of the keys calibration owns. Exit status 4 when it refuses (reason printed).
+    Calibrate {
+        /// Configuration file (its [vehicle] geometry; [sim] is the tractor).
+        #[arg(long, default_value = "config/demo.toml")]
+        config: PathBuf,
+        /// Write the TOML fragment here (default: print it only).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    },
     /// Validate a configuration: print it resolved, or every problem (exit status 2).
     CheckConfig {
         /// Configuration file.
@@ -341,6 +356,8 @@ fn main() -> ExitCode {
                 },
             )
         }),
+        Command::Calibrate { config, out, cfg } => load_config(&config, &cfg.set)
+            .and_then(|c| calibrate_cmd::calibrate(&c, out.as_deref())),
         Command::Sim {
             iface,
             config,

@@ -1,0 +1,335 @@
+//! Steering calibration (issue 15 point 4): a guided identification of the steering and the
+//! wheel-angle sensor, run against the simulator or a tractor on the bus.
+//!
+//! [`session::Session`] is the procedure (standstill steering tests, then a slow drive), fed the
+//! bus's [`Input`](crate::input::Input)s and answering the command to send each period;
+//! [`Session::finish`](session::Session) fits what it recorded:
+//!
+//! * the steering ([`identify`]): dead time, first-order lag, rate limit, deadband and backlash
+//!   of the map from commanded to sensed angle ([`model::SteeringModel`]), by simulation least
+//!   squares, with standard deviations; the two repetitions of the tests are fitted apart and
+//!   must agree;
+//! * the wheel-angle sensor ([`was`]): gain and zero offset against the GNSS yaw rate on the
+//!   drive.
+//!
+//! [`Calibration::toml_fragment`] writes the keys the controller and the supervisor read. Pure:
+//! no I/O, no clock; the driving of a bus is the caller's (`agsteer calibrate`,
+//! [`crate::demo::calibrate`]).
+
+pub mod fit;
+pub mod identify;
+pub mod model;
+pub mod session;
+pub mod was;
+
+use identify::{fit_steering, fit_steering_from, SteeringFit};
+use model::SteeringModel;
+pub use session::{Instruction, Session, Tick};
+use was::{fit_was, hold_result, Geometry, WasFit};
+
+/// Limits and shape of the procedure, SI.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CalibrationParams {
+    /// The steering tests need the tractor below this speed, m/s.
+    pub standstill_speed: f64,
+    /// The drive: asked speed and accepted range, m/s.
+    pub drive_speed: f64,
+    pub drive_speed_min: f64,
+    pub drive_speed_max: f64,
+    /// Big steering steps, either side of centre, rad.
+    pub step: f64,
+    /// Largest sensed angle held on the drive, rad.
+    pub hold_angle: f64,
+    /// No command beyond this, rad.
+    pub max_angle: f64,
+    /// While measuring on the drive the sensed angle must stay this close to the command, rad.
+    pub follow_tolerance: f64,
+    /// Longest wait for the operator to stop or reach the drive speed, s.
+    pub wait_timeout: f64,
+    pub geometry: Geometry,
+}
+
+impl Default for CalibrationParams {
+    fn default() -> Self {
+        CalibrationParams {
+            standstill_speed: 0.5 / 3.6,
+            drive_speed: 3.0 / 3.6,
+            drive_speed_min: 1.5 / 3.6,
+            drive_speed_max: 6.0 / 3.6,
+            step: 20f64.to_radians(),
+            hold_angle: 12f64.to_radians(),
+            max_angle: 30f64.to_radians(),
+            follow_tolerance: 3f64.to_radians(),
+            wait_timeout: 60.0,
+            geometry: Geometry {
+                wheelbase: 3.0,
+                antenna_forward: 0.0,
+                antenna_left: 0.0,
+            },
+        }
+    }
+}
+
+/// Why calibration refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CalibrationError {
+    #[error("moving at {speed_kmh:.1} km/h during {phase} (limit {limit_kmh:.1} km/h)")]
+    TooFast {
+        phase: &'static str,
+        speed_kmh: f64,
+        limit_kmh: f64,
+    },
+    #[error("the operator intervened at {t:.1} s: {how}")]
+    OperatorIntervened { t: f64, how: String },
+    #[error("inconsistent responses: {0}")]
+    Inconsistent(String),
+    #[error("no steering response: {0}")]
+    NoResponse(String),
+    #[error("not enough data: {0}")]
+    NoData(String),
+}
+
+/// A value and its standard deviation (`None`: not determined by the tests).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    pub value: f64,
+    pub sd: Option<f64>,
+}
+
+/// What calibration identified, in true wheel angles (SI).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Calibration {
+    pub dead_time: Estimate,
+    pub tau: Estimate,
+    /// Rate limit, rad/s. When the tests never reached it (`rate_reached` false) `value` is the
+    /// fastest motion seen: a lower bound.
+    pub rate: Estimate,
+    pub rate_reached: bool,
+    pub deadband: Estimate,
+    pub backlash: Estimate,
+    /// Sensor gain (sensed / true) and offset (sensed angle of straight driving, rad).
+    pub was_gain: Estimate,
+    pub was_offset: Estimate,
+    /// RMS of the steering fit's residuals, rad.
+    pub steering_rms: f64,
+    /// The fit in the sensor's terms and the sensor fit, as found.
+    pub steering_fit: SteeringFit,
+    pub was_fit: WasFit,
+}
+
+/// Do two fits of the same steering agree? (Tolerances above the tests' own scatter: 3 σ plus
+/// a floor.) Returns the first disagreement.
+fn disagreement(a: &SteeringFit, b: &SteeringFit) -> Option<String> {
+    let sd = |i: usize| {
+        let s = |f: &SteeringFit| f.sigma[i].unwrap_or(0.0);
+        (s(a).powi(2) + s(b).powi(2)).sqrt()
+    };
+    let (ma, mb) = (&a.model, &b.model);
+    let check = |name: &str, x: f64, y: f64, floor: f64, i: usize, unit: f64, u: &str| {
+        ((x - y).abs() > floor + 3.0 * sd(i)).then(|| {
+            format!(
+                "{name} {:.3} {u} in the first repetition, {:.3} {u} in the second",
+                x * unit,
+                y * unit
+            )
+        })
+    };
+    let deg = 1f64.to_degrees();
+    check("dead time", ma.dead_time, mb.dead_time, 0.02, 0, 1.0, "s")
+        .or_else(|| check("lag", ma.tau, mb.tau, 0.2 * ma.tau.max(mb.tau), 1, 1.0, "s"))
+        .or_else(|| {
+            (a.rate_bound_s > 0.3 && b.rate_bound_s > 0.3)
+                .then(|| {
+                    check(
+                        "rate limit",
+                        ma.rate,
+                        mb.rate,
+                        0.2 * ma.rate.max(mb.rate),
+                        2,
+                        deg,
+                        "°/s",
+                    )
+                })
+                .flatten()
+        })
+        .or_else(|| {
+            let lost = |m: &SteeringModel| m.deadband + 0.5 * m.backlash;
+            check(
+                "lost motion",
+                lost(ma),
+                lost(mb),
+                0.3f64.to_radians(),
+                3,
+                deg,
+                "°",
+            )
+        })
+}
+
+impl Session {
+    /// Fit what the procedure recorded. Refuses when the steering did not respond, the two
+    /// repetitions disagree, the model does not explain the responses or the drive's holds do
+    /// not lie on a line.
+    pub fn finish(&self) -> Result<Calibration, CalibrationError> {
+        if !self.is_done() {
+            return Err(CalibrationError::NoData(
+                "the procedure did not run to its end".into(),
+            ));
+        }
+        let (Some(&(t0, t1a)), Some(&(t2, t1))) = (self.markers.first(), self.markers.last())
+        else {
+            return Err(CalibrationError::NoData(
+                "no steering tests recorded".into(),
+            ));
+        };
+        let rec = &self.steering;
+        let whole = rec.window(t0, t1, 1.0);
+        // Did the wheels move at all? The big steps span 2·step.
+        let (lo, hi) = whole
+            .samples
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+                (lo.min(s.1), hi.max(s.1))
+            });
+        let span = 2.0 * self.params.step.min(self.params.max_angle);
+        if !(hi - lo >= 0.3 * span) {
+            return Err(CalibrationError::NoResponse(format!(
+                "the sensed angle moved {:.1}° for commands {:.1}° apart",
+                (hi - lo).max(0.0).to_degrees(),
+                span.to_degrees()
+            )));
+        }
+        let fit = fit_steering(&whole)
+            .ok_or_else(|| CalibrationError::NoData("too few wheel-angle samples".into()))?;
+        let first = fit_steering_from(&rec.window(t0, t1a, 1.0), Some(&fit.model));
+        let second = fit_steering_from(&rec.window(t2, t1, 1.0), Some(&fit.model));
+        if let (Some(a), Some(b)) = (first, second) {
+            if let Some(why) = disagreement(&a, &b) {
+                return Err(CalibrationError::Inconsistent(why));
+            }
+        }
+        // The sensor's own scatter, from the drive's holds (wheels still), against the fit.
+        let noise = self
+            .holds
+            .iter()
+            .filter_map(|h| {
+                let n = h.sensed.len();
+                (n > 10).then(|| {
+                    let m = h.sensed.iter().map(|s| s.1).sum::<f64>() / n as f64;
+                    (h.sensed.iter().map(|s| (s.1 - m).powi(2)).sum::<f64>() / n as f64).sqrt()
+                })
+            })
+            .fold(0.0, f64::max);
+        let allowed = 2.0 * noise + 0.15f64.to_radians();
+        if fit.rms > allowed {
+            return Err(CalibrationError::Inconsistent(format!(
+                "the steering model leaves {:.2}° RMS unexplained (sensor noise {:.2}°)",
+                fit.rms.to_degrees(),
+                noise.to_degrees()
+            )));
+        }
+        let results: Vec<_> = self
+            .holds
+            .iter()
+            .filter_map(|h| hold_result(h, &self.params.geometry))
+            .collect();
+        let was = fit_was(&results).ok_or_else(|| {
+            CalibrationError::NoData(format!(
+                "{} of {} drive holds measured: the sensor's gain needs three",
+                results.len(),
+                self.holds.len()
+            ))
+        })?;
+        if was.rms > 0.3f64.to_radians() {
+            return Err(CalibrationError::Inconsistent(format!(
+                "the drive's sensed angles lie {:.2}° RMS off a line through the yaw rates",
+                was.rms.to_degrees()
+            )));
+        }
+        let g = was.gain;
+        let m = fit.model.to_true(g);
+        let est = |value: f64, i: usize, scale: f64| Estimate {
+            value,
+            sd: fit.sigma[i].map(|s| s * scale),
+        };
+        // The rate is identified where the fitted response runs at it long enough for the
+        // data to pin it (σ within 5 %); else only the fastest motion is known.
+        let rate_reached =
+            fit.rate_bound_s > 0.5 && fit.sigma[2].is_some_and(|s| s < 0.05 * fit.model.rate);
+        Ok(Calibration {
+            dead_time: est(m.dead_time, 0, 1.0),
+            tau: est(m.tau, 1, 1.0),
+            rate: if rate_reached {
+                est(m.rate, 2, 1.0 / g)
+            } else {
+                Estimate {
+                    value: fit.fastest / g,
+                    sd: None,
+                }
+            },
+            rate_reached,
+            deadband: est(m.deadband, 3, 1.0 / g),
+            backlash: est(m.backlash, 4, 1.0 / g),
+            was_gain: Estimate {
+                value: g,
+                sd: Some(was.gain_sd),
+            },
+            was_offset: Estimate {
+                value: was.offset,
+                sd: Some(was.offset_sd),
+            },
+            steering_rms: fit.rms,
+            steering_fit: fit,
+            was_fit: was,
+        })
+    }
+}
+
+impl Calibration {
+    /// The calibration as the TOML the technician puts into the configuration (each key into
+    /// its table), with the uncertainties as comments.
+    pub fn toml_fragment(&self) -> String {
+        let sd = |e: &Estimate, scale: f64, digits: usize| match e.sd {
+            Some(s) => format!("± {:.*}", digits, s * scale),
+            None => "not determined".to_string(),
+        };
+        let deg = 1f64.to_degrees();
+        let lost = self.deadband.value + 0.5 * self.backlash.value;
+        let rate_note = if self.rate_reached {
+            sd(&self.rate, deg, 1)
+        } else {
+            "not reached by the tests: the fastest motion seen, a lower bound".to_string()
+        };
+        format!(
+            "# Written by `agsteer calibrate`: copy each key into its table of the configuration.\n\
+             [safety]\n\
+             actuator_dead_time_s = {:.3}  # {}\n\
+             actuator_tau_s = {:.3}  # {}\n\
+             actuator_rate_deg_s = {:.1}  # {}\n\
+             \n[track]\n\
+             # The prediction horizon covers the steering's dead time.\n\
+             lead_time_s = {:.3}\n\
+             # Lost motion = deadband {:.2}° ({}) + half the backlash {:.2}° ({}).\n\
+             lost_motion_initial_deg = {:.2}\n\
+             \n[vehicle]\n\
+             was_gain = {:.4}  # {}\n\
+             was_offset_deg = {:.2}  # {}\n",
+            self.dead_time.value,
+            sd(&self.dead_time, 1.0, 3),
+            self.tau.value,
+            sd(&self.tau, 1.0, 3),
+            self.rate.value * deg,
+            rate_note,
+            self.dead_time.value.min(1.0),
+            self.deadband.value * deg,
+            sd(&self.deadband, deg, 2),
+            self.backlash.value * deg,
+            sd(&self.backlash, deg, 2),
+            lost * deg,
+            self.was_gain.value,
+            sd(&self.was_gain, 1.0, 4),
+            self.was_offset.value * deg,
+            sd(&self.was_offset, deg, 2),
+        )
+    }
+}

@@ -1,0 +1,399 @@
+//! The guided procedure: a state machine fed the bus's inputs and ticked every control period,
+//! answering the steering command to send and what the operator is asked to do. No I/O: the
+//! caller (the simulator on the in-memory bus, a live bus) moves the frames.
+//!
+//! 1. **Stop.** The operator stops the tractor (the steering tests run at a standstill, below
+//!    `standstill_speed`).
+//! 2. **Steering tests**, twice: from 4° right of centre to centre (the play taken up from
+//!    one side), then steps of ±`step` (dead time, lag, rate limit) and small steps forward and
+//!    back (deadband and backlash). The two repetitions are fitted apart and must agree.
+//! 3. **Drive**: the operator drives ahead at about `drive_speed`; the wheels are held at a
+//!    sensed 0, ±`hold_angle`, ±`hold_angle`/2 in turn, settling then measuring the yaw rate
+//!    (the WAS gain and zero, [`super::was`]).
+//!
+//! Refused, with the reason: moving faster than allowed in a phase, the operator taking the
+//! wheel (override status, a disengage), the wheels held away from the command, no response.
+
+use super::identify::SteeringRecord;
+use super::was::Hold;
+use super::{CalibrationError, CalibrationParams};
+use crate::input::{Input, OperatorCommand, SensorStatus};
+
+/// What the operator is asked to do.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Instruction {
+    /// Stop and stay stopped (hands off the wheel).
+    Stop,
+    /// Drive ahead at this speed, m/s, on open ground (hands off the wheel).
+    Drive(f64),
+    /// Done: take over.
+    Finished,
+}
+
+/// One tick's answer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tick {
+    /// The command to send (sensor terms, rad); `None`: send a disengaged command.
+    pub command: Option<f64>,
+    pub instruction: Instruction,
+    /// The phase, for progress messages.
+    pub phase: &'static str,
+}
+
+/// The steering tests of one repetition: (offset from centre in units of the small-step
+/// degree for the small steps, hold s). The first two entries preload the play from below.
+const PRELOAD: [(f64, f64); 2] = [(-4.0, 3.0), (0.0, 4.0)];
+/// Big steps (× `step`) then small steps (degrees).
+const BIG: [(f64, f64); 4] = [(1.0, 4.0), (-1.0, 4.5), (1.0, 4.5), (0.0, 4.0)];
+const SMALL: [(f64, f64); 7] = [
+    (3.0, 2.5),
+    (4.0, 2.5),
+    (2.5, 2.5),
+    (1.5, 2.5),
+    (3.0, 2.5),
+    (0.5, 2.5),
+    (0.0, 3.0),
+];
+/// Repetitions of the steering tests.
+pub const REPETITIONS: usize = 2;
+/// Drive holds: settle, then measure, s.
+const HOLD_SETTLE: f64 = 4.0;
+const HOLD_MEASURE: f64 = 12.0;
+/// Sensed angles held on the drive, × `hold_angle`.
+const HOLDS: [f64; 5] = [0.0, 1.0, -1.0, 0.5, -0.5];
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Phase {
+    WaitStop { since: Option<f64> },
+    Steering,
+    WaitDrive { since: Option<f64> },
+    Holds,
+    Done,
+}
+
+/// The procedure's state and what it recorded.
+#[derive(Debug, Clone)]
+pub struct Session {
+    pub(super) params: CalibrationParams,
+    phase: Phase,
+    phase_start: f64,
+    /// Steering script: (offset rad, hold s), and where the pattern of each repetition starts
+    /// (s from the steering phase's start).
+    script: Vec<(f64, f64)>,
+    pub(super) markers: Vec<(f64, f64)>,
+    pub(super) steering: SteeringRecord,
+    pub(super) holds: Vec<Hold>,
+    last_command: Option<f64>,
+    speed: Option<(f64, f64)>,
+    wheel_speed: Option<(f64, f64)>,
+    sensed: Option<f64>,
+    heading_seen: bool,
+    started: Option<f64>,
+}
+
+impl Session {
+    pub fn new(params: CalibrationParams) -> Session {
+        let small = 1f64.to_radians();
+        let mut script = Vec::new();
+        for _ in 0..REPETITIONS {
+            for (o, h) in PRELOAD {
+                script.push((o * small, h));
+            }
+            for (o, h) in BIG {
+                script.push((o * params.step, h));
+            }
+            for (o, h) in SMALL {
+                script.push((o * small, h));
+            }
+        }
+        Session {
+            params,
+            phase: Phase::WaitStop { since: None },
+            phase_start: 0.0,
+            script,
+            markers: Vec::new(),
+            steering: SteeringRecord {
+                approach: 1.0,
+                ..Default::default()
+            },
+            holds: Vec::new(),
+            last_command: None,
+            speed: None,
+            wheel_speed: None,
+            sensed: None,
+            heading_seen: false,
+            started: None,
+        }
+    }
+
+    /// The steering tests' duration, s.
+    pub fn steering_duration(&self) -> f64 {
+        self.script.iter().map(|s| s.1).sum()
+    }
+
+    /// Feed one input.
+    pub fn on_input(&mut self, input: &Input) -> Result<(), CalibrationError> {
+        match input {
+            Input::WheelAngle(w) => {
+                if w.status == SensorStatus::OperatorOverride && self.active() {
+                    return Err(CalibrationError::OperatorIntervened {
+                        t: w.t,
+                        how: "the steering reports an operator override".into(),
+                    });
+                }
+                if let Some(a) = w.angle.filter(|a| a.is_finite()) {
+                    self.sensed = Some(a);
+                    match self.phase {
+                        Phase::Steering => self.steering.samples.push((w.t, a)),
+                        Phase::Holds => {
+                            if let Some(h) = self.measuring_hold(w.t) {
+                                h.sensed.push((w.t, a));
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            Input::Heading(h) => {
+                self.heading_seen = true;
+                if let Some(hold) = self.measuring_hold(h.t) {
+                    hold.heading.push((h.t, h.heading));
+                }
+            }
+            Input::CourseSpeed(c) => {
+                if let Some(v) = c.speed_mps.filter(|v| v.is_finite()) {
+                    self.speed = Some((c.t, v));
+                    if let Some(hold) = self.measuring_hold(c.t) {
+                        hold.speed.push((c.t, v));
+                    }
+                }
+                // Without a heading receiver the course over ground turns at the same rate.
+                if !self.heading_seen {
+                    if let (Some(course), Some(hold)) = (c.course, self.measuring_hold(c.t)) {
+                        hold.heading.push((c.t, course));
+                    }
+                }
+            }
+            Input::WheelSpeed(s) => {
+                if let Some(v) = s.speed_mps.filter(|v| v.is_finite()) {
+                    self.wheel_speed = Some((s.t, v));
+                }
+            }
+            Input::Operator(o) if self.active() => {
+                if matches!(
+                    o.command,
+                    OperatorCommand::Disengage | OperatorCommand::Pause
+                ) {
+                    return Err(CalibrationError::OperatorIntervened {
+                        t: o.t,
+                        how: format!("the operator sent {:?}", o.command),
+                    });
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn active(&self) -> bool {
+        matches!(self.phase, Phase::Steering | Phase::Holds)
+    }
+
+    /// The hold being measured at `t`, if any (the settling part is not recorded).
+    fn measuring_hold(&mut self, t: f64) -> Option<&mut Hold> {
+        if self.phase != Phase::Holds {
+            return None;
+        }
+        let span = HOLD_SETTLE + HOLD_MEASURE;
+        let into = t - self.phase_start;
+        let i = (into / span).floor();
+        if i < 0.0 || into - i * span < HOLD_SETTLE {
+            return None;
+        }
+        self.holds.get_mut(i as usize)
+    }
+
+    /// The speed now: the larger of the latest GNSS and wheel speeds not older than 1 s.
+    fn speed_at(&self, t: f64) -> Option<f64> {
+        [self.speed, self.wheel_speed]
+            .iter()
+            .flatten()
+            .filter(|(ts, _)| t - ts <= 1.0)
+            .map(|(_, v)| v.abs())
+            .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))
+    }
+
+    fn enter(&mut self, phase: Phase, t: f64) {
+        self.phase = phase;
+        self.phase_start = t;
+    }
+
+    fn too_fast(&self, phase: &'static str, speed: f64, limit: f64) -> CalibrationError {
+        CalibrationError::TooFast {
+            phase,
+            speed_kmh: speed * 3.6,
+            limit_kmh: limit * 3.6,
+        }
+    }
+
+    /// One control period at `t`.
+    pub fn tick(&mut self, t: f64) -> Result<Tick, CalibrationError> {
+        let p = self.params;
+        let started = *self.started.get_or_insert(t);
+        let speed = self.speed_at(t);
+        let limit = |a: f64| a.clamp(-p.max_angle, p.max_angle);
+        let out = match self.phase {
+            Phase::WaitStop { since } => {
+                let stopped = speed.is_some_and(|v| v <= p.standstill_speed);
+                let since = if stopped { since.or(Some(t)) } else { None };
+                if since.is_some_and(|s| t - s >= 1.0) {
+                    self.enter(Phase::Steering, t);
+                    self.steering.commands.clear();
+                    self.steering.samples.clear();
+                    return self.tick(t);
+                }
+                if t - started > p.wait_timeout {
+                    return Err(match speed {
+                        Some(v) => {
+                            self.too_fast("stopping for the steering tests", v, p.standstill_speed)
+                        }
+                        None => CalibrationError::NoData(
+                            "no speed (GNSS or wheel speed) received".into(),
+                        ),
+                    });
+                }
+                self.phase = Phase::WaitStop { since };
+                Tick {
+                    command: None,
+                    instruction: Instruction::Stop,
+                    phase: "stop the tractor",
+                }
+            }
+            Phase::Steering => {
+                if let Some(v) = speed.filter(|v| *v > p.standstill_speed) {
+                    return Err(self.too_fast("steering tests", v, p.standstill_speed));
+                }
+                let into = t - self.phase_start;
+                let mut acc = 0.0;
+                let mut command = None;
+                let per_rep = PRELOAD.len() + BIG.len() + SMALL.len();
+                for (k, &(o, h)) in self.script.iter().enumerate() {
+                    if k % per_rep == PRELOAD.len() && self.markers.len() <= k / per_rep {
+                        let rep_end = acc
+                            + self.script[k..k + per_rep - PRELOAD.len()]
+                                .iter()
+                                .map(|s| s.1)
+                                .sum::<f64>();
+                        self.markers
+                            .push((self.phase_start + acc, self.phase_start + rep_end));
+                    }
+                    if into < acc + h {
+                        command = Some(limit(o));
+                        break;
+                    }
+                    acc += h;
+                }
+                match command {
+                    Some(c) => {
+                        if self.last_command != Some(c) {
+                            self.steering.commands.push((t, c));
+                        }
+                        Tick {
+                            command: Some(c),
+                            instruction: Instruction::Stop,
+                            phase: "steering tests",
+                        }
+                    }
+                    None => {
+                        self.enter(Phase::WaitDrive { since: None }, t);
+                        return self.tick(t);
+                    }
+                }
+            }
+            Phase::WaitDrive { since } => {
+                if let Some(v) = speed.filter(|v| *v > p.drive_speed_max) {
+                    return Err(self.too_fast("the drive", v, p.drive_speed_max));
+                }
+                let ok = speed.is_some_and(|v| v >= p.drive_speed_min);
+                let since = if ok { since.or(Some(t)) } else { None };
+                if since.is_some_and(|s| t - s >= 2.0) {
+                    self.enter(Phase::Holds, t);
+                    self.holds = vec![Hold::default(); HOLDS.len()];
+                    return self.tick(t);
+                }
+                if t - self.phase_start > p.wait_timeout {
+                    return Err(CalibrationError::NoData(format!(
+                        "the tractor did not reach {:.1} km/h within {:.0} s",
+                        p.drive_speed_min * 3.6,
+                        p.wait_timeout
+                    )));
+                }
+                self.phase = Phase::WaitDrive { since };
+                Tick {
+                    command: Some(0.0),
+                    instruction: Instruction::Drive(p.drive_speed),
+                    phase: "drive ahead",
+                }
+            }
+            Phase::Holds => {
+                match speed {
+                    Some(v) if v > p.drive_speed_max => {
+                        return Err(self.too_fast("the drive", v, p.drive_speed_max))
+                    }
+                    Some(v) if v < p.drive_speed_min => {
+                        return Err(CalibrationError::NoData(format!(
+                            "the tractor slowed to {:.1} km/h during the drive (at least {:.1})",
+                            v * 3.6,
+                            p.drive_speed_min * 3.6
+                        )))
+                    }
+                    _ => {}
+                }
+                let span = HOLD_SETTLE + HOLD_MEASURE;
+                let into = t - self.phase_start;
+                let i = (into / span).floor() as usize;
+                match HOLDS.get(i) {
+                    Some(&h) => {
+                        let c = limit(h * p.hold_angle);
+                        // The wheels must follow while measuring: held away, someone steers.
+                        if into - i as f64 * span > HOLD_SETTLE {
+                            if let Some(s) =
+                                self.sensed.filter(|s| (s - c).abs() > p.follow_tolerance)
+                            {
+                                return Err(CalibrationError::OperatorIntervened {
+                                    t,
+                                    how: format!(
+                                        "the wheels are held at {:.1}° against a command of {:.1}°",
+                                        s.to_degrees(),
+                                        c.to_degrees()
+                                    ),
+                                });
+                            }
+                        }
+                        Tick {
+                            command: Some(c),
+                            instruction: Instruction::Drive(p.drive_speed),
+                            phase: "drive: wheel-angle sensor",
+                        }
+                    }
+                    None => {
+                        self.enter(Phase::Done, t);
+                        return self.tick(t);
+                    }
+                }
+            }
+            Phase::Done => Tick {
+                command: None,
+                instruction: Instruction::Finished,
+                phase: "done",
+            },
+        };
+        self.last_command = out.command;
+        Ok(out)
+    }
+
+    /// Whether the procedure has run to its end.
+    pub fn is_done(&self) -> bool {
+        self.phase == Phase::Done
+    }
+}

@@ -1,0 +1,44 @@
+//! A sampled subset of the robustness envelope (issue 15 point 3, `agsteer accuracy
+//! --envelope`): a few cells, default tracker only, each held to about twice the XTE RMS the
+//! full run measured (docs/envelope.md), so a change that makes the tracker less robust fails
+//! here without the hour the whole envelope takes. Simulated time only.
+
+use agsteer::config::TrackerChoice;
+use agsteer::demo::envelope::{cell_config, run_cell, Calibration, MATRIX};
+use std::path::Path;
+
+/// (variation, scenario, measured RMS cm in docs/envelope.md).
+const CELLS: &[(&str, &str, f64)] = &[
+    ("nominal", "straight_10kmh", 0.29),
+    ("gnss_white_3cm", "straight_10kmh", 0.73),
+    ("backlash_1", "straight_10kmh", 0.36),
+    ("dead_time_0.25", "straight_10kmh", 0.31),
+    ("deadband_1", "curve_r30", 0.63),
+];
+
+#[test]
+fn sampled_envelope_cells_stay_within_twice_their_figures() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut out = Vec::new();
+    for &(var, scenario, rms_cm) in CELLS {
+        let v = MATRIX
+            .iter()
+            .find(|v| v.name == var)
+            .unwrap_or_else(|| panic!("variation {var}"));
+        let path = root.join(format!("tools/scenarios/{scenario}.toml"));
+        let cfg = cell_config(&path, v, &[], Calibration::Truth).expect("valid cell");
+        let cell = run_cell(var, scenario, &cfg, &[TrackerChoice::Predictive]);
+        let r = cell.default_result().expect("ran");
+        let got = 100.0 * r.xte_rms_m;
+        out.push(format!(
+            "{var}/{scenario}: {got:.2} cm (figure {rms_cm}, bound {:.2})",
+            2.0 * rms_cm
+        ));
+        assert!(
+            r.finished && got <= 2.0 * rms_cm,
+            "{}",
+            out.join("\n")
+        );
+    }
+    eprintln!("{}", out.join("\n"));
+}
