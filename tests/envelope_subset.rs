@@ -34,11 +34,7 @@ fn sampled_envelope_cells_stay_within_twice_their_figures() {
             "{var}/{scenario}: {got:.2} cm (figure {rms_cm}, bound {:.2})",
             2.0 * rms_cm
         ));
-        assert!(
-            r.finished && got <= 2.0 * rms_cm,
-            "{}",
-            out.join("\n")
-        );
+        assert!(r.finished && got <= 2.0 * rms_cm, "{}", out.join("\n"));
     }
     eprintln!("{}", out.join("\n"));
 }
