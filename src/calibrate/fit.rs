@@ -38,8 +38,8 @@ pub fn nelder_mead<const N: usize>(
         }
         let mut centroid = [0.0; N];
         for p in pts.iter().take(N) {
-            for j in 0..N {
-                centroid[j] += p.0[j] / N as f64;
+            for (c, x) in centroid.iter_mut().zip(p.0) {
+                *c += x / N as f64;
             }
         }
         let along = |c: f64| {
@@ -75,8 +75,8 @@ pub fn nelder_mead<const N: usize>(
         // Shrink towards the best.
         let b = pts[0].0;
         for p in pts.iter_mut().skip(1) {
-            for j in 0..N {
-                p.0[j] = b[j] + 0.5 * (p.0[j] - b[j]);
+            for (x, bj) in p.0.iter_mut().zip(b) {
+                *x = bj + 0.5 * (*x - bj);
             }
             p.1 = f(&p.0);
         }

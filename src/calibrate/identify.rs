@@ -93,10 +93,10 @@ pub fn fit_steering_from(
     let times: Vec<f64> = rec.samples.iter().map(|s| s.0).collect();
     let meas: Vec<f64> = rec.samples.iter().map(|s| s.1).collect();
     let start = meas.iter().take(5).sum::<f64>() / meas.len().min(5) as f64;
-    // Fastest motion over ~50 ms windows.
+    // Fastest sensed motion over ~100 ms windows (a start for the rate).
     let mut fastest: f64 = 0.0;
     for i in 0..n {
-        if let Some(j) = (i + 1..n).find(|&j| times[j] - times[i] >= 0.05) {
+        if let Some(j) = (i + 1..n).find(|&j| times[j] - times[i] >= 0.1) {
             fastest = fastest.max((meas[j] - meas[i]).abs() / (times[j] - times[i]));
         }
     }
@@ -113,8 +113,9 @@ pub fn fit_steering_from(
         );
         pred.iter().zip(&meas).map(|(p, y)| (p - y) * (p - y)).sum()
     };
-    // Start: the best of a grid over dead time and lag, the rate above the fastest motion.
-    let rate0 = (1.5 * fastest).clamp(0.05, RATE_CEILING);
+    // Start: the best of a grid over dead time and lag, with the rate at the fastest sensed
+    // motion (a steering that ran at its limit) or half as fast again (one that did not).
+    let rates = [fastest, 1.5 * fastest].map(|r| r.clamp(0.05, RATE_CEILING));
     let mut best = (f64::INFINITY, [0.0; 5]);
     if let Some(m) = near {
         let x = [
@@ -131,10 +132,12 @@ pub fn fit_steering_from(
             break;
         }
         for &tau in &[0.03, 0.06, 0.1, 0.15, 0.22, 0.32, 0.45, 0.65, 0.9] {
-            let x = [di as f64 * 0.02, f64::ln(tau), rate0.ln(), 0.0, 0.0];
-            let c = cost(&model_of(&x), &mut pred);
-            if c < best.0 {
-                best = (c, x);
+            for rate in rates {
+                let x = [di as f64 * 0.02, f64::ln(tau), rate.ln(), 0.0, 0.0];
+                let c = cost(&model_of(&x), &mut pred);
+                if c < best.0 {
+                    best = (c, x);
+                }
             }
         }
     }

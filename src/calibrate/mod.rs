@@ -192,7 +192,7 @@ impl Session {
                 (lo.min(s.1), hi.max(s.1))
             });
         let span = 2.0 * self.params.step.min(self.params.max_angle);
-        if !(hi - lo >= 0.3 * span) {
+        if hi - lo < 0.3 * span || !(hi - lo).is_finite() {
             return Err(CalibrationError::NoResponse(format!(
                 "the sensed angle moved {:.1}° for commands {:.1}° apart",
                 (hi - lo).max(0.0).to_degrees(),
