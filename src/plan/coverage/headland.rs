@@ -308,17 +308,22 @@ pub fn headland_tracks(boundary: &[Vec2], p: &CoverageParams) -> Vec<Vec<Vec2>> 
         }
         // The opening rounds the convex corners; concave kinks that the offset itself made
         // (where offsets of distant edges meet) are cut away by discs and opened again.
+        // Each round opens the area minus all the discs so far: opening an opened area again
+        // shrinks its arcs of radius rs to points, and the polygon clipping of those
+        // degenerate offsets took seconds.
         let mut opened = offset(&offset(&area, -rs), rs);
+        let mut kink_discs: Vec<Area> = Vec::new();
         for _ in 0..KINK_ROUNDS {
             let kinks = concave_kinks(&opened, p.point_spacing, p.r_min);
             if kinks.is_empty() {
                 break;
             }
-            let discs: Vec<Area> = kinks
-                .iter()
-                .map(|(q, out)| disc(q + out * (rs - KINK_DISC_DEPTH), rs))
-                .collect();
-            opened = offset(&offset(&difference(&opened, &discs), -rs), rs);
+            kink_discs.extend(
+                kinks
+                    .iter()
+                    .map(|(q, out)| disc(q + out * (rs - KINK_DISC_DEPTH), rs)),
+            );
+            opened = offset(&offset(&difference(&area, &kink_discs), -rs), rs);
         }
         tracks.extend(tracks_of(&opened, p.point_spacing));
     }

@@ -9,6 +9,7 @@ pub mod decompose;
 pub mod geometry;
 pub mod headland;
 pub mod metrics;
+pub mod rings;
 mod runs;
 pub mod swath_angle;
 pub mod swaths;
@@ -91,6 +92,8 @@ pub struct FieldPlan {
     pub overlap_m2: f64,
     /// Turn shapes solved in the canonical frame (each reused for every alike turn).
     pub turn_shapes_solved: usize,
+    /// What the planner could not make clear, each naming the place (local frame, m).
+    pub warnings: Vec<String>,
 }
 
 /// A point of a path keeps the implement inside the field and off the obstacles: inside the
@@ -201,6 +204,11 @@ impl CoverageParams {
     }
 }
 
+/// How far a transit that cannot keep the implement clear of the edge keeps its path inside
+/// the field and off the obstacles, m (about half a tractor's width; the implement is lifted
+/// and may reach over the edge there): the guarantee for paths that do not work.
+pub const TRANSIT_CLEARANCE_M: f64 = 1.5;
+
 /// States a transit's waypoint search may expand before giving up.
 const ROUTE_MAX_EXPANSIONS: usize = 20_000;
 
@@ -252,16 +260,25 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         half + headland::chord_margin(p) - headland::CHORD_MARGIN,
     );
     let clear = |q: &Vec2| clear_map.clear(q);
-    // Waypoints for transits that cannot go direct: a grid of clear points over the field.
-    // (Built on first need: most plans never need it.)
-    let waypoint_grid = std::cell::OnceCell::new();
-    let waypoint_grid = || {
-        waypoint_grid.get_or_init(|| {
-            let (lo, hi) = crate::geo::polygon::bbox(field.boundary.iter())
-                .unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
-            transit::WaypointGrid::new(lo, hi, 2.0 * p.r_min, 20_000, &clear)
-        })
+    // Transits that find no way with the implement clear of the edge keep the tractor inside
+    // the field and off the obstacles (the guarantee for paths that do not work).
+    let loose_map = ClearMap::new(
+        field,
+        half.min(TRANSIT_CLEARANCE_M) + headland::chord_margin(p) - headland::CHORD_MARGIN,
+    );
+    let loose = |q: &Vec2| loose_map.clear(q);
+    // Waypoints for detours and transits that cannot go direct: grids of clear points over
+    // the field. (Built on first need: most plans never need them.)
+    let grid_of = |usable: &dyn Fn(&Vec2) -> bool| {
+        let (lo, hi) = crate::geo::polygon::bbox(field.boundary.iter())
+            .unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
+        transit::WaypointGrid::new(lo, hi, 2.0 * p.r_min, 20_000, usable)
     };
+    let waypoint_grid = std::cell::OnceCell::new();
+    let waypoint_grid = || waypoint_grid.get_or_init(|| grid_of(&clear));
+    let loose_grid = std::cell::OnceCell::new();
+    let loose_grid = || loose_grid.get_or_init(|| grid_of(&loose));
+    let warnings = std::cell::RefCell::new(Vec::<String>::new());
 
     // Cells and their swath directions.
     let global_angle = match p.swath_angle {
@@ -293,6 +310,30 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
             }
         }
     }
+
+    // Headland passes: the field's (outermost first), then the obstacles' (nearest first),
+    // those that keep clear of the field edge and the other obstacles.
+    let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
+        headland::headland_tracks(&field.boundary, p).into();
+    let mut obstacle_tracks: Vec<Vec<Vec2>> = headland::obstacle_tracks(&large, p)
+        .into_iter()
+        .filter(|t| {
+            let ok = t.iter().all(&clear);
+            if !ok {
+                tracing::debug!("an obstacle headland pass would leave the field; skipped");
+            }
+            ok
+        })
+        .collect();
+    // Transits may follow the headland passes (field and obstacles) where they are clear.
+    let rings = rings::Rings::new(
+        &field_tracks
+            .iter()
+            .chain(obstacle_tracks.iter())
+            .cloned()
+            .collect::<Vec<_>>(),
+        &clear,
+    );
 
     let tp = p.turn_params();
     let mut cache = crate::plan::turns::TurnCache::default();
@@ -356,26 +397,36 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
                 heading_at(target, cut_next),
             )
         };
-        // Without shortening any work first (direct, then through waypoints), then pulling
-        // the ends back metre by metre, then the waypoints again.
-        #[derive(Clone, Copy)]
+        // Without shortening any work first (direct, then along the headland), then pulling
+        // the ends back metre by metre, then along the headland again; all with the implement
+        // clear of the edge. Then with only the tractor inside the field: direct, along the
+        // headland, through waypoints.
+        #[derive(Clone, Copy, Debug)]
         enum Way {
             Direct,
+            Headland,
             Waypoints,
         }
-        let mut attempts = vec![(0, Way::Direct), (0, Way::Waypoints)];
-        attempts.extend((1..=max_cut).map(|t| (t, Way::Direct)));
-        attempts.push((max_cut, Way::Waypoints));
+        let mut attempts = vec![(0, Way::Direct, false), (0, Way::Headland, false)];
+        attempts.extend((1..=max_cut).map(|t| (t, Way::Direct, false)));
+        attempts.push((max_cut, Way::Headland, false));
+        attempts.extend([
+            (0, Way::Direct, true),
+            (0, Way::Headland, true),
+            (0, Way::Waypoints, true),
+        ]);
         let mut found = None;
-        for (t, way) in attempts {
+        for (t, way, relaxed) in attempts {
             let (cp, cn, f, hf, q, hq) = poses(t);
             if t > 0 && cp == 0 && cn == 0 {
                 continue;
             }
             let (r, step) = (p.r_min, p.point_spacing);
+            let ok: &dyn Fn(&Vec2) -> bool = if relaxed { &loose } else { &clear };
             let pts = match way {
-                Way::Direct => transit::transit(f, hf, q, hq, r, step, &clear)
+                Way::Direct => transit::transit(f, hf, q, hq, r, step, ok)
                     .and_then(|(pts, ok)| ok.then_some(pts)),
+                Way::Headland => rings.transit(f, hf, q, hq, r, step, ok),
                 Way::Waypoints => transit::route_graph(
                     f,
                     hf,
@@ -383,23 +434,30 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
                     hq,
                     r,
                     step,
-                    &clear,
-                    waypoint_grid(),
+                    ok,
+                    loose_grid(),
                     ROUTE_MAX_EXPANSIONS,
                 ),
             };
             if let Some(pts) = pts {
+                tracing::trace!(t, ?way, relaxed, "transit found");
                 found = Some((pts, cp, cn));
                 break;
             }
         }
         let (pts, cut_prev, cut_next) = match found {
             Some(x) => x,
-            // Nothing clear: the shortest direct curve (the plan's metrics will show it).
-            None => match transit::transit(from, h0, to, h, p.r_min, p.point_spacing, &clear) {
-                Some((pts, _)) => (pts, 0, 0),
-                None => return 0,
-            },
+            // No way inside the field: the shortest direct curve, reported.
+            None => {
+                warnings.borrow_mut().push(format!(
+                    "no transit inside the field from ({:.1}, {:.1}) to ({:.1}, {:.1}): the shortest curve is planned and leaves it",
+                    from.x, from.y, to.x, to.y
+                ));
+                match transit::transit(from, h0, to, h, p.r_min, p.point_spacing, &clear) {
+                    Some((pts, _)) => (pts, 0, 0),
+                    None => return 0,
+                }
+            }
         };
         if cut_prev > 0 {
             if let Some(last) = segments.last_mut() {
@@ -451,20 +509,6 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         )
     };
 
-    // Headland passes: the field's (outermost first), then the obstacles' (nearest first),
-    // those that keep clear of the field edge and the other obstacles.
-    let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
-        headland::headland_tracks(&field.boundary, p).into();
-    let mut obstacle_tracks: Vec<Vec<Vec2>> = headland::obstacle_tracks(&large, p)
-        .into_iter()
-        .filter(|t| {
-            let ok = t.iter().all(&clear);
-            if !ok {
-                tracing::debug!("an obstacle headland pass would leave the field; skipped");
-            }
-            ok
-        })
-        .collect();
     loop {
         let ring = match field_tracks.pop_front() {
             Some(r) => r,
@@ -600,6 +644,7 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         swaths: swath_total,
         overlap_m2,
         turn_shapes_solved: cache.solved,
+        warnings: warnings.into_inner(),
     })
 }
 

@@ -71,11 +71,27 @@ fn csc(
     for i in 1..n {
         pts.push(t1 + (t2 - t1) * (i as f64 / n as f64));
     }
+    // A straight much shorter than the point spacing: its end point would sit next to its
+    // start, and three-point curvature across such a short chord reads the whole chord angle
+    // of the arc before it; the second arc starts from the first's end instead.
+    let join = pts.len();
     arc(c2, theta, a2, s2, &mut pts);
+    if straight < 0.5 * step && pts.len() > join + 1 {
+        pts.remove(join);
+    }
     if let Some(last) = pts.last_mut() {
         *last = p2;
     }
     Some((length, pts))
+}
+
+/// Length of the shortest CSC curve from (`p1`, `h1`) to (`p2`, `h2`) with radius `r`, m.
+pub fn csc_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Option<f64> {
+    const WORDS: [(f64, f64); 4] = [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)];
+    WORDS
+        .iter()
+        .filter_map(|&(a, b)| csc(p1, h1, p2, h2, a, b, r, 1.0, false).map(|c| c.0))
+        .min_by(f64::total_cmp)
 }
 
 /// The shortest CSC transit for which `clear` holds at every point, else the shortest one

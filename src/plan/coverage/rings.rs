@@ -1,0 +1,278 @@
+//! Transits along the headland: the headland passes are closed, driveable tracks (curvature
+//! ≤ 1/r_min, clear of the edge by w/2), so a transit that cannot go direct can turn onto a
+//! pass, follow it and turn off it near its goal, as a driver does on the headland. Fields2Cover
+//! routes the same way (its route planner joins the swaths through the headland rings); this
+//! is a search over a few entry and exit points per ring, not over the whole field, so it costs
+//! a few Dubins curves where the waypoint search of [`super::transit::route_graph`] costs
+//! thousands.
+
+use super::transit::{csc_length, transit};
+use crate::geo::{vec_heading, Vec2};
+
+/// Points of a ring tried as the place to turn onto it (or off it), at most.
+const CANDIDATES_PER_END: usize = 24;
+
+/// Joins (entry, exit) verified point by point before giving up on a ring direction.
+const MAX_VERIFIED: usize = 48;
+
+/// One closed track: points (the first not repeated), the length along it, which points are
+/// clear.
+#[derive(Debug, Clone)]
+struct Ring {
+    pts: Vec<Vec2>,
+    /// `cum[i]`: length from `pts[0]` to `pts[i]`; `cum[n]` the whole ring, m.
+    cum: Vec<f64>,
+    /// `blocked[i]`: points among `pts[..i]` that are not clear (prefix counts).
+    blocked: Vec<u32>,
+}
+
+impl Ring {
+    fn new(track: &[Vec2], clear: &dyn Fn(&Vec2) -> bool) -> Option<Self> {
+        let mut pts: Vec<Vec2> = track.to_vec();
+        if pts.len() >= 2 && (pts[pts.len() - 1] - pts[0]).norm() < 1e-9 {
+            pts.pop();
+        }
+        if pts.len() < 4 {
+            return None;
+        }
+        let n = pts.len();
+        let mut cum = Vec::with_capacity(n + 1);
+        let mut blocked = Vec::with_capacity(n + 1);
+        let (mut len, mut b) = (0.0, 0u32);
+        for i in 0..n {
+            cum.push(len);
+            blocked.push(b);
+            len += (pts[(i + 1) % n] - pts[i]).norm();
+            b += u32::from(!clear(&pts[i]));
+        }
+        cum.push(len);
+        blocked.push(b);
+        if b as usize == n {
+            return None;
+        }
+        Some(Ring { pts, cum, blocked })
+    }
+
+    fn len(&self) -> usize {
+        self.pts.len()
+    }
+
+    /// Heading of travel at point `i` in direction `dir` (+1 along the indices, −1 against).
+    fn heading(&self, i: usize, dir: i32) -> f64 {
+        let n = self.len();
+        let j = if dir > 0 {
+            (i + 1) % n
+        } else {
+            (i + n - 1) % n
+        };
+        vec_heading(&(self.pts[j] - self.pts[i]))
+    }
+
+    /// Length along the ring from `i` to `j` in direction `dir`, m.
+    fn along(&self, i: usize, j: usize, dir: i32) -> f64 {
+        let total = self.cum[self.len()];
+        let d = if dir > 0 {
+            self.cum[j] - self.cum[i]
+        } else {
+            self.cum[i] - self.cum[j]
+        };
+        d.rem_euclid(total)
+    }
+
+    /// Are all points from `i` to `j` (inclusive) in direction `dir` clear?
+    fn stretch_clear(&self, i: usize, j: usize, dir: i32) -> bool {
+        let (a, b) = if dir > 0 { (i, j) } else { (j, i) };
+        // Points a..=b going up the indices, wrapping past the end.
+        let count = |from: usize, to_excl: usize| self.blocked[to_excl] - self.blocked[from];
+        if a <= b {
+            count(a, b + 1) == 0
+        } else {
+            count(a, self.len()) == 0 && count(0, b + 1) == 0
+        }
+    }
+
+    /// Points from `i` to `j` in direction `dir`, both included.
+    fn stretch(&self, i: usize, j: usize, dir: i32) -> Vec<Vec2> {
+        let n = self.len();
+        let mut out = vec![self.pts[i]];
+        let mut k = i;
+        while k != j {
+            k = if dir > 0 {
+                (k + 1) % n
+            } else {
+                (k + n - 1) % n
+            };
+            out.push(self.pts[k]);
+        }
+        out
+    }
+
+    /// Clear points near `q`: within `reach` m of the nearest, evenly thinned to at most
+    /// [`CANDIDATES_PER_END`].
+    fn near(&self, q: &Vec2, reach: f64) -> Vec<usize> {
+        let d: Vec<f64> = self.pts.iter().map(|p| (p - q).norm()).collect();
+        let nearest = d.iter().copied().fold(f64::INFINITY, f64::min);
+        let all: Vec<usize> = (0..self.len())
+            .filter(|&i| d[i] <= nearest + reach && self.blocked[i + 1] == self.blocked[i])
+            .collect();
+        let step = all.len().div_ceil(CANDIDATES_PER_END).max(1);
+        all.into_iter().step_by(step).collect()
+    }
+}
+
+/// The closed tracks a transit may follow.
+#[derive(Debug, Clone, Default)]
+pub struct Rings {
+    rings: Vec<Ring>,
+}
+
+impl Rings {
+    /// The tracks (closed: first point repeated last, or not) with their clear points.
+    pub fn new(tracks: &[Vec<Vec2>], clear: &dyn Fn(&Vec2) -> bool) -> Self {
+        Rings {
+            rings: tracks.iter().filter_map(|t| Ring::new(t, clear)).collect(),
+        }
+    }
+
+    /// A clear transit from (`p1`, heading `h1`) to (`p2`, `h2`): a Dubins curve of radius
+    /// `r` onto a ring, the ring's clear points, a Dubins curve off it; the shortest such of
+    /// the candidates tried, `None` when none is clear. Points about `step` m apart.
+    #[allow(clippy::too_many_arguments)]
+    pub fn transit(
+        &self,
+        p1: Vec2,
+        h1: f64,
+        p2: Vec2,
+        h2: f64,
+        r: f64,
+        step: f64,
+        clear: &dyn Fn(&Vec2) -> bool,
+    ) -> Option<Vec<Vec2>> {
+        let reach = 4.0 * r;
+        let mut best: Option<(f64, Vec<Vec2>)> = None;
+        for ring in &self.rings {
+            let entries = ring.near(&p1, reach);
+            let exits = ring.near(&p2, reach);
+            if entries.is_empty() || exits.is_empty() {
+                continue;
+            }
+            for dir in [1, -1] {
+                let ins: Vec<(usize, f64)> = entries
+                    .iter()
+                    .filter_map(|&i| {
+                        csc_length(p1, h1, ring.pts[i], ring.heading(i, dir), r).map(|l| (i, l))
+                    })
+                    .collect();
+                let outs: Vec<(usize, f64)> = exits
+                    .iter()
+                    .filter_map(|&j| {
+                        csc_length(ring.pts[j], ring.heading(j, dir), p2, h2, r).map(|l| (j, l))
+                    })
+                    .collect();
+                let mut joins: Vec<(f64, usize, usize)> = ins
+                    .iter()
+                    .flat_map(|&(i, li)| {
+                        outs.iter()
+                            .map(move |&(j, lj)| (li + ring.along(i, j, dir) + lj, i, j))
+                    })
+                    .filter(|&(_, i, j)| ring.stretch_clear(i, j, dir))
+                    .collect();
+                joins.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let mut curve_in = std::collections::HashMap::new();
+                let mut curve_out = std::collections::HashMap::new();
+                for &(cost, i, j) in joins.iter().take(MAX_VERIFIED) {
+                    if best.as_ref().is_some_and(|b| b.0 <= cost) {
+                        break;
+                    }
+                    let a = curve_in
+                        .entry(i)
+                        .or_insert_with(|| {
+                            transit(p1, h1, ring.pts[i], ring.heading(i, dir), r, step, clear)
+                                .and_then(|(pts, ok)| ok.then_some(pts))
+                        })
+                        .clone();
+                    let Some(a) = a else { continue };
+                    let b = curve_out
+                        .entry(j)
+                        .or_insert_with(|| {
+                            transit(ring.pts[j], ring.heading(j, dir), p2, h2, r, step, clear)
+                                .and_then(|(pts, ok)| ok.then_some(pts))
+                        })
+                        .clone();
+                    let Some(b) = b else { continue };
+                    let mut pts = a;
+                    pts.extend(ring.stretch(i, j, dir).into_iter().skip(1));
+                    pts.extend(b.into_iter().skip(1));
+                    let len = crate::geo::polygon::polyline_length(&pts);
+                    if best.as_ref().is_none_or(|b| len < b.0) {
+                        best = Some((len, pts));
+                    }
+                    break;
+                }
+            }
+        }
+        best.map(|b| b.1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geo::v2;
+
+    /// A U-shaped field's ring: the way from one arm's tip to the other's goes round the bay,
+    /// where a direct curve would cross it.
+    #[test]
+    fn a_transit_follows_the_ring_round_a_bay() {
+        // Track round a U (arms 20 m wide, bay 60 m wide and 80 m deep), 1 m apart.
+        let corners = [
+            v2(0.0, 0.0),
+            v2(100.0, 0.0),
+            v2(100.0, 100.0),
+            v2(80.0, 100.0),
+            v2(80.0, 20.0),
+            v2(20.0, 20.0),
+            v2(20.0, 100.0),
+            v2(0.0, 100.0),
+            v2(0.0, 0.0),
+        ];
+        let track = crate::geo::polygon::resample(&corners, 1.0);
+        // Clear: within 10.5 m of the track (a corridor), sharp corners allowed for the test.
+        let near_track = |q: &Vec2| {
+            corners
+                .windows(2)
+                .any(|s| crate::geo::polygon::point_segment_distance(q, &s[0], &s[1]) <= 10.5)
+        };
+        let rings = Rings::new(&[track], &near_track);
+        let from = v2(10.0, 90.0);
+        let to = v2(90.0, 90.0);
+        let pts = rings
+            .transit(
+                from,
+                std::f64::consts::FRAC_PI_2,
+                to,
+                -std::f64::consts::FRAC_PI_2,
+                3.0,
+                0.5,
+                &near_track,
+            )
+            .expect("a way round the bay");
+        assert!(pts.iter().all(near_track));
+        assert!((pts[0] - from).norm() < 1e-9);
+        assert!((pts[pts.len() - 1] - to).norm() < 1e-9);
+        // It went round the bottom of the U.
+        assert!(pts.iter().any(|q| q.y < 12.0));
+        // A direct curve would cross the bay.
+        let (direct, ok) = transit(
+            from,
+            std::f64::consts::FRAC_PI_2,
+            to,
+            -std::f64::consts::FRAC_PI_2,
+            3.0,
+            0.5,
+            &near_track,
+        )
+        .unwrap();
+        assert!(!ok && !direct.is_empty());
+    }
+}
