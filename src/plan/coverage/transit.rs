@@ -355,6 +355,27 @@ pub fn route_graph(
     None
 }
 
+/// `points` without those closer than `min_gap` m to the point kept before them (the last point
+/// is kept, the one before it dropped instead): where curves are joined (an arc's end, a short
+/// straight, the next arc) a chord of a few centimetres makes three-point curvature read the
+/// whole chord angle of the arc next to it.
+pub fn thin(points: Vec<Vec2>, min_gap: f64) -> Vec<Vec2> {
+    let Some(&last) = points.last() else {
+        return points;
+    };
+    let mut out: Vec<Vec2> = Vec::with_capacity(points.len());
+    for q in &points[..points.len() - 1] {
+        if out.last().is_none_or(|l| (q - l).norm() >= min_gap) {
+            out.push(*q);
+        }
+    }
+    while out.len() > 1 && out.last().is_some_and(|l| (last - l).norm() < min_gap) {
+        out.pop();
+    }
+    out.push(last);
+    out
+}
+
 /// A straight from `a` to `b` as points about `step` m apart.
 pub fn straight(a: Vec2, b: Vec2, step: f64) -> Vec<Vec2> {
     let n = ((b - a).norm() / step).ceil().max(1.0) as usize;
