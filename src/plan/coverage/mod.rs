@@ -441,7 +441,7 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
             };
             if let Some(pts) = pts {
                 tracing::trace!(t, ?way, relaxed, "transit found");
-                found = Some((transit::thin(pts, 0.5 * step), cp, cn));
+                found = Some((pts, cp, cn));
                 break;
             }
         }

@@ -58,27 +58,26 @@ fn csc(
     if !points {
         return Some((length, Vec::new()));
     }
-    let mut pts = Vec::new();
-    let arc = |c: Vec2, h0: f64, sweep: f64, s: f64, pts: &mut Vec<Vec2>| {
-        let n = ((sweep * r) / step).ceil().max(1.0) as usize;
-        for i in 0..=n {
-            let h = h0 + s * sweep * i as f64 / n as f64;
-            pts.push(c - left_normal(&heading_vec(h)) * (s * r));
-        }
+    // Points evenly spaced along the exact curve (arc, straight, arc): every point lies on
+    // the curve and the chords are all alike, so three-point curvature never reads more than
+    // 1/r, even across the joins of the pieces.
+    let n = (length / step).ceil().max(1.0) as usize;
+    let (l1, l2) = (r * a1, r * a1 + straight);
+    let on_arc = |c: Vec2, h0: f64, s: f64, along: f64| {
+        c - left_normal(&heading_vec(h0 + s * along / r)) * (s * r)
     };
-    arc(c1, h1, a1, s1, &mut pts);
-    let n = (straight / step).ceil().max(1.0) as usize;
-    for i in 1..n {
-        pts.push(t1 + (t2 - t1) * (i as f64 / n as f64));
-    }
-    // A straight much shorter than the point spacing: its end point would sit next to its
-    // start, and three-point curvature across such a short chord reads the whole chord angle
-    // of the arc before it; the second arc starts from the first's end instead.
-    let join = pts.len();
-    arc(c2, theta, a2, s2, &mut pts);
-    if straight < 0.5 * step && pts.len() > join + 1 {
-        pts.remove(join);
-    }
+    let mut pts: Vec<Vec2> = (0..=n)
+        .map(|k| {
+            let at = length * k as f64 / n as f64;
+            if at <= l1 {
+                on_arc(c1, h1, s1, at)
+            } else if at <= l2 {
+                t1 + heading_vec(theta) * (at - l1)
+            } else {
+                on_arc(c2, theta, s2, at - l2)
+            }
+        })
+        .collect();
     if let Some(last) = pts.last_mut() {
         *last = p2;
     }
@@ -353,27 +352,6 @@ pub fn route_graph(
         relax(s, g, at, &mut best, &mut heap);
     }
     None
-}
-
-/// `points` without those closer than `min_gap` m to the point kept before them (the last point
-/// is kept, the one before it dropped instead): where curves are joined (an arc's end, a short
-/// straight, the next arc) a chord of a few centimetres makes three-point curvature read the
-/// whole chord angle of the arc next to it.
-pub fn thin(points: Vec<Vec2>, min_gap: f64) -> Vec<Vec2> {
-    let Some(&last) = points.last() else {
-        return points;
-    };
-    let mut out: Vec<Vec2> = Vec::with_capacity(points.len());
-    for q in &points[..points.len() - 1] {
-        if out.last().is_none_or(|l| (q - l).norm() >= min_gap) {
-            out.push(*q);
-        }
-    }
-    while out.len() > 1 && out.last().is_some_and(|l| (last - l).norm() < min_gap) {
-        out.pop();
-    }
-    out.push(last);
-    out
 }
 
 /// A straight from `a` to `b` as points about `step` m apart.
