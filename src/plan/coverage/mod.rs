@@ -5,6 +5,7 @@
 //! Input is a [`Field`] in the local ENU frame (see [`crate::field`] for reading GeoJSON and
 //! ISO 11783-10 TASKDATA into one). Every stage is a pure function of its inputs.
 
+pub mod bypass;
 pub mod decompose;
 pub mod geometry;
 pub mod headland;
@@ -211,6 +212,15 @@ pub const TRANSIT_CLEARANCE_M: f64 = 1.5;
 
 /// States a transit's waypoint search may expand before giving up.
 const ROUTE_MAX_EXPANSIONS: usize = 20_000;
+
+/// States a detour's waypoint search may expand before giving up: the bypass of arcs
+/// ([`bypass::bypass`]) is tried first and passes nearly every small obstacle; a search that
+/// fails expands all it may, and 20 000 states took seconds per blocked stretch.
+const DETOUR_MAX_EXPANSIONS: usize = 2_000;
+
+/// Clearance added to the bypass circle beyond the implement's half width and the chord
+/// margin, m.
+const BYPASS_SLACK_M: f64 = 0.05;
 
 /// Plan the whole field: headland passes (outermost first), then the cells in a short order,
 /// each swept by its runs of swaths with turns, joined by transits.
@@ -480,6 +490,34 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     // First a single waypoint beside the obstacle (a smooth swerve), on either side, further
     // out step by step; then the waypoint grid.
     let detour = |from: Vec2, h0: f64, to: Vec2, h1: f64| -> Option<Vec<Vec2>> {
+        // First a bypass of arcs round a circle holding the small obstacles near the line
+        // (the implement's half width and the chord margin beyond them), the gentlest first:
+        // leaving the line on 3·r_min, 2·r_min, then r_min, on the side away from the
+        // obstacles' centre first.
+        let near: Vec<&Vec<Vec2>> = small
+            .iter()
+            .zip(&small_discs)
+            .filter(|(_, (c, r))| crate::geo::polygon::point_segment_distance(c, &from, &to) <= *r)
+            .map(|(o, _)| o)
+            .collect();
+        if !near.is_empty() {
+            let (centre, reach) = bypass::enclosing_circle(near.iter().copied());
+            let radius = (reach + half + headland::chord_margin(p) + BYPASS_SLACK_M).max(p.r_min);
+            let across =
+                (centre - from).dot(&crate::geo::left_normal(&crate::geo::heading_vec(h0)));
+            let away = if across > 0.0 { -1.0 } else { 1.0 };
+            for r_leave in [3.0 * p.r_min, 2.0 * p.r_min, p.r_min] {
+                for side in [away, -away] {
+                    if let Some(pts) =
+                        bypass::bypass(from, h0, to, centre, radius, r_leave, side, p.point_spacing)
+                    {
+                        if pts.iter().all(&clear) {
+                            return Some(pts);
+                        }
+                    }
+                }
+            }
+        }
         let mid = 0.5 * (from + to);
         let side = crate::geo::left_normal(&crate::geo::heading_vec(h0));
         for k in 1..=8 {
@@ -505,7 +543,7 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
             p.point_spacing,
             &clear,
             waypoint_grid(),
-            ROUTE_MAX_EXPANSIONS,
+            DETOUR_MAX_EXPANSIONS,
         )
     };
 
