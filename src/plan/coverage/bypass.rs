@@ -59,6 +59,7 @@ fn sample(pieces: &[Piece], step: f64) -> Vec<Vec2> {
 /// (+1 left, −1 right), leaving and rejoining the line on arcs of radius `r_leave` m; `None`
 /// when the line misses the circle on that side's far edge or the arcs do not fit between
 /// `from` and `to`. Points about `step` m apart.
+#[allow(clippy::too_many_arguments)]
 pub fn bypass(
     from: Vec2,
     heading: f64,
