@@ -50,6 +50,7 @@ fn params() -> CoverageParams {
         route: RouteOrder::Auto,
         small_obstacle_max_m: 0.0,
         max_curvature_rate: 0.0,
+        headland_order: Default::default(),
     }
 }
 

@@ -48,6 +48,8 @@ pub struct FieldConfig {
     pub boundary_tolerance_m: f64,
     /// ENU origin: "auto" (boundary bounding-box centre) or "config" (job.origin_*).
     pub origin: FieldOrigin,
+    /// Headland passes "first" (before the swaths) or "last" (after them).
+    pub headland_order: crate::plan::coverage::HeadlandOrder,
 }
 
 impl Default for FieldConfig {
@@ -60,6 +62,7 @@ impl Default for FieldConfig {
             small_obstacle_max_m: 15.0,
             boundary_tolerance_m: 0.1,
             origin: FieldOrigin::Auto,
+            headland_order: crate::plan::coverage::HeadlandOrder::First,
         }
     }
 }

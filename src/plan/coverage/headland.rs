@@ -386,6 +386,7 @@ mod tests {
             route: Default::default(),
             small_obstacle_max_m: 20.0,
             max_curvature_rate: 0.0,
+            headland_order: Default::default(),
         }
     }
 

@@ -51,6 +51,19 @@ pub enum RouteOrder {
     Skip,
 }
 
+/// When the headland passes are driven.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadlandOrder {
+    /// Headland passes first, outermost first (the swaths' turns then run on worked ground;
+    /// mowing, spraying, harvest).
+    #[default]
+    First,
+    /// Swaths first, then the headland passes, innermost first: tillage and seeding work the
+    /// headland last, over the tracks their turns left.
+    Last,
+}
+
 /// Everything the coverage planner needs besides the field. Units in the names' docs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CoverageParams {
@@ -73,6 +86,8 @@ pub struct CoverageParams {
     /// Largest curvature rate per metre driven, 1/m², for continuous-curvature fishtail turns
     /// (clothoid + arc + clothoid); 0 = fishtails of arcs only.
     pub max_curvature_rate: f64,
+    /// Headland passes before or after the swaths.
+    pub headland_order: HeadlandOrder,
 }
 
 /// A complete field plan: segments in driving order plus the areas they were made for.
@@ -223,7 +238,8 @@ const DETOUR_MAX_EXPANSIONS: usize = 2_000;
 const BYPASS_SLACK_M: f64 = 0.05;
 
 /// Plan the whole field: headland passes (outermost first), then the cells in a short order,
-/// each swept by its runs of swaths with turns, joined by transits.
+/// each swept by its runs of swaths with turns, joined by transits; with
+/// [`HeadlandOrder::Last`] the cells first, then the headland passes innermost first.
 pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> {
     p.validate()?;
     if field.boundary.len() < 3 || crate::geo::polygon::signed_area(&field.boundary) <= 0.0 {
@@ -325,6 +341,10 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     // those that keep clear of the field edge and the other obstacles.
     let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
         headland::headland_tracks(&field.boundary, p).into();
+    if p.headland_order == HeadlandOrder::Last {
+        // Worked last, from the inside out: the outermost pass along the edge ends the job.
+        field_tracks.make_contiguous().reverse();
+    }
     let mut obstacle_tracks: Vec<Vec<Vec2>> = headland::obstacle_tracks(&large, p)
         .into_iter()
         .filter(|t| {
@@ -547,85 +567,6 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         )
     };
 
-    loop {
-        let ring = match field_tracks.pop_front() {
-            Some(r) => r,
-            None if !obstacle_tracks.is_empty() => {
-                let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
-                let dist = |t: &Vec<Vec2>| {
-                    t.iter()
-                        .map(|q| (q - here).norm())
-                        .fold(f64::INFINITY, f64::min)
-                };
-                let k = (0..obstacle_tracks.len())
-                    .min_by(|&i, &j| {
-                        dist(&obstacle_tracks[i]).total_cmp(&dist(&obstacle_tracks[j]))
-                    })
-                    .unwrap_or(0);
-                obstacle_tracks.swap_remove(k)
-            }
-            None => break,
-        };
-        let n = ring.len();
-        if n < 4 {
-            continue;
-        }
-        // Start the closed track where the transit from the vehicle is clear: a little ahead
-        // of it (the first pass: mid the longest boundary edge).
-        let open = &ring[..n - 1];
-        let target = match at {
-            Some((q, h)) => q + crate::geo::heading_vec(h) * (2.5 * p.r_min),
-            None => {
-                let b = &field.boundary;
-                let i = (0..b.len())
-                    .max_by(|&i, &j| {
-                        let li = (b[(i + 1) % b.len()] - b[i]).norm();
-                        let lj = (b[(j + 1) % b.len()] - b[j]).norm();
-                        li.total_cmp(&lj)
-                    })
-                    .unwrap_or(0);
-                0.5 * (b[i] + b[(i + 1) % b.len()])
-            }
-        };
-        let nearest = (0..open.len())
-            .min_by(|&i, &j| {
-                (open[i] - target)
-                    .norm()
-                    .total_cmp(&(open[j] - target).norm())
-            })
-            .unwrap_or(0);
-        let m = open.len();
-        let mut start = nearest;
-        if let Some((q, h)) = at {
-            // At most about 48 candidate starts around the track (each try is a whole curve).
-            for k in (0..m).step_by((m / 48).max(1)) {
-                let i = (nearest + k) % m;
-                let hi = vec_heading(&(open[(i + 1) % m] - open[i]));
-                if let Some((_, true)) =
-                    transit::transit(q, h, open[i], hi, p.r_min, p.point_spacing, &clear)
-                {
-                    start = i;
-                    break;
-                }
-            }
-        }
-        let mut track: Vec<Vec2> = (0..m).map(|k| open[(start + k) % m]).collect();
-        track.push(open[start]);
-        let n = track.len();
-        let cut = go_to(&mut segments, &mut at, &track, 0);
-        let track = track[cut..].to_vec();
-        let n = n - cut;
-        let hl = vec_heading(&(track[n - 1] - track[n - 2]));
-        push(
-            &mut segments,
-            SegmentKind::Headland,
-            Direction::Forward,
-            0,
-            track.clone(),
-        );
-        at = Some((track[n - 1], hl));
-    }
-
     // Runs of every cell, visited greedily nearest first.
     let mut pending: Vec<(usize, f64, Vec<swaths::RunSwath>, swaths::SwathLines)> = Vec::new();
     let mut swath_total = 0;
@@ -645,33 +586,121 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
             pending.push((ci, *angle, run, lines.clone()));
         }
     }
-    while !pending.is_empty() {
-        let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
-        let (k, _) = pending
-            .iter()
-            .enumerate()
-            .map(|(k, (_, angle, run, lines))| {
-                let (line, (x0, _)) = run[0];
-                let q = swaths::unrotate(v2(x0, lines.ys[line]), *angle);
-                (k, (q - here).norm())
-            })
-            .fold((0, f64::INFINITY), |b, c| if c.1 < b.1 { c } else { b });
-        let (ci, angle, run, lines) = pending.swap_remove(k);
-        drive_run(
-            &run,
-            &lines,
-            angle,
-            ci,
-            p,
-            &tp,
-            &mut cache,
-            &clear,
-            &mut segments,
-            &mut at,
-            &mut go_to,
-            &detour,
-            &small_discs,
-        )?;
+    // The headland passes before or after the swaths.
+    let phases = match p.headland_order {
+        HeadlandOrder::First => [true, false],
+        HeadlandOrder::Last => [false, true],
+    };
+    for headland_phase in phases {
+        if headland_phase {
+            loop {
+                let ring = match field_tracks.pop_front() {
+                    Some(r) => r,
+                    None if !obstacle_tracks.is_empty() => {
+                        let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
+                        let dist = |t: &Vec<Vec2>| {
+                            t.iter()
+                                .map(|q| (q - here).norm())
+                                .fold(f64::INFINITY, f64::min)
+                        };
+                        let k = (0..obstacle_tracks.len())
+                            .min_by(|&i, &j| {
+                                dist(&obstacle_tracks[i]).total_cmp(&dist(&obstacle_tracks[j]))
+                            })
+                            .unwrap_or(0);
+                        obstacle_tracks.swap_remove(k)
+                    }
+                    None => break,
+                };
+                let n = ring.len();
+                if n < 4 {
+                    continue;
+                }
+                // Start the closed track where the transit from the vehicle is clear: a little ahead
+                // of it (the first pass: mid the longest boundary edge).
+                let open = &ring[..n - 1];
+                let target = match at {
+                    Some((q, h)) => q + crate::geo::heading_vec(h) * (2.5 * p.r_min),
+                    None => {
+                        let b = &field.boundary;
+                        let i = (0..b.len())
+                            .max_by(|&i, &j| {
+                                let li = (b[(i + 1) % b.len()] - b[i]).norm();
+                                let lj = (b[(j + 1) % b.len()] - b[j]).norm();
+                                li.total_cmp(&lj)
+                            })
+                            .unwrap_or(0);
+                        0.5 * (b[i] + b[(i + 1) % b.len()])
+                    }
+                };
+                let nearest = (0..open.len())
+                    .min_by(|&i, &j| {
+                        (open[i] - target)
+                            .norm()
+                            .total_cmp(&(open[j] - target).norm())
+                    })
+                    .unwrap_or(0);
+                let m = open.len();
+                let mut start = nearest;
+                if let Some((q, h)) = at {
+                    // At most about 48 candidate starts around the track (each try is a whole curve).
+                    for k in (0..m).step_by((m / 48).max(1)) {
+                        let i = (nearest + k) % m;
+                        let hi = vec_heading(&(open[(i + 1) % m] - open[i]));
+                        if let Some((_, true)) =
+                            transit::transit(q, h, open[i], hi, p.r_min, p.point_spacing, &clear)
+                        {
+                            start = i;
+                            break;
+                        }
+                    }
+                }
+                let mut track: Vec<Vec2> = (0..m).map(|k| open[(start + k) % m]).collect();
+                track.push(open[start]);
+                let n = track.len();
+                let cut = go_to(&mut segments, &mut at, &track, 0);
+                let track = track[cut..].to_vec();
+                let n = n - cut;
+                let hl = vec_heading(&(track[n - 1] - track[n - 2]));
+                push(
+                    &mut segments,
+                    SegmentKind::Headland,
+                    Direction::Forward,
+                    0,
+                    track.clone(),
+                );
+                at = Some((track[n - 1], hl));
+            }
+        } else {
+            while !pending.is_empty() {
+                let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
+                let (k, _) = pending
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (_, angle, run, lines))| {
+                        let (line, (x0, _)) = run[0];
+                        let q = swaths::unrotate(v2(x0, lines.ys[line]), *angle);
+                        (k, (q - here).norm())
+                    })
+                    .fold((0, f64::INFINITY), |b, c| if c.1 < b.1 { c } else { b });
+                let (ci, angle, run, lines) = pending.swap_remove(k);
+                drive_run(
+                    &run,
+                    &lines,
+                    angle,
+                    ci,
+                    p,
+                    &tp,
+                    &mut cache,
+                    &clear,
+                    &mut segments,
+                    &mut at,
+                    &mut go_to,
+                    &detour,
+                    &small_discs,
+                )?;
+            }
+        }
     }
 
     Ok(FieldPlan {

@@ -10,6 +10,7 @@ pub(crate) fn params(w: f64, r: f64, passes: usize) -> CoverageParams {
         route: RouteOrder::Auto,
         small_obstacle_max_m: 0.0,
         max_curvature_rate: 0.0,
+        headland_order: Default::default(),
     }
 }
 
@@ -175,4 +176,54 @@ fn rectangle_l_and_obstacle_fields_plan_clear_and_driveable() {
         .segments
         .iter()
         .all(|s| s.direction == Direction::Forward));
+}
+
+#[test]
+fn headland_order_last_works_the_swaths_first_and_the_headland_from_the_inside_out() {
+    let field = Field {
+        boundary: vec![
+            v2(0.0, 0.0),
+            v2(200.0, 0.0),
+            v2(200.0, 120.0),
+            v2(0.0, 120.0),
+        ],
+        obstacles: vec![],
+    };
+    let mut p = params(6.0, 5.0, 3);
+    let first = check(&field, &p);
+    p.headland_order = HeadlandOrder::Last;
+    let last = check(&field, &p);
+    let kinds = |plan: &FieldPlan| -> Vec<SegmentKind> {
+        plan.segments
+            .iter()
+            .map(|s| s.kind)
+            .filter(|k| matches!(k, SegmentKind::Work | SegmentKind::Headland))
+            .collect()
+    };
+    let (kf, kl) = (kinds(&first), kinds(&last));
+    assert_eq!(kf[0], SegmentKind::Headland);
+    assert_eq!(kl[0], SegmentKind::Work);
+    let last_work = kl.iter().rposition(|k| *k == SegmentKind::Work).unwrap();
+    let first_headland = kl.iter().position(|k| *k == SegmentKind::Headland).unwrap();
+    assert!(
+        last_work < first_headland,
+        "every swath before the headland"
+    );
+    assert_eq!(first.swaths, last.swaths);
+    // Innermost pass first: the first headland pass of "last" keeps farther from the edge
+    // than its last one.
+    let edge = |q: &Vec2| q.x.min(200.0 - q.x).min(q.y).min(120.0 - q.y);
+    let passes: Vec<&PlanSegment> = last
+        .segments
+        .iter()
+        .filter(|s| s.kind == SegmentKind::Headland)
+        .collect();
+    assert_eq!(passes.len(), 3);
+    let mean_edge =
+        |s: &PlanSegment| s.points.iter().map(edge).sum::<f64>() / s.points.len() as f64;
+    assert!(mean_edge(passes[0]) > mean_edge(passes[2]) + 6.0);
+    // Both orders cover the field alike.
+    let mf = metrics::plan_metrics(&field, &first, 6.0);
+    let ml = metrics::plan_metrics(&field, &last, 6.0);
+    assert!((mf.covered_fraction - ml.covered_fraction).abs() < 0.005);
 }
