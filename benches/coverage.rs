@@ -1,6 +1,9 @@
 //! Field coverage planning: each stage and the whole plan for a 100 ha irregular 12-gon with
-//! one obstacle (w = r_min = 6 m, 3 headland passes = 18 m), and the whole plan at 10, 100 and
-//! 1000 ha to show how it scales with field size.
+//! one obstacle (w = r_min = 6 m, 3 headland passes = 18 m), the whole plan at 10, 100 and
+//! 1000 ha to show how it scales with field size, and the whole plan of every real field of
+//! tools/fields/real/ up to 100 ha at widths 3, 6, 12 and 36 m and r_min 5 and 8 m with the
+//! configuration's other defaults (issue 17 point 6: plan only, metrics separate).
+//! `cargo bench --bench coverage -- coverage_real/FIELD` runs one field.
 
 use agsteer::geo::{v2, Vec2};
 use agsteer::plan::coverage::{
@@ -110,5 +113,47 @@ fn scaling(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, stages, scaling);
+fn real_fields(c: &mut Criterion) {
+    let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tools/fields/real"));
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    files.retain(|p| p.extension().is_some_and(|e| e == "geojson"));
+    files.sort();
+    let cfg = agsteer::config::Config::default();
+    let mut g = c.benchmark_group("coverage_real");
+    g.sample_size(10);
+    g.measurement_time(std::time::Duration::from_secs(1));
+    g.warm_up_time(std::time::Duration::from_millis(200));
+    for path in files {
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        let Ok(loaded) = agsteer::field::load_field(&text, &cfg.field_load_options()) else {
+            continue;
+        };
+        if loaded.cleanup.area_after_m2 > 100e4 {
+            continue;
+        }
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default();
+        for w in [3.0, 6.0, 12.0, 36.0] {
+            for r in [5.0, 8.0] {
+                let mut p = cfg.coverage_params();
+                p.line_width = w;
+                p.r_min = r;
+                g.bench_with_input(
+                    BenchmarkId::new(&name, format!("w{w}_r{r}")),
+                    &loaded.field,
+                    |b, f| b.iter(|| plan_field(black_box(f), &p)),
+                );
+            }
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, stages, scaling, real_fields);
 criterion_main!(benches);
