@@ -51,7 +51,7 @@ fn check_config_reports_every_problem_with_status_2() {
         "{err}"
     );
     assert!(
-        err.contains("control.dt_s = 2: must be in 0.005..=0.5"),
+        err.contains("control.dt_s = 2: must be in 0.005..=0.3"),
         "{err}"
     );
     let (code, _, err) = agsteer(

@@ -31,6 +31,16 @@ impl Checker {
             );
         }
     }
+    /// `v` must be 0 (off) or finite and in `lo..=hi`.
+    pub(crate) fn off_or_range(&mut self, key: &str, v: f64, lo: f64, hi: f64) {
+        if !(v == 0.0 || (v.is_finite() && v >= lo && v <= hi)) {
+            self.push(
+                key,
+                fmt_num(v),
+                &format!("must be 0 (off) or in {}..={}", fmt_num(lo), fmt_num(hi)),
+            );
+        }
+    }
     /// `v` must be two finite numbers (a local ENU point).
     pub(crate) fn finite2(&mut self, key: &str, v: [f64; 2]) {
         if !(v[0].is_finite() && v[1].is_finite()) {

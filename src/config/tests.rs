@@ -26,7 +26,7 @@ fn messages_name_key_value_and_rule() {
     .unwrap();
     let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
     assert!(msgs.contains(&"guidance.a = 0: must be an integer >= 1".to_string()));
-    assert!(msgs.contains(&"control.dt_s = 2: must be in 0.005..=0.5".to_string()));
+    assert!(msgs.contains(&"control.dt_s = 2: must be in 0.005..=0.3".to_string()));
     assert!(msgs
         .iter()
         .any(|m| m.starts_with("vehicle.wheelbase_m = -1: must be in")));
@@ -75,7 +75,7 @@ fn observer_and_arcs_keys_parse_and_validate() {
     assert_eq!(cfg.job.kind, JobKind::Arcs);
     let msgs: Vec<String> = cfg.validate().iter().map(|p| p.to_string()).collect();
     for m in [
-        "track.observer_drift_tau_s = -1: must be in 0..=600",
+        "track.observer_drift_tau_s = -1: must be 0 (off) or in 1..=600",
         "track.observer_min_speed_mps = 0: must be in 0.1..=10",
         "track.observer_slip_limit_mps_per_deg = 2: must be in 0..=1",
         "track.observer_coast_max_s = 700: must be in 0..=600",
@@ -313,5 +313,43 @@ fn every_integer_key_refuses_what_does_not_fit_and_never_wraps() {
                 }
             }
         }
+    }
+}
+
+#[test]
+fn tuning_that_made_tracking_unstable_is_refused_by_name() {
+    // Each value below made `agsteer demo` or an accuracy scenario fail (tracking_unstable or
+    // off_line) while it was in range (issue 20); the values beside it tracked.
+    for (bad, good) in [
+        (
+            "track.observer_drift_tau_s=0.1",
+            "track.observer_drift_tau_s=1",
+        ),
+        (
+            "track.observer_bias_tau_s=0.05",
+            "track.observer_bias_tau_s=0",
+        ),
+        ("track.tangent_length_m=0.5", "track.tangent_length_m=0.3"),
+        ("track.gnss_latency_s=0.7", "track.gnss_latency_s=0.5"),
+        (
+            "track.integral_gain_rad_per_m_s=0.5",
+            "track.integral_gain_rad_per_m_s=0.2",
+        ),
+        ("track.ld_min_m=12", "track.ld_min_m=6"),
+        ("track.ld_gain_s=3", "track.ld_gain_s=2"),
+        ("control.dt_s=0.4", "control.dt_s=0.3"),
+    ] {
+        let key = bad.split('=').next().unwrap();
+        let problems = Config::parse_with("", &[bad.to_string()])
+            .unwrap()
+            .validate();
+        assert!(problems.iter().any(|p| p.key == key), "{bad}: {problems:?}");
+        let problems = Config::parse_with("", &[good.to_string()])
+            .unwrap()
+            .validate();
+        assert!(
+            !problems.iter().any(|p| p.key == key),
+            "{good}: {problems:?}"
+        );
     }
 }

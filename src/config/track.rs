@@ -45,9 +45,9 @@ pub struct TrackConfig {
     pub integral_min_speed_mps: f64,
     /// Disturbance observer (predictive tracker only; see
     /// [`ObserverParams`](crate::estimate::ObserverParams)): time constant of the wheel-angle
-    /// offset estimate, s (0 = off).
+    /// offset estimate, s (0 = off, else 1..=600).
     pub observer_bias_tau_s: f64,
-    /// Time constant of the world-frame drift (slip) estimate, s (0 = off).
+    /// Time constant of the world-frame drift (slip) estimate, s (0 = off, else 1..=600).
     pub observer_drift_tau_s: f64,
     /// The observer learns only above this speed, m/s.
     pub observer_min_speed_mps: f64,
@@ -56,7 +56,7 @@ pub struct TrackConfig {
     /// Largest drift speed the observer may estimate, m/s.
     pub observer_drift_limit_mps: f64,
     /// Time constant of the slope-slip coefficient (lateral slip per degree of IMU roll) at 2°
-    /// of roll, s (0 = off).
+    /// of roll, s (0 = off, else 1..=600).
     pub observer_slip_tau_s: f64,
     /// Largest slope-slip coefficient, m/s per degree of roll.
     pub observer_slip_limit_mps_per_deg: f64,
@@ -125,11 +125,17 @@ impl Default for TrackConfig {
 }
 
 impl TrackConfig {
-    /// Range checks of `[track]`.
+    /// Range checks of `[track]`. The tuning keys that can make tracking unstable are held to
+    /// ranges measured stable (`agsteer demo` and the `all_disturbances` scenario across each
+    /// key's former range, issue 20): the observer's time constants 0 (off) or ≥ 1 s (0.1 s
+    /// drift or 0.05 s bias: the demo weaves until tracking_unstable), the B-spline tangent
+    /// ≤ 0.3 m (0.5 m: off_line on the R = 15 m curve, 1 m: tracking_unstable in the demo), the
+    /// look-ahead ≤ 6 m + 2 s (12 m: off_line in the demo; 3 s: off_line at 15 km/h), the GNSS latency compensated ≤ 0.5 s (0.7 s against the
+    /// true 0.05 s: tracking_unstable), the integral gain ≤ 0.2 (0.5: tracking_unstable).
     pub(crate) fn validate(&self, c: &mut Checker) {
         let t = self;
-        c.range("track.ld_min_m", t.ld_min_m, 0.2, 50.0);
-        c.range("track.ld_gain_s", t.ld_gain_s, 0.0, 10.0);
+        c.range("track.ld_min_m", t.ld_min_m, 0.2, 6.0);
+        c.range("track.ld_gain_s", t.ld_gain_s, 0.0, 2.0);
         if t.local_nodes_after < 1 {
             c.push(
                 "track.local_nodes_after",
@@ -144,9 +150,9 @@ impl TrackConfig {
                 "local_nodes_before + local_nodes_after must be <= 64",
             );
         }
-        c.range("track.tangent_length_m", t.tangent_length_m, 0.01, 5.0);
+        c.range("track.tangent_length_m", t.tangent_length_m, 0.01, 0.3);
         c.range("track.local_spacing_m", t.local_spacing_m, 0.01, 1.0);
-        c.range("track.gnss_latency_s", t.gnss_latency_s, 0.0, 1.0);
+        c.range("track.gnss_latency_s", t.gnss_latency_s, 0.0, 0.5);
         c.range("track.lead_time_s", t.lead_time_s, 0.0, 1.0);
         c.range("track.stanley_gain_per_s", t.stanley_gain_per_s, 0.0, 50.0);
         c.range(
@@ -159,7 +165,7 @@ impl TrackConfig {
             "track.integral_gain_rad_per_m_s",
             t.integral_gain_rad_per_m_s,
             0.0,
-            1.0,
+            0.2,
         );
         c.range("track.integral_limit_deg", t.integral_limit_deg, 0.0, 10.0);
         c.range("track.integral_capture_m", t.integral_capture_m, 0.01, 5.0);
@@ -169,16 +175,16 @@ impl TrackConfig {
             0.0,
             10.0,
         );
-        c.range(
+        c.off_or_range(
             "track.observer_bias_tau_s",
             t.observer_bias_tau_s,
-            0.0,
+            1.0,
             600.0,
         );
-        c.range(
+        c.off_or_range(
             "track.observer_drift_tau_s",
             t.observer_drift_tau_s,
-            0.0,
+            1.0,
             600.0,
         );
         c.range(
@@ -199,10 +205,10 @@ impl TrackConfig {
             0.0,
             2.0,
         );
-        c.range(
+        c.off_or_range(
             "track.observer_slip_tau_s",
             t.observer_slip_tau_s,
-            0.0,
+            1.0,
             600.0,
         );
         c.range(
