@@ -38,7 +38,7 @@ fn prepare_demo_job(
                         &m,
                         fj.params.line_width,
                         fj.params.r_min,
-                        &[],
+                        &fj.plan.warnings,
                     );
                     (m, f)
                 });

@@ -223,7 +223,14 @@ where
     }
     let ((metrics, (findings, ground)), metrics_time) = timed("metrics", || {
         let m = plan_metrics(&loaded.field, &plan, params.line_width);
-        let f = plan_findings(&loaded, &plan, &m, params.line_width, params.r_min, &[]);
+        let f = plan_findings(
+            &loaded,
+            &plan,
+            &m,
+            params.line_width,
+            params.r_min,
+            &plan.warnings,
+        );
         (m, f)
     });
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
