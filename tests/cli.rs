@@ -138,6 +138,27 @@ fn dbc_decode_reassembles_129029_and_reports_bad_frames() {
 }
 
 #[test]
+fn dbc_decode_names_iso_11783_5_network_frames() {
+    // A Request for Address Claimed, an Address Claimed (agsteer's default NAME) and a
+    // Cannot Claim (from the null address): named, not "unknown".
+    let log = "(1.0) can0 18EAFF2A#00EE00\n(1.1) can0 18EEFF2A#0100000000811420\n\
+               (1.2) can0 18EEFFFE#0100000000811420\n";
+    let (_, out, _) = agsteer(&["dbc", "decode"], log);
+    let objs: Vec<serde_json::Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(objs[0]["name"], "Request");
+    assert_eq!(objs[0]["signals"]["pgn"], 0xEE00);
+    assert_eq!(objs[1]["name"], "AddressClaimed");
+    assert_eq!(objs[1]["signals"]["source"], 0x2A);
+    assert_eq!(objs[1]["signals"]["function"], 129);
+    assert_eq!(objs[1]["signals"]["identity_number"], 1);
+    assert_eq!(objs[2]["name"], "CannotClaimAddress");
+    assert!(objs.iter().all(|o| o.get("error").is_none()), "{out}");
+}
+
+#[test]
 fn frames_table_is_up_to_date() {
     let committed =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/dbc/FRAMES.md")).unwrap();

@@ -39,6 +39,7 @@ fn kill_during_write_leaves_old_or_new_file() {
         index_rank: 0,
         phase: Phase::Work,
         lines_done: 0,
+        nudge_m: 0.0,
     };
     progress_file::save(&path, &template).unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(20);

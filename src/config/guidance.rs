@@ -29,13 +29,16 @@ pub struct GuidanceConfig {
     pub stopped_speed_mps: f64,
     /// A vehicle stopped within this distance of a cusp moves on to the next segment, m.
     pub cusp_capture_m: f64,
-    /// Approach paths: when the operator engages at the start of a line too far from it to
-    /// engage (|XTE| ≥ `safety.max_engage_xte_m` or heading error ≥
+    /// Approach paths: when the operator engages too far from the path to engage (at the
+    /// job's start, or resuming it after a restart, a pause or a manual drive) (|XTE| ≥ `safety.max_engage_xte_m` or heading error ≥
     /// `safety.max_engage_heading_error_deg`), plan a continuous-curvature path (reversing
     /// where shorter, κ_max = 1/`vehicle.r_min_m`, σ_max = `vehicle.max_curvature_rate_per_m2`)
     /// from the vehicle to the line start, inside the field when the job has one, and drive
     /// it first. false = refuse to engage there, as without approach paths.
     pub approach_paths: bool,
+    /// One step of the operator's nudge (OperatorCommand nudge): the job's lines shift by
+    /// this many metres per step, left of A→B for steps > 0, m.
+    pub nudge_step_m: f64,
 }
 
 impl Default for GuidanceConfig {
@@ -51,6 +54,7 @@ impl Default for GuidanceConfig {
             stopped_speed_mps: 0.05,
             cusp_capture_m: 1.0,
             approach_paths: true,
+            nudge_step_m: 0.02,
         }
     }
 }
@@ -78,6 +82,7 @@ impl GuidanceConfig {
             );
         }
         c.range("guidance.end_distance_m", g.end_distance_m, 0.0, 10.0);
+        c.range("guidance.nudge_step_m", g.nudge_step_m, 0.001, 1.0);
         c.range("guidance.cusp_decel_mps2", g.cusp_decel_mps2, 0.05, 5.0);
         c.range(
             "guidance.stopped_speed_mps",

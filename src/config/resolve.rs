@@ -280,6 +280,7 @@ impl Config {
                 stopped_speed: g.stopped_speed_mps,
                 capture: g.cusp_capture_m,
             },
+            nudge_step: g.nudge_step_m,
         }
     }
 

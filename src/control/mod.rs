@@ -19,6 +19,7 @@ use crate::track::{registry, steering_from_travel, travel_pose, IntegralAction, 
 
 pub mod isobus;
 pub mod node;
+pub mod operator;
 pub mod params;
 pub mod replay;
 
@@ -150,7 +151,7 @@ impl Controller {
         if !g.approach_allowed() {
             return None;
         }
-        let est = self.estimator.estimate(t)?;
+        let est = self.job_estimate(t)?;
         let (xte, heading_error) = g.errors(&est.pose)?;
         if xte.abs() < a.params.max_xte && heading_error.abs() < a.params.max_heading_error {
             return None;
@@ -179,6 +180,22 @@ impl Controller {
             n
         });
         Some(result)
+    }
+
+    /// The estimate at `t` in the job's frame: moved right by the operator's nudge, so that
+    /// the vehicle tracks every path shifted left by it (issue 16 point 5).
+    fn job_estimate(&self, t: f64) -> Option<VehicleEstimate> {
+        let mut est = self.estimator.estimate(t)?;
+        let nudge = self.guidance.nudge_m();
+        if nudge != 0.0 {
+            est.pose.pos -= left_normal(&self.guidance.reference_direction()) * nudge;
+        }
+        Some(est)
+    }
+
+    /// The vehicle's estimated position at `t` (local ENU m, not shifted by the nudge).
+    pub fn position(&self, t: f64) -> Option<Vec2> {
+        self.estimator.estimate(t).map(|e| e.pose.pos)
     }
 
     pub fn on_fix(&mut self, fix: &GnssFix) {
@@ -217,7 +234,7 @@ impl Controller {
             track: None,
             direction: Direction::Forward,
         };
-        let Some(est) = self.estimator.estimate(t) else {
+        let Some(est) = self.job_estimate(t) else {
             return Ok(out);
         };
         out.estimate = Some(est);

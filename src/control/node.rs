@@ -3,12 +3,13 @@
 //! feeds it in-memory ones, so both run exactly the same code on exactly the same frames.
 
 use super::isobus::{IsoLink, IsoStatus, GUIDANCE_MESSAGE_PERIOD};
+use super::operator::{JobRequest, OperatorState, MAX_NUDGE_M, MIN_LINE_LENGTH_M};
 use super::params::{BusParams, OutputKind};
 use super::Controller;
 use crate::can::codec::{
     DirectionRequest, DirectionRequestDirection, GuidanceStatus, GuidanceStatusState,
-    GuidanceSystemCommand, GuidanceSystemCommandCommandStatus, Packer, SteeringCommand,
-    SteeringCommandMode,
+    GuidanceSystemCommand, GuidanceSystemCommandCommandStatus, OperatorReplyCommand,
+    OperatorReplyResult, Packer, SteeringCommand, SteeringCommandMode,
 };
 use crate::can::{Frame, TimedFrame};
 use crate::estimate::GnssFix;
@@ -49,6 +50,10 @@ pub struct NodeStatus {
     /// The steering's lost motion (backlash + actuator deadband) learnt so far, degrees.
     pub steering_lost_motion_deg: f64,
     pub bad_frames: u64,
+    /// The job driven: 0 the configured one, k the k-th line recorded by set A / set B.
+    pub job: u8,
+    /// The operator's nudge: the job shifted left of A→B, m.
+    pub nudge_m: f64,
     /// The address claim and the steering ECU (ISO 11783).
     #[serde(flatten)]
     pub isobus: IsoStatus,
@@ -95,6 +100,8 @@ pub struct ControllerNode {
     /// The wheel-angle sensor: gain and offset (rad), see [`BusParams::was_gain`].
     was_gain: f64,
     was_offset: f64,
+    /// Nudge, set A / set B, select job (see [`super::operator`]).
+    operator: OperatorState,
 }
 
 /// How the node handles a change of driving direction (docs/METHODS.md, Manoeuvres at work: the
@@ -187,6 +194,7 @@ impl ControllerNode {
             } else {
                 0.0
             },
+            operator: OperatorState::default(),
             status: NodeStatus {
                 state: SafetyState::Disengaged,
                 fault: FaultCode::None,
@@ -201,6 +209,8 @@ impl ControllerNode {
                 wheel_angle_command_deg: 0.0,
                 steering_lost_motion_deg: 0.0,
                 bad_frames: 0,
+                job: 0,
+                nudge_m: 0.0,
                 isobus: IsoLink::new(bus.iso).status(),
             },
         }
@@ -427,14 +437,110 @@ impl ControllerNode {
                 self.supervisor.request_disengage();
                 self.supervisor.acknowledge();
             }
-            // Not implemented yet (issue 16 point 5).
-            OperatorCommand::None
-            | OperatorCommand::Nudge { .. }
-            | OperatorCommand::SetA
-            | OperatorCommand::SetB
-            | OperatorCommand::SelectJob { .. }
-            | OperatorCommand::Unknown { .. } => {}
+            OperatorCommand::Nudge { steps } => self.nudge(steps),
+            OperatorCommand::SetA => {
+                let result = match self.ctrl.position(t) {
+                    Some(p) => {
+                        self.operator.point_a = Some(p);
+                        tracing::info!(east_m = p.x, north_m = p.y, "operator: point A set");
+                        OperatorReplyResult::Done
+                    }
+                    None => OperatorReplyResult::NoPosition,
+                };
+                self.operator.reply(OperatorReplyCommand::SetA, result);
+            }
+            OperatorCommand::SetB => {
+                let b = self.ctrl.position(t);
+                let refusal = match (self.operator.point_a, b) {
+                    _ if self.status.engaged => Some(OperatorReplyResult::Engaged),
+                    (_, None) => Some(OperatorReplyResult::NoPosition),
+                    (None, _) => Some(OperatorReplyResult::NoPointA),
+                    (Some(a), Some(b)) if (b - a).norm() < MIN_LINE_LENGTH_M => {
+                        Some(OperatorReplyResult::LineTooShort)
+                    }
+                    (Some(a), Some(b)) => {
+                        self.operator.pending = Some(JobRequest::Line { a, b });
+                        None
+                    }
+                };
+                if let Some(r) = refusal {
+                    self.operator.reply(OperatorReplyCommand::SetB, r);
+                }
+            }
+            OperatorCommand::SelectJob { job } => {
+                if self.status.engaged {
+                    let r = OperatorReplyResult::Engaged;
+                    self.operator.reply(OperatorReplyCommand::SelectJob, r);
+                } else {
+                    self.operator.pending = Some(JobRequest::Select { job });
+                }
+            }
+            OperatorCommand::None | OperatorCommand::Unknown { .. } => {}
         }
+    }
+
+    /// Shift the job by `steps` nudge steps (0: report the total).
+    fn nudge(&mut self, steps: i32) {
+        let g = self.ctrl.guidance();
+        let total = g.nudge_m() + steps as f64 * self.ctrl.params().nudge_step;
+        let result = if total.abs() > MAX_NUDGE_M + 1e-9 {
+            OperatorReplyResult::OutOfRange
+        } else {
+            if steps != 0 {
+                // Whole millimetres, as the reply carries it and the file keeps it.
+                let total = (total * 1e3).round() / 1e3;
+                self.ctrl.guidance_mut().set_nudge(total);
+                tracing::info!(nudge_m = total, "operator: job nudged");
+            }
+            OperatorReplyResult::Done
+        };
+        self.operator.reply(OperatorReplyCommand::Nudge, result);
+    }
+
+    /// A job change set A / set B or select job asked for, for the job layer to make (then
+    /// [`ControllerNode::finish_job_request`]).
+    pub fn take_job_request(&mut self) -> Option<JobRequest> {
+        self.operator.pending.take()
+    }
+
+    /// The job layer made (or could not make) the change `request` asked for: `result`, and
+    /// with `done` the controller of the new job and its number (0 the configured job, k the
+    /// k-th recorded line). Answered on the bus with the next period.
+    pub fn finish_job_request(
+        &mut self,
+        request: JobRequest,
+        result: OperatorReplyResult,
+        done: Option<(super::Controller, u8)>,
+    ) {
+        if let Some((ctrl, job)) = done {
+            self.replace_job(ctrl, job);
+        }
+        self.operator.reply(request.command(), result);
+    }
+
+    /// Drive another job from now on (not while engaged: the caller has checked): the
+    /// supervisor, the bus link and the sources stay as they are.
+    pub fn replace_job(&mut self, ctrl: super::Controller, job: u8) {
+        self.supervisor.request_disengage();
+        self.ctrl = ctrl;
+        self.ctrl.set_engaged(false);
+        self.operator.job = job;
+        self.operator.point_a = None;
+        self.cusp = false;
+        self.approach_refused = false;
+        self.supervised_line = None;
+        self.last_request = None;
+        tracing::info!(job, "operator: job selected");
+    }
+
+    /// Say which job the node was built for (0 the configured one, k the k-th recorded line).
+    pub fn set_job_number(&mut self, job: u8) {
+        self.operator.job = job;
+    }
+
+    /// The job driven: 0 the configured one, k the k-th recorded line.
+    pub fn job_number(&self) -> u8 {
+        self.operator.job
     }
 
     /// The direction to request this period, for segment jobs and approach paths (AB jobs
@@ -589,6 +695,15 @@ impl ControllerNode {
             }
         }
         self.supervise_line();
+        if !self.operator.replies.is_empty() {
+            let nudge = self.ctrl.guidance().nudge_m();
+            for (command, result) in std::mem::take(&mut self.operator.replies) {
+                let reply = self.operator.frame(command, result, nudge);
+                if let Ok(f) = self.packer.pack(&reply) {
+                    out.push(f);
+                }
+            }
+        }
         let cmd = self
             .supervisor
             .step(t, c.wheel_angle, c.xte, c.heading_error);
@@ -647,6 +762,8 @@ impl ControllerNode {
             finished: g.is_finished(),
             wheel_angle_command_deg: angle_deg,
             steering_lost_motion_deg: self.ctrl.lost_motion().to_degrees(),
+            job: self.operator.job,
+            nudge_m: g.nudge_m(),
             isobus: self.iso.status(),
             ..self.status
         };

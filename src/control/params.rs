@@ -36,6 +36,8 @@ pub struct ControlParams {
     pub approach: Option<ApproachParams>,
     pub guidance: GuidanceParams,
     pub cusp: CuspParams,
+    /// One step of the operator's nudge, m.
+    pub nudge_step: f64,
 }
 
 /// Integral action on the cross-track error (see [`IntegralAction`]).

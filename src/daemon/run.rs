@@ -201,6 +201,22 @@ fn spawn_progress_writer(path: PathBuf) -> mpsc::SyncSender<Progress> {
     tx
 }
 
+/// The job book's writer thread (the control loop never writes a file).
+fn spawn_jobs_writer(path: PathBuf) -> mpsc::SyncSender<crate::store::jobs_file::JobBook> {
+    let (tx, rx) = mpsc::sync_channel::<crate::store::jobs_file::JobBook>(4);
+    std::thread::Builder::new()
+        .name("agsteer-jobs".into())
+        .spawn(move || {
+            for b in rx {
+                if let Err(e) = crate::store::jobs_file::save(&path, &b) {
+                    tracing::error!("saving the job book: {e}");
+                }
+            }
+        })
+        .ok();
+    tx
+}
+
 /// Load what the daemon starts with ([`crate::job::startup::load`], shared with `agsteerd
 /// --check`) and log what was planned and what will be lost. For `job.kind = "field"` this
 /// reads `job.field_path` and plans its coverage, for `"maneuver"` it reads the map and plans
@@ -413,6 +429,35 @@ async fn run_async(
         ntrip_password,
         ..
     } = start_up(&cfg)?;
+    // The operator's job book: a restart drives the job selected last (issue 16 point 5).
+    let jobs_path = crate::store::jobs_file::jobs_path(&resolved.daemon.state_dir);
+    let mut book = crate::store::jobs_file::load(&jobs_path).unwrap_or_else(|e| {
+        tracing::warn!("{e}; driving the configured job");
+        Default::default()
+    });
+    let configured = job.clone();
+    let job = if book.selected == 0 {
+        job
+    } else {
+        match crate::job::operator::selected_job(&resolved, job, &book) {
+            Ok(j) => {
+                tracing::info!(
+                    job = book.selected,
+                    "driving the line recorded by set A / set B"
+                );
+                j
+            }
+            Err(e) => {
+                tracing::warn!(
+                    "job {} of {}: {e}; driving the configured job",
+                    book.selected,
+                    jobs_path.display()
+                );
+                book.selected = 0;
+                configured.clone()
+            }
+        }
+    };
     let iface = resolved.daemon.interface.clone();
     let bus = std::rc::Rc::new(AsyncSocketCan::open(&iface, &receive_filters()).map_err(
         |source| DaemonError::Open {
@@ -423,7 +468,9 @@ async fn run_async(
     let resume = crate::job::resume::resume_or_start(&job, &progress_path);
     // The node is built once; a SIGHUP only retunes it (apply_reload), so the plan is kept.
     let mut node = crate::job::build_node(&resolved, &job, resume.as_ref())?;
+    node.set_job_number(book.selected);
     let progress_tx = spawn_progress_writer(progress_path.clone());
+    let jobs_tx = spawn_jobs_writer(jobs_path);
     let bus_log = match bus_log {
         Some(p) => {
             tracing::info!(
@@ -560,6 +607,14 @@ async fn run_async(
                             }
                             if node.on_frame(&tf) {
                                 out.on_fix(&mut node, tf.t, &mut stats, &mut interval);
+                            }
+                            // Set B / select job: planned here (an AB job is planned in
+                            // microseconds), the book saved by its writer thread.
+                            if crate::job::operator::apply_request(
+                                &mut node, &resolved, &configured, &mut book,
+                            ) && jobs_tx.try_send(book.clone()).is_err()
+                            {
+                                tracing::warn!("job book writer busy; this save is skipped");
                             }
                         }
                         Some(BusEvent::Down(e)) => {

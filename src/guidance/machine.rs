@@ -16,11 +16,31 @@ use crate::track::local_path::{nearest_global, LocalPath, LocalPathParams};
 /// Something the binaries log.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Event {
-    LineStarted { block: u64, rank: u64, line: u64 },
-    LineFinished { block: u64, rank: u64, line: u64 },
-    TurnStarted { from_line: u64, to_line: u64 },
-    BlockChanged { block: u64 },
-    JobFinished { lines_done: u64 },
+    LineStarted {
+        block: u64,
+        rank: u64,
+        line: u64,
+    },
+    LineFinished {
+        block: u64,
+        rank: u64,
+        line: u64,
+    },
+    TurnStarted {
+        from_line: u64,
+        to_line: u64,
+    },
+    BlockChanged {
+        block: u64,
+    },
+    JobFinished {
+        lines_done: u64,
+    },
+    /// The operator nudged the job: every line shifted left of the job's reference
+    /// direction by `nudge_m` in all (issue 16 point 5).
+    Nudged {
+        nudge_m: f64,
+    },
 }
 
 impl std::fmt::Display for Event {
@@ -37,6 +57,9 @@ impl std::fmt::Display for Event {
             }
             Event::BlockChanged { block } => write!(f, "block changed: block {block}"),
             Event::JobFinished { lines_done } => write!(f, "job finished: {lines_done} lines"),
+            Event::Nudged { nudge_m } => {
+                write!(f, "nudged: the job is {nudge_m:+.3} m left of its plan")
+            }
         }
     }
 }
@@ -85,6 +108,9 @@ pub struct Guidance {
     approach: Vec<JobSegment>,
     /// The approach segment being driven, while approaching.
     approach_index: Option<usize>,
+    /// The operator's nudge: the job shifted left of its reference direction, m (saved
+    /// with progress).
+    nudge_m: f64,
 }
 
 impl Guidance {
@@ -109,6 +135,7 @@ impl Guidance {
             events: Vec::with_capacity(16),
             approach: Vec::new(),
             approach_index: None,
+            nudge_m: 0.0,
         };
         g.start_work_line()?;
         Ok(g)
@@ -143,6 +170,7 @@ impl Guidance {
         g.index_block = block;
         g.index_rank = rank as usize;
         g.lines_done = saved.lines_done;
+        g.nudge_m = saved.nudge_m;
         match saved.phase {
             Phase::Finished => {
                 g.phase = Phase::Finished;
@@ -360,6 +388,43 @@ impl Guidance {
             index_rank: self.index_rank as u64,
             phase: self.phase,
             lines_done: self.lines_done,
+            nudge_m: self.nudge_m,
+        }
+    }
+
+    /// The operator's nudge, m left of [`Guidance::reference_direction`].
+    pub fn nudge_m(&self) -> f64 {
+        self.nudge_m
+    }
+
+    /// Set the operator's nudge (m, positive left): saved with progress from now on (an
+    /// [`Event::Nudged`] says it changed).
+    pub fn set_nudge(&mut self, nudge_m: f64) {
+        if nudge_m.is_finite() && nudge_m != self.nudge_m {
+            self.nudge_m = nudge_m;
+            self.events.push(Event::Nudged { nudge_m });
+        }
+    }
+
+    /// The job's reference direction, which a nudge is left of: A→B of an AB job, the first
+    /// segment's direction of a segment job (unit vector).
+    pub fn reference_direction(&self) -> Vec2 {
+        let d = match &self.plan {
+            JobPlan::Ab(plan) => {
+                let (a, b) = plan.line_endpoints(0, false);
+                b - a
+            }
+            JobPlan::Segments(job) => job
+                .segments()
+                .first()
+                .and_then(|s| Some(*s.points.get(1)? - *s.points.first()?))
+                .unwrap_or(Vec2::new(1.0, 0.0)),
+        };
+        let n = d.norm();
+        if n > 0.0 && n.is_finite() {
+            d / n
+        } else {
+            Vec2::new(1.0, 0.0)
         }
     }
 
@@ -581,193 +646,4 @@ impl Guidance {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::config::Config;
-
-    fn ab_params(cfg: &Config) -> crate::plan::abline::AbParams {
-        cfg.ab_params()
-    }
-
-    fn guidance_params(cfg: &Config) -> GuidanceParams {
-        cfg.control_params().guidance
-    }
-    use crate::plan::job::SegmentJob;
-
-    /// Drive an ideal vehicle along whatever path the machine hands out and return the lines
-    /// in the order they were finished.
-    fn drive(
-        cfg: &Config,
-        resume: Option<&Progress>,
-        stop_after: Option<usize>,
-    ) -> (Vec<u64>, Progress) {
-        let plan = AbPlan::new(ab_params(cfg)).unwrap();
-        let job = cfg.job_definition();
-        let mut g = match resume {
-            Some(p) => Guidance::resume(plan, job, guidance_params(cfg), p).unwrap(),
-            None => Guidance::new(plan, job, guidance_params(cfg)).unwrap(),
-        };
-        let mut finished = Vec::new();
-        for _ in 0..2_000_000 {
-            if g.is_finished() || stop_after.is_some_and(|n| finished.len() >= n) {
-                break;
-            }
-            let path = g.global_path();
-            let i = (g.index_global() + 3).min(path.len() - 1);
-            let d = path[i].pos - path[i - 1].pos;
-            let pose = Pose::new(path[i].pos.x, path[i].pos.y, d.y.atan2(d.x));
-            g.update(&pose).unwrap();
-            for ev in g.drain_events() {
-                if let Event::LineFinished { line, .. } = ev {
-                    finished.push(line);
-                }
-            }
-        }
-        (finished, g.progress())
-    }
-
-    fn cfg_with_lines(n: u64) -> Config {
-        let mut cfg = Config::default();
-        cfg.job.line_num = n;
-        cfg.job.point_b_m = [0.0, 20.0];
-        cfg
-    }
-
-    #[test]
-    fn visits_every_line_exactly_once() {
-        let n_block = AbPlan::new(ab_params(&Config::default()))
-            .unwrap()
-            .block_size() as u64;
-        for count in [1, n_block - 1, n_block, n_block + 1, 2 * n_block + 3, 100] {
-            let cfg = cfg_with_lines(count);
-            let (mut lines, progress) = drive(&cfg, None, None);
-            assert_eq!(
-                progress.phase,
-                Phase::Finished,
-                "{count} lines: not finished"
-            );
-            assert_eq!(lines.len() as u64, count, "{count} lines: {lines:?}");
-            lines.sort_unstable();
-            assert_eq!(lines, (0..count).collect::<Vec<_>>(), "{count} lines");
-        }
-    }
-
-    #[test]
-    fn resume_drives_no_line_twice() {
-        let cfg = cfg_with_lines(23);
-        let (full, _) = drive(&cfg, None, None);
-        for stop in [1usize, 5, 11, 22] {
-            let (first, saved) = drive(&cfg, None, Some(stop));
-            let (second, end) = drive(&cfg, Some(&saved), None);
-            assert_eq!(end.phase, Phase::Finished);
-            let mut all = first.clone();
-            all.extend(&second);
-            assert_eq!(all, full, "stop after {stop}");
-        }
-    }
-
-    /// A segment job: two swaths joined by a semicircle, driven by an ideal vehicle.
-    fn segment_job() -> SegmentJob {
-        use crate::geo::{v2, Direction};
-        use crate::plan::coverage::SegmentKind;
-        use crate::plan::job::JobSegment;
-        let line = |x: f64, up: bool| -> Vec<Vec2> {
-            let ys: Vec<f64> = (0..=30).map(|i| i as f64).collect();
-            let pts = ys.iter().map(|&y| v2(x, y));
-            if up {
-                pts.collect()
-            } else {
-                pts.rev().collect()
-            }
-        };
-        let arc: Vec<Vec2> = (0..=18)
-            .map(|i| {
-                let a = std::f64::consts::PI * (1.0 - i as f64 / 18.0);
-                v2(5.0 + 5.0 * a.cos(), 30.0 + 5.0 * a.sin())
-            })
-            .collect();
-        let seg = |kind, points| JobSegment {
-            kind,
-            direction: Direction::Forward,
-            cell: 0,
-            points,
-        };
-        SegmentJob::new(vec![
-            seg(SegmentKind::Work, line(0.0, true)),
-            seg(SegmentKind::Turn, arc),
-            seg(SegmentKind::Work, line(10.0, false)),
-        ])
-        .unwrap()
-    }
-
-    fn drive_segments(resume: Option<&Progress>, stop_after: usize) -> (Vec<u64>, Progress) {
-        let cfg = Config::default();
-        let plan = JobPlan::from(segment_job());
-        let job = cfg.job_definition().with_plan(&plan);
-        let mut g = match resume {
-            Some(p) => Guidance::resume(plan, job, guidance_params(&cfg), p).unwrap(),
-            None => Guidance::new(plan, job, guidance_params(&cfg)).unwrap(),
-        };
-        let mut finished = Vec::new();
-        let mut started = 0;
-        for _ in 0..100_000 {
-            if g.is_finished() || started > stop_after {
-                break;
-            }
-            let path = g.global_path();
-            let i = (g.index_global() + 1).min(path.len() - 1);
-            let d = path[i].pos - path[i - 1].pos;
-            g.update(&Pose::new(path[i].pos.x, path[i].pos.y, d.y.atan2(d.x)))
-                .unwrap();
-            for ev in g.drain_events() {
-                match ev {
-                    Event::LineFinished { line, .. } => finished.push(line),
-                    Event::LineStarted { .. } | Event::TurnStarted { .. } => started += 1,
-                    _ => {}
-                }
-            }
-        }
-        (finished, g.progress())
-    }
-
-    #[test]
-    fn segment_job_drives_every_segment_in_order_and_resumes_per_segment() {
-        let (finished, end) = drive_segments(None, usize::MAX);
-        assert_eq!(end.phase, Phase::Finished);
-        assert_eq!(finished, vec![0, 2], "work segments finished in order");
-        assert_eq!(end.lines_done, 3, "every segment counts");
-        // Stop after the turn has started: the saved progress points at the turn segment.
-        let (first, saved) = drive_segments(None, 1);
-        assert_eq!(first, vec![0]);
-        assert_eq!((saved.index_rank, saved.phase), (1, Phase::Turn));
-        assert!(saved.job.plan_checksum.is_some());
-        let (second, end) = drive_segments(Some(&saved), usize::MAX);
-        assert_eq!(second, vec![2], "resume drives no segment twice");
-        assert_eq!(end.phase, Phase::Finished);
-        // Another plan refuses the saved progress.
-        let cfg = Config::default();
-        let mut other = segment_job().segments().to_vec();
-        other[2].points[0].x += 0.5;
-        let other = JobPlan::from(SegmentJob::new(other).unwrap());
-        let job = cfg.job_definition().with_plan(&other);
-        let err = Guidance::resume(other, job, guidance_params(&cfg), &saved).err();
-        assert_eq!(err, Some(GuidanceError::DifferentJob));
-    }
-
-    #[test]
-    fn resume_refuses_another_job() {
-        let cfg = cfg_with_lines(10);
-        let (_, saved) = drive(&cfg, None, Some(3));
-        let mut other = cfg.clone();
-        other.job.line_width_m = 4.0;
-        let plan = AbPlan::new(ab_params(&other)).unwrap();
-        let err = Guidance::resume(
-            plan,
-            other.job_definition(),
-            guidance_params(&other),
-            &saved,
-        )
-        .err();
-        assert_eq!(err, Some(GuidanceError::DifferentJob));
-    }
-}
+mod tests;

@@ -165,10 +165,16 @@ fn split_top_level(s: &str) -> Vec<&str> {
     out
 }
 
+/// The largest nudge a progress file may carry, m (far beyond any operator's correction).
+pub const MAX_NUDGE_M: f64 = 1000.0;
+
 /// Why saved progress is impossible for the plan it claims: names the field, its value and
 /// what the plan allows.
 pub fn check_against_plan(p: &Progress, plan: &crate::plan::job::JobPlan) -> Result<(), String> {
     use crate::plan::job::JobPlan;
+    if !(p.nudge_m.is_finite() && p.nudge_m.abs() <= MAX_NUDGE_M) {
+        return Err(format!("nudge_m {}: beyond ±{MAX_NUDGE_M} m", p.nudge_m));
+    }
     let (block, rank) = (p.index_block, p.index_rank);
     let (expected_done, last) = match plan {
         JobPlan::Ab(ab) => {
@@ -245,6 +251,10 @@ pub struct Progress {
     pub phase: Phase,
     /// Lines finished so far.
     pub lines_done: u64,
+    /// The operator's nudge: the job shifted left of its reference direction, m (issue 16
+    /// point 5; 0 in files written before it).
+    #[serde(default)]
+    pub nudge_m: f64,
 }
 
 /// Why a progress file cannot be trusted.
@@ -322,6 +332,7 @@ mod tests {
             index_rank: 5,
             phase: Phase::Turn,
             lines_done: 23,
+            nudge_m: 0.0,
         }
     }
 

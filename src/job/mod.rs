@@ -16,6 +16,7 @@
 pub mod field;
 pub mod identity;
 pub mod maneuver;
+pub mod operator;
 pub mod resume;
 pub mod startup;
 
@@ -149,21 +150,35 @@ pub fn build_node(
     job: &PreparedJob,
     resume: Option<&Progress>,
 ) -> Result<ControllerNode, ControlError> {
-    let ctrl = Controller::new(
+    let ctrl = build_controller(resolved, job, resume)?;
+    let origin = job.origin.unwrap_or(resolved.planning.origin);
+    Ok(ControllerNode::new(
+        ctrl,
+        &resolved.safety,
+        &resolved.bus,
+        origin,
+    ))
+}
+
+/// The controller driving `job`, continuing `resume`, approach paths checked against its field.
+pub fn build_controller(
+    resolved: &Resolved,
+    job: &PreparedJob,
+    resume: Option<&Progress>,
+) -> Result<Controller, ControlError> {
+    let mut ctrl = Controller::new(
         &resolved.control,
         job.plan.clone(),
         job.definition.clone(),
         resume,
     )?;
-    let origin = job.origin.unwrap_or(resolved.planning.origin);
-    let mut node = ControllerNode::new(ctrl, &resolved.safety, &resolved.bus, origin);
     if let Some(field) = &job.field {
         match maneuver::field_clearance(&resolved.planning.maneuver, field) {
-            Ok(clear) => node.controller_mut().set_approach_clearance(clear),
+            Ok(clear) => ctrl.set_approach_clearance(clear),
             Err(e) => tracing::warn!("approach paths are not checked against the field: {e}"),
         }
     }
-    Ok(node)
+    Ok(ctrl)
 }
 
 /// The controller node of a configuration's job (taken as it is: see [`Config::resolved`]),

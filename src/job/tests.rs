@@ -20,6 +20,7 @@ fn progress(job: &JobDefinition) -> Progress {
         index_rank: 3,
         phase: Phase::Work,
         lines_done: 3,
+        nudge_m: 0.0,
     }
 }
 

@@ -153,6 +153,7 @@ fn save_progress(
         index_rank: rank,
         phase,
         lines_done,
+        nudge_m: 0.0,
     };
     progress_file::save(&progress_file::progress_path(dir.path()), &p).unwrap();
     dir

@@ -158,6 +158,11 @@ fn check_target(path: &Path) -> Result<(), ProgressFileError> {
 /// rename over `path`, fsync the directory. The directory is created (0700) or checked
 /// ([`ensure_state_dir`]); a non-regular file at `path` is refused, not replaced.
 pub fn save(path: &Path, progress: &Progress) -> Result<(), ProgressFileError> {
+    save_bytes(path, ".progress.json.", progress.encode().as_bytes())
+}
+
+/// [`save`]'s atomic write of any state file's `bytes` (temp files named `prefix`*`.tmp`).
+pub(crate) fn save_bytes(path: &Path, prefix: &str, bytes: &[u8]) -> Result<(), ProgressFileError> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -165,12 +170,11 @@ pub fn save(path: &Path, progress: &Progress) -> Result<(), ProgressFileError> {
     ensure_state_dir(dir)?;
     check_target(path)?;
     let mut tmp = tempfile::Builder::new()
-        .prefix(".progress.json.")
+        .prefix(prefix)
         .suffix(".tmp")
         .tempfile_in(dir)
         .map_err(io(dir))?;
-    tmp.write_all(progress.encode().as_bytes())
-        .map_err(io(tmp.path()))?;
+    tmp.write_all(bytes).map_err(io(tmp.path()))?;
     tmp.as_file().sync_all().map_err(io(path))?;
     // Checked again just before the rename (the window left is the rename itself, which
     // replaces a link or a file and never writes through one).
@@ -185,7 +189,7 @@ pub fn save(path: &Path, progress: &Progress) -> Result<(), ProgressFileError> {
 
 /// The bytes of the state file at `path` (`None` when there is none), opened without
 /// following a link and without blocking on a FIFO, refused unless a regular file.
-fn read_state_file(path: &Path) -> Result<Option<Vec<u8>>, ProgressFileError> {
+pub(crate) fn read_state_file(path: &Path) -> Result<Option<Vec<u8>>, ProgressFileError> {
     let file = match OpenOptions::new()
         .read(true)
         .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
@@ -245,6 +249,11 @@ fn remove_stale_temps(path: &Path) {
     }
 }
 
+/// Move a corrupt state file other than the progress file aside (`*.corrupt-N`), saying why.
+pub(crate) fn move_aside_as(path: &Path, reason: String) -> ProgressFileError {
+    move_aside(path, ProgressError::Content(reason))
+}
+
 /// Move a corrupt file aside (`*.corrupt-N`) and say where.
 pub fn move_aside(path: &Path, reason: ProgressError) -> ProgressFileError {
     let moved_to = (0u32..1000)
@@ -299,6 +308,7 @@ mod tests {
             index_rank: 3,
             phase: Phase::Work,
             lines_done: 3,
+            nudge_m: 0.0,
         }
     }
 

@@ -151,6 +151,14 @@ impl LogDecoder {
         obj.insert("id".into(), Value::from(format!("{id:08X}")));
         let mut extra = Vec::new();
         match codec::decode(id, &bytes) {
+            // ISO 11783-5 network management is not in the DBC: named by can::isobus.
+            Err(_) if agsteer::can::isobus::read(&lf.frame).is_some() => {
+                if let Some(nf) = agsteer::can::isobus::read(&lf.frame) {
+                    let (name, signals) = network_json(&nf);
+                    obj.insert("name".into(), Value::from(name));
+                    obj.insert("signals".into(), signals);
+                }
+            }
             Err(e) => {
                 if let Some((_, def)) = codec::find(id) {
                     obj.insert("name".into(), Value::from(def.name));
@@ -215,5 +223,40 @@ impl LogDecoder {
             }
         }
         Ok(())
+    }
+}
+
+/// An ISO 11783-5 Request (PGN 59904) or Address Claimed (60928; Cannot Claim from the null
+/// address) as a name and its fields.
+fn network_json(nf: &agsteer::can::isobus::NetworkFrame) -> (&'static str, Value) {
+    use agsteer::can::isobus::{NetworkFrame, NULL_ADDRESS};
+    match *nf {
+        NetworkFrame::Request { pgn, dest, source } => (
+            "Request",
+            json!({"pgn": pgn, "destination": dest, "source": source}),
+        ),
+        NetworkFrame::AddressClaimed { name, source } => {
+            let f = name.fields();
+            (
+                if source == NULL_ADDRESS {
+                    "CannotClaimAddress"
+                } else {
+                    "AddressClaimed"
+                },
+                json!({
+                    "source": source,
+                    "name": format!("{:016X}", name.0),
+                    "self_configurable": f.self_configurable,
+                    "industry_group": f.industry_group,
+                    "device_class_instance": f.device_class_instance,
+                    "device_class": f.device_class,
+                    "function": f.function,
+                    "function_instance": f.function_instance,
+                    "ecu_instance": f.ecu_instance,
+                    "manufacturer_code": f.manufacturer_code,
+                    "identity_number": f.identity_number,
+                }),
+            )
+        }
     }
 }
