@@ -43,11 +43,14 @@ pub enum Exit {
     ProgressNotSaved = 8,
     /// `agsteer replay --strict`: a control period sends other frames than the log.
     ReplayDiffers = 9,
+    /// `agsteer calibrate`: calibration refused (the vehicle moved too fast, the operator
+    /// intervened, or the responses were inconsistent; the reason printed).
+    CalibrationRefused = 10,
 }
 
 impl Exit {
     /// Every status, in numeric order.
-    pub const ALL: [Exit; 10] = [
+    pub const ALL: [Exit; 11] = [
         Exit::Success,
         Exit::Error,
         Exit::Invalid,
@@ -58,10 +61,11 @@ impl Exit {
         Exit::AccuracyNotMet,
         Exit::ProgressNotSaved,
         Exit::ReplayDiffers,
+        Exit::CalibrationRefused,
     ];
 
     /// The number the process exits with.
-    pub fn code(self) -> u8 {
+    pub const fn code(self) -> u8 {
         self as u8
     }
 
@@ -80,6 +84,7 @@ impl Exit {
             }
             Exit::ProgressNotSaved => "demo, agsteerd: progress could not be saved",
             Exit::ReplayDiffers => "replay --strict: a control period differs from the log",
+            Exit::CalibrationRefused => "calibrate: refused (the reason printed)",
         }
     }
 

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use std::path::Path;
 
 /// Exit status when calibration refuses.
-pub const REFUSED: u8 = 4;
+pub const REFUSED: u8 = agsteer::exit::Exit::CalibrationRefused.code();
 
 fn show(e: &Estimate, scale: f64, unit: &str, digits: usize) -> String {
     match e.sd {

@@ -250,7 +250,7 @@ enum Command {
     /// Identify the steering (dead time, lag, rate limit, deadband/backlash) and the
     /// wheel-angle sensor (gain, offset) on the simulated tractor of the configuration's
     /// [sim] over the in-memory bus; prints them with their uncertainty and writes the TOML
-    /// fragment of the keys calibration owns. Exit status 4 when it refuses (reason printed).
+    /// fragment of the keys calibration owns. Exit status 10 when it refuses (reason printed).
     Calibrate {
         /// Configuration file (its [vehicle] geometry; [sim] is the tractor).
         #[arg(long, default_value = "config/demo.toml")]
