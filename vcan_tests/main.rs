@@ -314,6 +314,47 @@ fn c_engage_and_disengage_from_cansend() {
         cmds.iter().any(|c| c.1 == 1) && cmds.last().is_some_and(|c| c.1 == 0),
         "modes on the bus"
     );
+    // Operator commands (issue 16 point 5), answered by OperatorReply: set A, 3 s of driving,
+    // set B builds job 1 on the spot; a nudge of 5 steps; select job 0 goes back.
+    let dump = Candump::start(&iface);
+    term.command(6, 0, 0);
+    std::thread::sleep(Duration::from_secs(3));
+    term.command(7, 0, 0);
+    assert!(
+        wait_status(Duration::from_secs(1), |s| s["job"] == 1).is_some(),
+        "set B drives job 1: {:?}",
+        status()
+    );
+    term.command(5, 5, 0);
+    assert!(wait_status(Duration::from_secs(1), |s| s["nudge_m"] == 0.1).is_some());
+    term.command(8, 0, 0);
+    assert!(wait_status(Duration::from_secs(1), |s| s["job"] == 0).is_some());
+    std::thread::sleep(Duration::from_millis(200));
+    std::fs::write("/tmp/operator.log", dump.stop().join("\n") + "\n").unwrap();
+    let out = run_ok("agsteer", &["dbc", "decode", "/tmp/operator.log"]);
+    let replies: Vec<(String, String, f64, f64)> = out
+        .lines()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .filter(|o| o["name"] == "OperatorReply")
+        .map(|o| {
+            let s = &o["signals"];
+            (
+                s["Command"].to_string(),
+                s["Result"].to_string(),
+                s["Job"].as_f64().unwrap_or(-1.0),
+                s["Nudge"].as_f64().unwrap_or(f64::NAN),
+            )
+        })
+        .collect();
+    println!("VCAN-OPERATOR replies {replies:?}");
+    assert_eq!(replies.len(), 4, "{replies:?}");
+    assert!(
+        replies.iter().all(|r| r.1 == "0.0" || r.1 == "0"),
+        "all done: {replies:?}"
+    );
+    assert_eq!(replies[1].2, 1.0, "set B: job 1");
+    assert_eq!(replies[2].3, 100.0, "nudge: 100 mm");
+    assert_eq!(replies[3].2, 0.0, "select job 0");
 }
 
 /// (d) `ip link set down` then `up`: the daemon survives, reports the fault, and sends again

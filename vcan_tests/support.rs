@@ -269,6 +269,10 @@ impl Terminal {
     }
     /// 1 engage, 2 disengage, 3 pause, 4 resume.
     pub fn send(&mut self, command: u8) {
+        self.command(command, 0, 0);
+    }
+    /// Any operator command: 5 nudge (`nudge` steps), 6 set A, 7 set B, 8 select job `job`.
+    pub fn command(&mut self, command: u8, nudge: i32, job: u8) {
         let frame = run_ok(
             "agsteer",
             &[
@@ -276,8 +280,8 @@ impl Terminal {
                 "encode",
                 "OperatorCommand",
                 &format!("Command={command}"),
-                "Nudge=0",
-                "Job=0",
+                &format!("Nudge={nudge}"),
+                &format!("Job={job}"),
                 &format!("Counter={}", self.counter),
             ],
         );
