@@ -200,3 +200,73 @@ fn the_tables_in_the_help_and_the_readme_are_the_code() {
         agsteer::exit::markdown_table()
     );
 }
+
+/// A field job is driven only when its plan keeps every guarantee: for each field, `agsteer
+/// plan` (which writes a breaking plan for inspection and exits 4) and the job set-up of the
+/// demo and of `agsteerd --check` agree — a plan that breaks a guarantee is refused with 4
+/// (demo) or 2 (the daemon's check), naming the first violation; a clean plan is driven (its
+/// first line started).
+/// The fields are real parcels at the demo-field's implement (12 m, r_min 6 m); whichever of
+/// them the planner gets right, the two answers must be the same.
+#[test]
+fn a_field_job_whose_plan_breaks_a_guarantee_is_refused_not_driven() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut refused = 0;
+    for name in ["at_invekos_hole", "ch_lwb_hole", "nl_brp_rect"] {
+        let field = format!("tools/fields/real/{name}.geojson");
+        let path = format!("job.field_path={field:?}");
+        let out = dir.path().join(name).display().to_string();
+        let plan = agsteer(&[
+            "plan",
+            "--config",
+            "config/demo-field.toml",
+            "--field",
+            &field,
+            "--out",
+            &out,
+        ]);
+        let demo = agsteer(&[
+            "demo",
+            "--config",
+            "config/demo-field.toml",
+            "--out",
+            &out,
+            "--stop-after",
+            "1",
+            "--set",
+            &path,
+        ]);
+        let state = dir.path().join(name).join("state").display().to_string();
+        let socket = dir.path().join(name).join("s.sock").display().to_string();
+        let check = run(
+            env!("CARGO_BIN_EXE_agsteerd"),
+            &[
+                "--config",
+                "config/demo-field.toml",
+                "--check",
+                "--set",
+                &path,
+                "--set",
+                &format!("progress.state_dir={state:?}"),
+                "--set",
+                &format!("bus.status_socket={socket:?}"),
+            ],
+        );
+        if plan.code == i32::from(Exit::PlanViolation.code()) {
+            refused += 1;
+            demo.is(Exit::PlanViolation, &["breaks", "guarantee", &field]);
+            check.is(Exit::Invalid, &["breaks", "guarantee"]);
+        } else {
+            assert_eq!(plan.code, 0, "{name}: plan\n{}", plan.stderr);
+            // Driven: how well is the tracker's business (exit 0, 6 or 7), not the plan's.
+            assert!(
+                demo.stderr.contains("line started") && demo.code != 4 && demo.code != 2,
+                "{name}: demo exit {}\n{}",
+                demo.code,
+                demo.stderr
+            );
+            assert_eq!(check.code, 0, "{name}: check\n{}", check.stderr);
+        }
+    }
+    eprintln!("{refused} of 3 field plans break a guarantee and were refused");
+}

@@ -115,9 +115,9 @@ fn demo_field_job_resumes_its_own_plan_and_refuses_another() {
     assert!(saved.lines_done >= 20);
     assert_eq!(saved.job, job.job_definition(&cfg));
 
-    // Another plan of the same field (four headland passes: one and two both give the turns'
-    // minimum) must not take this progress.
-    let overrides = ["field.headland_passes=4".to_string()];
+    // Another plan of the same field (three headland passes: one and two both give the turns'
+    // minimum, four break a guarantee and are refused at set-up) must not take this progress.
+    let overrides = ["field.headland_passes=3".to_string()];
     let other_cfg = Config::load(
         std::path::Path::new(concat!(
             env!("CARGO_MANIFEST_DIR"),

@@ -43,6 +43,19 @@ pub enum FieldJobError {
         #[source]
         source: PlanError,
     },
+    /// The plan breaks a guarantee (a path point outside the field or in an obstacle, a
+    /// working pass's implement over an edge, a curve tighter than r_min): never driven.
+    #[error(
+        "the coverage plan of {} breaks {count} guarantee(s), first: {first}; it is not driven \
+         (`agsteer plan --field {}` draws and lists them)",
+        path.display(),
+        path.display()
+    )]
+    Violates {
+        path: PathBuf,
+        count: usize,
+        first: Box<crate::plan::coverage::metrics::checks::Violation>,
+    },
     #[error("the coverage plan of {} cannot be driven as a segment job", path.display())]
     Job {
         path: PathBuf,
@@ -126,6 +139,21 @@ impl FieldJob {
             source,
         })?;
         let plan_time = start.elapsed();
+        // The independent checks (issue 17 point 2): the daemon, the demo and the simulator
+        // never drive a plan that breaks a guarantee; `agsteer plan` writes it for inspection.
+        let violations = crate::plan::coverage::metrics::checks::check_plan(
+            &loaded.field,
+            &plan,
+            params.line_width,
+            params.r_min,
+        );
+        if let Some(first) = violations.first() {
+            return Err(FieldJobError::Violates {
+                path: path.to_path_buf(),
+                count: violations.len(),
+                first: Box::new(first.clone()),
+            });
+        }
         let mut job = FieldJob::from_plan(path, loaded, params.clone(), plan)?;
         job.plan_time = plan_time;
         Ok(job)

@@ -46,9 +46,9 @@ fn field_job_is_planned_and_its_progress_resumed() {
 fn progress_saved_with_another_plan_checksum_is_not_resumed() {
     let cfg = demo_field_config(&[]);
     let job = prepare_config(&cfg).unwrap();
-    // Four headland passes instead of two (more than the turns need, so the plan changes):
+    // Three headland passes instead of two (more than the turns need, so the plan changes):
     // every job key is the same, only the plan differs.
-    let other_cfg = demo_field_config(&["field.headland_passes=4"]);
+    let other_cfg = demo_field_config(&["field.headland_passes=3"]);
     let other = prepare_config(&other_cfg).unwrap();
     assert_ne!(other.definition.plan_checksum, job.definition.plan_checksum);
     let changes = other.definition.differences(&job.definition);

@@ -435,9 +435,19 @@ fn main() -> ExitCode {
 }
 
 /// The status of a failed command: [`Exit::Invalid`] when an invalid configuration (or
-/// `--set`) caused it, [`Exit::Error`] otherwise (a file that cannot be read included).
+/// `--set`) caused it, [`Exit::PlanViolation`] when a field job's plan breaks a guarantee
+/// (refused, not driven), [`Exit::Error`] otherwise (a file that cannot be read included).
 fn exit_for_error(e: &anyhow::Error) -> Exit {
     use agsteer::config::ConfigError;
+    use agsteer::job::field::FieldJobError;
+    if e.chain().any(|c| {
+        matches!(
+            c.downcast_ref::<FieldJobError>(),
+            Some(FieldJobError::Violates { .. })
+        )
+    }) {
+        return Exit::PlanViolation;
+    }
     let invalid = e.chain().any(|c| {
         matches!(
             c.downcast_ref::<ConfigError>(),
