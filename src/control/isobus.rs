@@ -176,17 +176,7 @@ mod tests {
     fn params(claim: bool, loop_: bool) -> IsoParams {
         IsoParams {
             claim: claim.then(|| ClaimParams {
-                name: Name::new(&NameFields {
-                    self_configurable: true,
-                    industry_group: 2,
-                    device_class_instance: 0,
-                    device_class: 0,
-                    function: 23,
-                    function_instance: 0,
-                    ecu_instance: 0,
-                    manufacturer_code: 0,
-                    identity_number: 1,
-                }),
+                name: Name::new(&NameFields::GUIDANCE_CONTROLLER),
                 preferred: 0x2A,
                 range: (128, 235),
             }),

@@ -36,14 +36,17 @@ pub fn load_saved(job: &PreparedJob, path: &Path) -> Result<Saved, ProgressFileE
     let Some(p) = progress_file::load(path)? else {
         return Ok(Saved::Nothing);
     };
+    classify(job, p).map_err(|why| progress_file::move_aside(path, ProgressError::Content(why)))
+}
+
+/// Saved progress against `job`: another job's ([`Saved::Foreign`]) or ours, checked against
+/// the plan (`Err` with the reason when its contents are impossible for it).
+fn classify(job: &PreparedJob, p: Progress) -> Result<Saved, String> {
     let changes = job.definition.differences(&p.job);
     if !changes.is_empty() {
         return Ok(Saved::Foreign(changes));
     }
-    match check_against_plan(&p, &job.plan) {
-        Ok(()) => Ok(Saved::Ours(p)),
-        Err(why) => Err(progress_file::move_aside(path, ProgressError::Content(why))),
-    }
+    check_against_plan(&p, &job.plan).map(|()| Saved::Ours(p))
 }
 
 /// [`load_saved`] leaving the file as it is (`agsteerd --check`): a corrupt or impossible
@@ -52,17 +55,10 @@ pub fn peek_saved(job: &PreparedJob, path: &Path) -> Result<Saved, ProgressFileE
     let Some(p) = progress_file::peek(path)? else {
         return Ok(Saved::Nothing);
     };
-    let changes = job.definition.differences(&p.job);
-    if !changes.is_empty() {
-        return Ok(Saved::Foreign(changes));
-    }
-    match check_against_plan(&p, &job.plan) {
-        Ok(()) => Ok(Saved::Ours(p)),
-        Err(why) => Err(ProgressFileError::Invalid {
-            path: path.to_path_buf(),
-            reason: ProgressError::Content(why),
-        }),
-    }
+    classify(job, p).map_err(|why| ProgressFileError::Invalid {
+        path: path.to_path_buf(),
+        reason: ProgressError::Content(why),
+    })
 }
 
 /// The differences of a foreign progress, in a line.
