@@ -277,6 +277,48 @@ pub fn obstacle_tracks(obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Vec<Vec<V
     tracks
 }
 
+/// Least distance between two rings that do not cross, m.
+fn ring_distance(a: &[Vec2], b: &[Vec2]) -> f64 {
+    use crate::geo::polygon::point_segment_distance;
+    let one_way = |a: &[Vec2], b: &[Vec2]| {
+        let n = b.len();
+        a.iter()
+            .flat_map(|q| (0..n).map(move |i| point_segment_distance(q, &b[i], &b[(i + 1) % n])))
+            .fold(f64::INFINITY, f64::min)
+    };
+    one_way(a, b).min(one_way(b, a))
+}
+
+/// Split the obstacles into (small, headland): the large ones (larger than
+/// `small_obstacle_max_m`) get headland passes, and so do the small ones a headland pass's
+/// implement would reach (nearer the boundary or another headland obstacle than the headland
+/// is wide plus w/2): the passes bend round them. The other small ones are passed on detours.
+pub fn split_obstacles(
+    boundary: &[Vec2],
+    obstacles: &[Vec<Vec2>],
+    p: &CoverageParams,
+) -> (Vec<Vec<Vec2>>, Vec<Vec<Vec2>>) {
+    let (mut small, mut large): (Vec<Vec<Vec2>>, Vec<Vec<Vec2>>) = obstacles
+        .iter()
+        .cloned()
+        .partition(|o| super::obstacle_size(o) <= p.small_obstacle_max_m);
+    let reach = obstacle_headland_width(p) + 0.5 * p.line_width + chord_margin(p);
+    // Promoted ones may bring others within reach: repeat until none moves.
+    loop {
+        let near = |o: &Vec<Vec2>| {
+            ring_distance(o, boundary) < reach
+                || large.iter().any(|l| ring_distance(o, l) < reach)
+        };
+        let (moved, kept): (Vec<_>, Vec<_>) = small.into_iter().partition(near);
+        small = kept;
+        if moved.is_empty() {
+            break;
+        }
+        large.extend(moved);
+    }
+    (small, large)
+}
+
 /// `areas` minus every obstacle grown by `margin` m.
 pub fn subtract_obstacles(areas: &[Area], obstacles: &[Vec<Vec2>], margin: f64) -> Vec<Area> {
     if obstacles.is_empty() {
@@ -290,6 +332,82 @@ pub fn subtract_obstacles(areas: &[Area], obstacles: &[Vec<Vec2>], margin: f64) 
         margin,
     );
     difference(areas, &grown)
+}
+
+/// The headland passes of a field and of the obstacles that get a headland, pass by pass
+/// (nearest the edge first): [`Passes::field`] the outer rings, [`Passes::obstacles`] the rings
+/// round the obstacles.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Passes {
+    pub field: Vec<Vec<Vec2>>,
+    pub obstacles: Vec<Vec<Vec2>>,
+}
+
+/// The headland passes of the field with its headland obstacles: pass k runs along the rings of
+/// the area at [`pass_offset`] from the boundary *and* from every obstacle (boundary shrunk,
+/// obstacles grown, their sharp corners bent round discs of radius r_min, opened), so a pass
+/// near an obstacle bends round it instead of crossing it, and obstacles whose headlands meet
+/// the field's share its outer pass. Closed tracks, resampled to `point_spacing`.
+pub fn passes_around(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Passes {
+    let rs = p.r_min * SMOOTHING_RADIUS_FACTOR;
+    let mut out = Passes::default();
+    for k in 0..passes(p) {
+        let d = pass_offset(p, k);
+        let mut area = offset(&[(boundary.to_vec(), vec![])], -d);
+        let mut discs = corner_discs(boundary, d, rs);
+        if !discs.is_empty() {
+            area = difference(&area, &discs);
+        }
+        if !obstacles.is_empty() {
+            let rings: Vec<Area> = obstacles.iter().map(|o| (o.clone(), vec![])).collect();
+            // An obstacle's convex corners turn right for the field around it: walk each
+            // obstacle clockwise so they are the right-hand turns.
+            discs = obstacles
+                .iter()
+                .flat_map(|o| {
+                    let cw: Vec<Vec2> = o.iter().rev().copied().collect();
+                    corner_discs(&cw, d, rs)
+                })
+                .collect();
+            let grown = union(&offset(&rings, d), &discs);
+            area = difference(&area, &grown);
+        }
+        let opened = open_without_kinks(&area, rs, p);
+        for (outer, holes) in &opened {
+            out.field.extend(tracks_of(
+                &[(outer.clone(), vec![])],
+                p.point_spacing,
+            ));
+            for h in holes {
+                out.obstacles
+                    .extend(tracks_of(&[(h.clone(), vec![])], p.point_spacing));
+            }
+        }
+    }
+    out
+}
+
+/// `area` opened by `rs` (convex corners rounded), with the concave kinks that the offsets
+/// made (where offsets of distant edges meet) cut away by discs and opened again.
+fn open_without_kinks(area: &[Area], rs: f64, p: &CoverageParams) -> Vec<Area> {
+    // Each round opens the area minus all the discs so far: opening an opened area again
+    // shrinks its arcs of radius rs to points, and the polygon clipping of those degenerate
+    // offsets took seconds.
+    let mut opened = offset(&offset(area, -rs), rs);
+    let mut kink_discs: Vec<Area> = Vec::new();
+    for _ in 0..KINK_ROUNDS {
+        let kinks = concave_kinks(&opened, p.point_spacing, p.r_min);
+        if kinks.is_empty() {
+            break;
+        }
+        kink_discs.extend(
+            kinks
+                .iter()
+                .map(|(q, out)| disc(q + out * (rs - KINK_DISC_DEPTH), rs)),
+        );
+        opened = offset(&offset(&difference(area, &kink_discs), -rs), rs);
+    }
+    opened
 }
 
 /// The headland passes, outermost first: closed tracks (first point repeated last) at

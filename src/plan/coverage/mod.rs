@@ -254,11 +254,8 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     let margin = half + headland::CHORD_MARGIN;
     // Small obstacles (seed 001) stay in the working area: the swaths run through them and
     // each blocked stretch becomes a detour. Large ones get a headland and split the swaths.
-    let (small, large): (Vec<Vec<Vec2>>, Vec<Vec<Vec2>>) = field
-        .obstacles
-        .iter()
-        .cloned()
-        .partition(|o| obstacle_size(o) <= p.small_obstacle_max_m);
+    // Small ones within reach of a headland pass get a headland too (the passes bend round).
+    let (small, large) = headland::split_obstacles(&field.boundary, &field.obstacles, p);
     // Each small obstacle as a disc (centre, radius + w/2 + 1 m), to find the swaths that pass
     // near one without checking every point of every swath.
     let small_discs: Vec<(Vec2, f64)> = small
@@ -339,31 +336,28 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
 
     // Headland passes: the field's (outermost first), then the obstacles' (nearest first),
     // those that keep clear of the field edge and the other obstacles.
-    let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
-        headland::headland_tracks(&field.boundary, p).into();
-    if p.headland_order == HeadlandOrder::Last {
-        // Worked last, from the inside out: the outermost pass along the edge ends the job.
-        field_tracks.make_contiguous().reverse();
-    }
-    let mut obstacle_tracks: Vec<Vec<Vec2>> = headland::obstacle_tracks(&large, p)
-        .into_iter()
-        .filter(|t| {
-            let ok = t.iter().all(&clear);
-            if !ok {
-                tracing::debug!("an obstacle headland pass would leave the field; skipped");
-            }
-            ok
-        })
-        .collect();
+    let headland::Passes {
+        field: field_passes,
+        obstacles: obstacle_passes,
+    } = headland::passes_around(&field.boundary, &large, p);
     // Transits may follow the headland passes (field and obstacles) where they are clear.
     let rings = rings::Rings::new(
-        &field_tracks
+        &field_passes
             .iter()
-            .chain(obstacle_tracks.iter())
+            .chain(obstacle_passes.iter())
             .cloned()
             .collect::<Vec<_>>(),
         &clear,
     );
+    // A pass is worked only where its implement is clear (a guarantee): a pass that is not
+    // clear throughout is cut into its clear stretches, and the cut is reported.
+    let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
+        clear_stretches(field_passes, &clear, &warnings).into();
+    if p.headland_order == HeadlandOrder::Last {
+        // Worked last, from the inside out: the outermost pass along the edge ends the job.
+        field_tracks.make_contiguous().reverse();
+    }
+    let mut obstacle_tracks = clear_stretches(obstacle_passes, &clear, &warnings);
 
     let tp = p.turn_params();
     let mut cache = crate::plan::turns::TurnCache::default();
@@ -616,6 +610,29 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
                 if n < 4 {
                     continue;
                 }
+                if (ring[n - 1] - ring[0]).norm() > 1e-9 {
+                    // An open stretch of a cut pass: driven from its end nearer the vehicle.
+                    let here = at.map(|a| a.0).unwrap_or(ring[0]);
+                    let mut track = ring;
+                    if (track[n - 1] - here).norm() < (track[0] - here).norm() {
+                        track.reverse();
+                    }
+                    let cut = go_to(&mut segments, &mut at, &track, 0);
+                    let track = track[cut..].to_vec();
+                    let n = track.len();
+                    if n >= 2 {
+                        let end = (track[n - 1], vec_heading(&(track[n - 1] - track[n - 2])));
+                        push(
+                            &mut segments,
+                            SegmentKind::Headland,
+                            Direction::Forward,
+                            0,
+                            track,
+                        );
+                        at = Some(end);
+                    }
+                    continue;
+                }
                 // Start the closed track where the transit from the vehicle is clear: a little ahead
                 // of it (the first pass: mid the longest boundary edge).
                 let open = &ring[..n - 1];
@@ -713,6 +730,46 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         turn_shapes_solved: cache.solved,
         warnings: warnings.into_inner(),
     })
+}
+
+/// The closed tracks, each whole when every point is clear, else cut into its clear stretches
+/// (open, at least 3 points), each cut reported in `warnings` with its place.
+fn clear_stretches(
+    tracks: Vec<Vec<Vec2>>,
+    clear: &dyn Fn(&Vec2) -> bool,
+    warnings: &std::cell::RefCell<Vec<String>>,
+) -> Vec<Vec<Vec2>> {
+    let mut out = Vec::new();
+    for track in tracks {
+        let ok: Vec<bool> = track.iter().map(clear).collect();
+        let Some(first_bad) = ok.iter().position(|c| !c) else {
+            out.push(track);
+            continue;
+        };
+        // The closed track without its repeated last point, walked from a blocked point.
+        let m = track.len() - 1;
+        let mut stretch: Vec<Vec2> = Vec::new();
+        let mut dropped = 0;
+        for k in 1..=m {
+            let i = (first_bad + k) % m;
+            if ok[i] {
+                stretch.push(track[i]);
+            } else {
+                dropped += 1;
+                if stretch.len() >= 3 {
+                    out.push(std::mem::take(&mut stretch));
+                } else {
+                    stretch.clear();
+                }
+            }
+        }
+        let q = track[first_bad];
+        warnings.borrow_mut().push(format!(
+            "headland pass cut at ({:.1}, {:.1}): {dropped} of its {m} points would put the implement over the edge or an obstacle",
+            q.x, q.y
+        ));
+    }
+    out
 }
 
 #[cfg(test)]
