@@ -306,8 +306,7 @@ pub fn split_obstacles(
     // Promoted ones may bring others within reach: repeat until none moves.
     loop {
         let near = |o: &Vec<Vec2>| {
-            ring_distance(o, boundary) < reach
-                || large.iter().any(|l| ring_distance(o, l) < reach)
+            ring_distance(o, boundary) < reach || large.iter().any(|l| ring_distance(o, l) < reach)
         };
         let (moved, kept): (Vec<_>, Vec<_>) = small.into_iter().partition(near);
         small = kept;
@@ -374,10 +373,8 @@ pub fn passes_around(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoveragePar
         }
         let opened = open_without_kinks(&area, rs, p);
         for (outer, holes) in &opened {
-            out.field.extend(tracks_of(
-                &[(outer.clone(), vec![])],
-                p.point_spacing,
-            ));
+            out.field
+                .extend(tracks_of(&[(outer.clone(), vec![])], p.point_spacing));
             for h in holes {
                 out.obstacles
                     .extend(tracks_of(&[(h.clone(), vec![])], p.point_spacing));
