@@ -16,12 +16,14 @@
 //! no I/O, no clock; the driving of a bus is the caller's (`agsteer calibrate`,
 //! [`crate::demo::calibrate`]).
 
+pub mod figures;
 pub mod fit;
 pub mod identify;
 pub mod model;
 pub mod session;
 pub mod was;
 
+pub use figures::{Figure, Figures};
 use identify::{fit_steering, fit_steering_from, SteeringFit};
 use model::SteeringModel;
 pub use session::{Instruction, Session, Tick};
@@ -46,6 +48,11 @@ pub struct CalibrationParams {
     pub follow_tolerance: f64,
     /// Longest wait for the operator to stop or reach the drive speed, s.
     pub wait_timeout: f64,
+    /// Every hold of the steering tests and of the drive lasts this × its nominal time (1:
+    /// about 85 s of steering tests and 80 s of drive). Shorter suits a fast steering and a
+    /// quiet sensor only: a hold too short for the steering to settle shows as inconsistent
+    /// responses and is refused.
+    pub time_scale: f64,
     pub geometry: Geometry,
 }
 
@@ -61,6 +68,7 @@ impl Default for CalibrationParams {
             max_angle: 30f64.to_radians(),
             follow_tolerance: 3f64.to_radians(),
             wait_timeout: 60.0,
+            time_scale: 1.0,
             geometry: Geometry {
                 wheelbase: 3.0,
                 antenna_forward: 0.0,

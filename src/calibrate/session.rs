@@ -71,6 +71,15 @@ enum Phase {
     Done,
 }
 
+/// The procedure's time scale, kept in a sane range (a non-finite or non-positive value is 1).
+fn time_scale(p: &CalibrationParams) -> f64 {
+    if p.time_scale.is_finite() && p.time_scale > 0.0 {
+        p.time_scale.clamp(0.05, 10.0)
+    } else {
+        1.0
+    }
+}
+
 /// The procedure's state and what it recorded.
 #[derive(Debug, Clone)]
 pub struct Session {
@@ -94,16 +103,17 @@ pub struct Session {
 impl Session {
     pub fn new(params: CalibrationParams) -> Session {
         let small = 1f64.to_radians();
+        let k = time_scale(&params);
         let mut script = Vec::new();
         for _ in 0..REPETITIONS {
             for (o, h) in PRELOAD {
-                script.push((o * small, h));
+                script.push((o * small, h * k));
             }
             for (o, h) in BIG {
-                script.push((o * params.step, h));
+                script.push((o * params.step, h * k));
             }
             for (o, h) in SMALL {
-                script.push((o * small, h));
+                script.push((o * small, h * k));
             }
         }
         Session {
@@ -129,6 +139,32 @@ impl Session {
     /// The steering tests' duration, s.
     pub fn steering_duration(&self) -> f64 {
         self.script.iter().map(|s| s.1).sum()
+    }
+
+    /// The drive's holds: settling time and whole hold, s.
+    fn hold_times(&self) -> (f64, f64) {
+        let k = time_scale(&self.params);
+        (HOLD_SETTLE * k, (HOLD_SETTLE + HOLD_MEASURE) * k)
+    }
+
+    /// The procedure's duration once the tractor is stopped and driving when asked, s.
+    pub fn nominal_duration(&self) -> f64 {
+        self.steering_duration() + HOLDS.len() as f64 * self.hold_times().1
+    }
+
+    /// The command actually sent at `t` (sensor terms, rad), when something between the
+    /// procedure and the steering limits it (the supervisor's rate limit): the steering tests
+    /// are fitted to what the steering was sent, not to what the procedure asked.
+    pub fn sent(&mut self, t: f64, command: f64) {
+        if self.phase != Phase::Steering || !command.is_finite() {
+            return;
+        }
+        let c = &mut self.steering.commands;
+        match c.last_mut() {
+            Some(last) if last.0 == t => last.1 = command,
+            Some(last) if last.1 == command => {}
+            _ => c.push((t, command)),
+        }
     }
 
     /// Feed one input.
@@ -204,10 +240,10 @@ impl Session {
         if self.phase != Phase::Holds {
             return None;
         }
-        let span = HOLD_SETTLE + HOLD_MEASURE;
+        let (settle, span) = self.hold_times();
         let into = t - self.phase_start;
         let i = (into / span).floor();
-        if i < 0.0 || into - i * span < HOLD_SETTLE {
+        if i < 0.0 || into - i * span < settle {
             return None;
         }
         self.holds.get_mut(i as usize)
@@ -246,10 +282,16 @@ impl Session {
             Phase::WaitStop { since } => {
                 let stopped = speed.is_some_and(|v| v <= p.standstill_speed);
                 let since = if stopped { since.or(Some(t)) } else { None };
-                if since.is_some_and(|s| t - s >= 1.0) {
+                // Stopped for a second (scaled with the holds): not just passing through zero.
+                if since.is_some_and(|s| t - s >= (time_scale(&p)).max(0.3)) {
                     self.enter(Phase::Steering, t);
                     self.steering.commands.clear();
                     self.steering.samples.clear();
+                    // Room for a 200 Hz sensor and a command every 5 ms, so that recording
+                    // does not allocate in the control period (a daemon runs this).
+                    let n = (self.steering_duration() * 200.0) as usize + 256;
+                    self.steering.samples.reserve(n);
+                    self.steering.commands.reserve(n);
                     return self.tick(t);
                 }
                 if t - started > p.wait_timeout {
@@ -316,9 +358,16 @@ impl Session {
                 }
                 let ok = speed.is_some_and(|v| v >= p.drive_speed_min);
                 let since = if ok { since.or(Some(t)) } else { None };
-                if since.is_some_and(|s| t - s >= 2.0) {
+                if since.is_some_and(|s| t - s >= (2.0 * time_scale(&p)).max(0.5)) {
                     self.enter(Phase::Holds, t);
-                    self.holds = vec![Hold::default(); HOLDS.len()];
+                    let n = (self.hold_times().1 * 200.0) as usize + 64;
+                    self.holds = (0..HOLDS.len())
+                        .map(|_| Hold {
+                            sensed: Vec::with_capacity(n),
+                            heading: Vec::with_capacity(n),
+                            speed: Vec::with_capacity(n),
+                        })
+                        .collect();
                     return self.tick(t);
                 }
                 if t - self.phase_start > p.wait_timeout {
@@ -349,14 +398,14 @@ impl Session {
                     }
                     _ => {}
                 }
-                let span = HOLD_SETTLE + HOLD_MEASURE;
+                let (settle, span) = self.hold_times();
                 let into = t - self.phase_start;
                 let i = (into / span).floor() as usize;
                 match HOLDS.get(i) {
                     Some(&h) => {
                         let c = limit(h * p.hold_angle);
                         // The wheels must follow while measuring: held away, someone steers.
-                        if into - i as f64 * span > HOLD_SETTLE {
+                        if into - i as f64 * span > settle {
                             if let Some(s) =
                                 self.sensed.filter(|s| (s - c).abs() > p.follow_tolerance)
                             {

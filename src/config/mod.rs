@@ -8,7 +8,7 @@
 //!
 //! One file per section (`job.rs`, `guidance.rs`, `vehicle.rs`, `control.rs`, `track.rs`,
 //! `sim.rs`, `bus.rs`, `isobus.rs`, `safety.rs`, `daemon.rs`, `progress.rs`, `field.rs`, `maneuver.rs`,
-//! `gnss.rs`, `sources.rs`, `acceptance.rs`), each
+//! `gnss.rs`, `sources.rs`, `acceptance.rs`, `calibration.rs`), each
 //! holding the section's struct, its defaults and its validation; [`check`] holds the
 //! range-check helpers. This module holds the whole [`Config`], loading, `--set` overrides and
 //! the errors. It does no I/O but reading the file named to [`Config::load`].
@@ -19,6 +19,7 @@
 
 mod acceptance;
 mod bus;
+mod calibration;
 pub(crate) mod check;
 mod control;
 mod daemon;
@@ -40,6 +41,7 @@ mod vehicle;
 
 pub use acceptance::{AcceptanceConfig, AccuracyMiss};
 pub use bus::{BusConfig, OutputKind};
+pub use calibration::CalibrationConfig;
 pub use control::ControlConfig;
 pub use daemon::DaemonConfig;
 pub use field::{FieldConfig, FieldOrigin, SwathAngleChoice};
@@ -111,6 +113,7 @@ pub struct Config {
     pub gnss: GnssConfig,
     pub sources: SourcesConfig,
     pub acceptance: AcceptanceConfig,
+    pub calibration: CalibrationConfig,
 }
 
 /// Apply `key.path=value` overrides to a TOML tree. The value is parsed as a TOML value
@@ -300,6 +303,7 @@ impl Config {
         self.gnss.validate(&mut c);
         self.sources.validate(&mut c);
         self.acceptance.validate(&mut c);
+        self.calibration.validate(&mut c);
         envelope::validate(self, &mut c);
         c.problems
     }

@@ -42,6 +42,8 @@ pub struct Resolved {
     pub bus: BusParams,
     pub sim: SimSetup,
     pub daemon: DaemonParams,
+    /// The steering calibration procedure (`[calibration]`, `[vehicle]`).
+    pub calibration: crate::calibrate::CalibrationParams,
 }
 
 /// What job to plan and how (`[job]`, `[guidance]`, `[field]`, `[maneuver]`, `[vehicle]`).
@@ -141,6 +143,7 @@ impl Config {
             bus: self.bus_params(),
             sim: self.sim_setup(),
             daemon: self.daemon_params(),
+            calibration: self.calibration_params(),
         }
     }
 

@@ -2,14 +2,19 @@
 //! → `track` → `safety` → `can`, without I/O: the daemon feeds it SocketCAN frames, the demo
 //! feeds it in-memory ones, so both run exactly the same code on exactly the same frames.
 
+mod calibration;
+mod commands;
+
+pub use calibration::CalibrationProgress;
+
 use super::isobus::{IsoLink, IsoStatus, GUIDANCE_MESSAGE_PERIOD};
-use super::operator::{JobRequest, OperatorState, MAX_NUDGE_M, MIN_LINE_LENGTH_M};
+use super::operator::{JobRequest, OperatorState};
 use super::params::{BusParams, OutputKind};
 use super::Controller;
 use crate::can::codec::{
     DirectionRequest, DirectionRequestDirection, GuidanceStatus, GuidanceStatusState,
-    GuidanceSystemCommand, GuidanceSystemCommandCommandStatus, OperatorReplyCommand,
-    OperatorReplyResult, Packer, SteeringCommand, SteeringCommandMode,
+    GuidanceSystemCommand, GuidanceSystemCommandCommandStatus, OperatorReplyResult, Packer,
+    SteeringCommand, SteeringCommandMode,
 };
 use crate::can::{Frame, TimedFrame};
 use crate::estimate::GnssFix;
@@ -17,7 +22,7 @@ use crate::geo::wgs84::{EnuFrame, LatLon};
 use crate::geo::Direction;
 use crate::input::can::CanAdapter;
 use crate::input::source::{SourceChange, SourceSelector};
-use crate::input::{CheckedLink, Input, OperatorCommand, PositionInput, SensorStatus};
+use crate::input::{CheckedLink, Input, PositionInput, SensorStatus};
 use crate::safety::{
     CheckedInput, FaultCode, FixQuality, SafetyParams, SafetyState, SteeringCommand as Cmd,
     Supervisor,
@@ -102,6 +107,8 @@ pub struct ControllerNode {
     was_offset: f64,
     /// Nudge, set A / set B, select job (see [`super::operator`]).
     operator: OperatorState,
+    /// The steering calibration mode ([`calibration`]).
+    calibration: calibration::CalibrationState,
 }
 
 /// How the node handles a change of driving direction (docs/METHODS.md, Manoeuvres at work: the
@@ -195,6 +202,7 @@ impl ControllerNode {
                 0.0
             },
             operator: OperatorState::default(),
+            calibration: calibration::CalibrationState::new(),
             status: NodeStatus {
                 state: SafetyState::Disengaged,
                 fault: FaultCode::None,
@@ -237,7 +245,7 @@ impl ControllerNode {
         bus: &BusParams,
     ) {
         self.ctrl.set_tuning(control);
-        self.supervisor.set_params(node_safety_params(safety, bus));
+        self.set_supervisor_params(node_safety_params(safety, bus));
         self.output = bus.output;
         self.sources.set_params(bus.sources);
         self.status_every = status_every(bus.status_period, self.ctrl.params().dt);
@@ -299,6 +307,7 @@ impl ControllerNode {
         let Some(input) = input else {
             return false;
         };
+        self.calibration_input(&input);
         if let Input::Position(p) = &input {
             self.on_position(p);
             return true;
@@ -414,87 +423,6 @@ impl ControllerNode {
                 }
             }
         }
-    }
-
-    fn on_operator(&mut self, t: f64, command: OperatorCommand) {
-        match command {
-            OperatorCommand::Engage | OperatorCommand::Resume => {
-                match self.ctrl.plan_approach(t) {
-                    Some(Ok(parts)) => {
-                        self.approach_refused = false;
-                        tracing::info!(parts, "approach path to the line start planned")
-                    }
-                    // Logged once per run of refusals (an operator may hold the button).
-                    Some(Err(e)) if !self.approach_refused => {
-                        self.approach_refused = true;
-                        tracing::warn!("no approach path: {e}")
-                    }
-                    _ => {}
-                }
-                self.supervisor.request_engage()
-            }
-            OperatorCommand::Disengage | OperatorCommand::Pause => {
-                self.supervisor.request_disengage();
-                self.supervisor.acknowledge();
-            }
-            OperatorCommand::Nudge { steps } => self.nudge(steps),
-            OperatorCommand::SetA => {
-                let result = match self.ctrl.position(t) {
-                    Some(p) => {
-                        self.operator.point_a = Some(p);
-                        tracing::info!(east_m = p.x, north_m = p.y, "operator: point A set");
-                        OperatorReplyResult::Done
-                    }
-                    None => OperatorReplyResult::NoPosition,
-                };
-                self.operator.reply(OperatorReplyCommand::SetA, result);
-            }
-            OperatorCommand::SetB => {
-                let b = self.ctrl.position(t);
-                let refusal = match (self.operator.point_a, b) {
-                    _ if self.status.engaged => Some(OperatorReplyResult::Engaged),
-                    (_, None) => Some(OperatorReplyResult::NoPosition),
-                    (None, _) => Some(OperatorReplyResult::NoPointA),
-                    (Some(a), Some(b)) if (b - a).norm() < MIN_LINE_LENGTH_M => {
-                        Some(OperatorReplyResult::LineTooShort)
-                    }
-                    (Some(a), Some(b)) => {
-                        self.operator.pending = Some(JobRequest::Line { a, b });
-                        None
-                    }
-                };
-                if let Some(r) = refusal {
-                    self.operator.reply(OperatorReplyCommand::SetB, r);
-                }
-            }
-            OperatorCommand::SelectJob { job } => {
-                if self.status.engaged {
-                    let r = OperatorReplyResult::Engaged;
-                    self.operator.reply(OperatorReplyCommand::SelectJob, r);
-                } else {
-                    self.operator.pending = Some(JobRequest::Select { job });
-                }
-            }
-            OperatorCommand::None | OperatorCommand::Unknown { .. } => {}
-        }
-    }
-
-    /// Shift the job by `steps` nudge steps (0: report the total).
-    fn nudge(&mut self, steps: i32) {
-        let g = self.ctrl.guidance();
-        let total = g.nudge_m() + steps as f64 * self.ctrl.params().nudge_step;
-        let result = if total.abs() > MAX_NUDGE_M + 1e-9 {
-            OperatorReplyResult::OutOfRange
-        } else {
-            if steps != 0 {
-                // Whole millimetres, as the reply carries it and the file keeps it.
-                let total = (total * 1e3).round() / 1e3;
-                self.ctrl.guidance_mut().set_nudge(total);
-                tracing::info!(nudge_m = total, "operator: job nudged");
-            }
-            OperatorReplyResult::Done
-        };
-        self.operator.reply(OperatorReplyCommand::Nudge, result);
     }
 
     /// A job change set A / set B or select job asked for, for the job layer to make (then
@@ -683,7 +611,12 @@ impl ControllerNode {
                 }
             }
         };
-        let request = self.direction_request(&c);
+        // While calibrating, the procedure's demand replaces the tracker's.
+        let calibration = self.calibration_demand(t);
+        let request = match self.calibration_direction() {
+            Some(r) => Some(r),
+            None => self.direction_request(&c),
+        };
         if let Some(r) = request {
             self.supervisor.set_direction_change(t, self.cusp);
             let due = self.last_request != Some(r) || self.ticks % self.status_every == 0;
@@ -694,7 +627,9 @@ impl ControllerNode {
                 self.last_request = Some(r);
             }
         }
-        self.supervise_line();
+        if calibration.is_none() {
+            self.supervise_line();
+        }
         if !self.operator.replies.is_empty() {
             let nudge = self.ctrl.guidance().nudge_m();
             for (command, result) in std::mem::take(&mut self.operator.replies) {
@@ -704,10 +639,14 @@ impl ControllerNode {
                 }
             }
         }
-        let cmd = self
-            .supervisor
-            .step(t, c.wheel_angle, c.xte, c.heading_error);
-        self.ctrl.set_engaged(cmd.engaged);
+        let cmd = match calibration {
+            Some(demand) => self.supervisor.step(t, demand, Some(0.0), Some(0.0)),
+            None => self
+                .supervisor
+                .step(t, c.wheel_angle, c.xte, c.heading_error),
+        };
+        self.calibration_sent(t, &cmd);
+        self.ctrl.set_engaged(cmd.engaged && calibration.is_none());
         let angle_deg = cmd.wheel_angle.to_degrees().clamp(-90.0, 90.0);
         // The steering servos the sensor's reading: command in its terms.
         let sensed_deg = (self.was_gain * cmd.wheel_angle + self.was_offset)

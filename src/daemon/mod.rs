@@ -7,6 +7,7 @@
 //! controller node frames and ticks; the node itself never blocks.
 
 pub mod bus_log;
+pub mod calibration;
 pub mod gnss;
 pub mod notify;
 pub mod run;

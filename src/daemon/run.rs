@@ -97,6 +97,9 @@ struct StatusReply<'a> {
     /// `--bus-log`, when on.
     #[serde(skip_serializing_if = "Option::is_none")]
     bus_log: Option<BusLogStats>,
+    /// The steering calibration under way or the last one's result.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    calibration: Option<super::calibration::CalibrationReply<'a>>,
 }
 
 /// One source seen, for the status reply.
@@ -357,6 +360,7 @@ struct Outputs {
     iface: String,
     progress: mpsc::SyncSender<Progress>,
     log: Option<BusLog>,
+    calibration: super::calibration::CalibrationRunner,
 }
 
 impl Outputs {
@@ -364,6 +368,7 @@ impl Outputs {
     fn step(&mut self, node: &mut ControllerNode, t: f64, stats: &mut LoopStats) -> bool {
         self.frames.clear();
         node.tick(t, &mut self.frames);
+        self.calibration.poll(node);
         // A period without frames (claiming) says nothing of the link.
         let sent = send_all(&self.bus, t, &self.frames, stats, self.log.as_ref());
         if sent && !self.bus_up && !self.frames.is_empty() {
@@ -538,6 +543,7 @@ async fn run_async(
         iface: iface.clone(),
         progress: progress_tx,
         log: bus_log,
+        calibration: super::calibration::CalibrationRunner::new(resolved.daemon.state_dir.clone()),
     };
     let mut stats = LoopStats {
         bus_up: true,
@@ -653,6 +659,7 @@ async fn run_async(
                                 gnss: gnss.as_ref().map(|g| g.status(monotonic_s())),
                                 sources: sources_reply(node.sources(), monotonic_s()),
                                 bus_log: out.log.as_ref().map(BusLog::stats),
+                                calibration: out.calibration.reply(&node),
                             };
                             let mut text = serde_json::to_string(&reply).unwrap_or_default();
                             text.push('\n');

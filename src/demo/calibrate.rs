@@ -28,18 +28,9 @@ pub struct Operator {
     pub change_tau: Option<(f64, f64)>,
 }
 
-/// The procedure's parameters from the configuration: the geometry and wheel-angle limit of
-/// `[vehicle]`.
+/// The procedure's parameters from the configuration ([`Config::calibration_params`]).
 pub fn params_for(cfg: &Config) -> CalibrationParams {
-    let v = &cfg.vehicle;
-    let mut p = CalibrationParams::default();
-    p.geometry.wheelbase = v.wheelbase_m;
-    p.geometry.antenna_forward = v.antenna_forward_m;
-    p.geometry.antenna_left = v.antenna_left_m;
-    p.max_angle = (cfg.max_wheel_angle() - 5f64.to_radians()).max(5f64.to_radians());
-    p.step = p.step.min(p.max_angle);
-    p.hold_angle = p.hold_angle.min(p.max_angle);
-    p
+    cfg.calibration_params()
 }
 
 /// Progress: (simulated time s, phase), called when the phase changes.

@@ -135,6 +135,7 @@ fn operator_command(c: &codec::OperatorCommand) -> OperatorCommand {
             },
             None => OperatorCommand::None,
         },
+        OperatorCommandCommand::Calibrate => OperatorCommand::Calibrate,
         OperatorCommandCommand::Other(code) => OperatorCommand::Unknown { code },
     }
 }

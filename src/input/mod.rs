@@ -198,6 +198,8 @@ pub enum OperatorCommand {
     SelectJob {
         job: u8,
     },
+    /// Start the steering calibration (agsteerd's calibration mode).
+    Calibrate,
     /// A command code the sender's definition does not name.
     Unknown {
         code: u8,

@@ -152,12 +152,9 @@ pub fn build_node(
 ) -> Result<ControllerNode, ControlError> {
     let ctrl = build_controller(resolved, job, resume)?;
     let origin = job.origin.unwrap_or(resolved.planning.origin);
-    Ok(ControllerNode::new(
-        ctrl,
-        &resolved.safety,
-        &resolved.bus,
-        origin,
-    ))
+    let mut node = ControllerNode::new(ctrl, &resolved.safety, &resolved.bus, origin);
+    node.set_calibration_params(resolved.calibration);
+    Ok(node)
 }
 
 /// The controller driving `job`, continuing `resume`, approach paths checked against its field.

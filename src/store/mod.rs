@@ -8,6 +8,7 @@
 //! encodes progress, [`crate::field`] parses fields); whether a saved progress belongs to the
 //! job is the job layer's question ([`crate::job::resume`]).
 
+pub mod calibration_file;
 pub mod jobs_file;
 pub mod progress_file;
 

@@ -2,6 +2,7 @@
 
 mod accuracy_cmd;
 mod calibrate_cmd;
+mod calibrate_live;
 mod dbc_cmd;
 mod demo_cmd;
 mod maneuver_cmd;
@@ -252,12 +253,24 @@ enum Command {
     /// [sim] over the in-memory bus; prints them with their uncertainty and writes the TOML
     /// fragment of the keys calibration owns. Exit status 10 when it refuses (reason printed).
     Calibrate {
-        /// Configuration file (its [vehicle] geometry; [sim] is the tractor).
+        /// Configuration file (its [vehicle] geometry and [calibration]; [sim] is the tractor;
+        /// with --interface, the daemon's: its bus.status_socket).
         #[arg(long, default_value = "config/demo.toml")]
         config: PathBuf,
         /// Write the TOML fragment here (default: print it only).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Calibrate the tractor on this CAN interface: the running agsteerd does it in its
+        /// calibration mode (started by the operator command `calibrate`, followed on its
+        /// status socket). Without it, the simulator of [sim] on the in-memory bus.
+        #[arg(long)]
+        interface: Option<String>,
+        /// agsteerd's status socket (default: the config's bus.status_socket).
+        #[arg(long)]
+        socket: Option<PathBuf>,
+        /// With --interface: give up after this long, s.
+        #[arg(long, default_value_t = 900.0)]
+        timeout_s: f64,
         #[command(flatten)]
         cfg: ConfigArgs,
     },
@@ -356,8 +369,25 @@ fn main() -> ExitCode {
                 },
             )
         }),
-        Command::Calibrate { config, out, cfg } => load_config(&config, &cfg.set)
-            .and_then(|c| calibrate_cmd::calibrate(&c, out.as_deref())),
+        Command::Calibrate {
+            config,
+            out,
+            interface,
+            socket,
+            timeout_s,
+            cfg,
+        } => load_config(&config, &cfg.set).and_then(|c| match interface {
+            Some(interface) => {
+                let socket = socket.unwrap_or_else(|| PathBuf::from(&c.bus.status_socket));
+                let live = calibrate_live::Live {
+                    interface: &interface,
+                    socket: &socket,
+                    timeout_s,
+                };
+                calibrate_live::calibrate_live(&live, out.as_deref())
+            }
+            None => calibrate_cmd::calibrate(&c, out.as_deref()),
+        }),
         Command::Sim {
             iface,
             config,

@@ -14,6 +14,13 @@ pub const MAX_REPLY_BYTES: usize = 1024 * 1024;
 /// Read the status JSON from `socket` and print it pretty. The whole exchange (connect and
 /// read to the end) must finish within `timeout_s`; errors name the socket and the limit.
 pub fn status(socket: &Path, timeout_s: f64) -> Result<u8> {
+    let v = query(socket, timeout_s)?;
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(0)
+}
+
+/// The status JSON from `socket`, within `timeout_s` (see [`status`]).
+pub fn query(socket: &Path, timeout_s: f64) -> Result<serde_json::Value> {
     if !(timeout_s.is_finite() && timeout_s > 0.0 && timeout_s <= 3600.0) {
         bail!("--timeout-s {timeout_s}: must be in (0, 3600] s");
     }
@@ -59,8 +66,6 @@ pub fn status(socket: &Path, timeout_s: f64) -> Result<u8> {
     }
     let text = std::str::from_utf8(&reply)
         .with_context(|| format!("status reply from {} is not UTF-8", socket.display()))?;
-    let v: serde_json::Value = serde_json::from_str(text.trim())
-        .with_context(|| format!("status reply from {} is not JSON", socket.display()))?;
-    println!("{}", serde_json::to_string_pretty(&v)?);
-    Ok(0)
+    serde_json::from_str(text.trim())
+        .with_context(|| format!("status reply from {} is not JSON", socket.display()))
 }
