@@ -3,7 +3,9 @@
 //! obstacles, so every transit is driveable forward (curvature ≤ 1/r_min).
 
 use crate::geo::{heading_vec, left_normal, wrap_angle, Vec2};
+use std::cell::RefCell;
 use std::f64::consts::TAU;
+use std::rc::Rc;
 
 /// Points of the Dubins CSC path from (`p1`, heading `h1`) to (`p2`, heading `h2`) with turn
 /// senses `s1`, `s2` (+1 left, −1 right), about `step` m apart (none unless `points`); `None`
@@ -84,10 +86,21 @@ fn csc(
     Some((length, pts))
 }
 
+/// The CSC words from (`p1`, `h1`) to (`p2`, `h2`) with radius `r` that have a solution,
+/// shortest first: (length m, turn senses).
+fn words_by_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Vec<(f64, (f64, f64))> {
+    const WORDS: [(f64, f64); 4] = [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)];
+    let mut words: Vec<(f64, (f64, f64))> = WORDS
+        .iter()
+        .filter_map(|&(a, b)| csc(p1, h1, p2, h2, a, b, r, 1.0, false).map(|c| (c.0, (a, b))))
+        .collect();
+    words.sort_by(|a, b| a.0.total_cmp(&b.0));
+    words
+}
+
 /// Length of the shortest CSC curve from (`p1`, `h1`) to (`p2`, `h2`) with radius `r`, m.
 pub fn csc_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Option<f64> {
-    const WORDS: [(f64, f64); 4] = [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)];
-    WORDS
+    [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)]
         .iter()
         .filter_map(|&(a, b)| csc(p1, h1, p2, h2, a, b, r, 1.0, false).map(|c| c.0))
         .min_by(f64::total_cmp)
@@ -104,13 +117,8 @@ pub fn transit(
     step: f64,
     clear: &dyn Fn(&Vec2) -> bool,
 ) -> Option<(Vec<Vec2>, bool)> {
-    const WORDS: [(f64, f64); 4] = [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)];
     // Lengths first; points only for the words tried, shortest first.
-    let mut words: Vec<(f64, (f64, f64))> = WORDS
-        .iter()
-        .filter_map(|&(a, b)| csc(p1, h1, p2, h2, a, b, r, step, false).map(|c| (c.0, (a, b))))
-        .collect();
-    words.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let words = words_by_length(p1, h1, p2, h2, r);
     let points = |(a, b): (f64, f64)| csc(p1, h1, p2, h2, a, b, r, step, true).map(|c| c.1);
     for &(_, word) in &words {
         let pts = points(word)?;
@@ -132,6 +140,32 @@ pub struct WaypointGrid {
     pub ny: usize,
     /// Node (i, j) at `j * nx + i` is usable.
     pub usable: Vec<bool>,
+    /// The curves between nodes, solved once (see [`EdgeTable`]).
+    edges: RefCell<EdgeTable>,
+}
+
+/// One CSC word of an edge between grid nodes: its length (m) and its points relative to the
+/// edge's first node.
+#[derive(Debug, Clone)]
+struct EdgeWord {
+    length: f64,
+    pts: Vec<Vec2>,
+}
+
+/// Nodes an edge of the waypoint graph may join: up to this many grid steps apart each way.
+const EDGE_REACH: i64 = 2;
+const EDGE_SPAN: usize = (2 * EDGE_REACH + 1) as usize;
+
+/// The CSC words of every edge of the waypoint graph, solved once in the grid's frame: the
+/// curve from a node with heading index `ha` to the node (`di`, `dj`) steps away with heading
+/// index `hb` has the same shape wherever the node lies (Fields2Cover solves its turns once in
+/// a canonical frame the same way), so the search only translates the points and checks them.
+#[derive(Debug, Clone, Default)]
+struct EdgeTable {
+    /// (r_min, point spacing) the table was solved for, as bits.
+    key: (u64, u64),
+    /// Words shortest first per (di, dj, ha, hb); `None` until first needed.
+    slots: Vec<Option<Rc<[EdgeWord]>>>,
 }
 
 impl WaypointGrid {
@@ -154,6 +188,7 @@ impl WaypointGrid {
             nx,
             ny,
             usable: vec![false; nx * ny],
+            edges: RefCell::default(),
         };
         for j in 0..ny {
             for i in 0..nx {
@@ -161,6 +196,33 @@ impl WaypointGrid {
             }
         }
         grid
+    }
+
+    /// The words of the edge from a node with heading index `ha` to the node (`di`, `dj`)
+    /// steps away with heading index `hb`, shortest first, points `step` m apart.
+    fn edge_words(&self, d: (i64, i64), ha: usize, hb: usize, r: f64, step: f64) -> Rc<[EdgeWord]> {
+        let mut table = self.edges.borrow_mut();
+        let key = (r.to_bits(), step.to_bits());
+        if table.key != key || table.slots.is_empty() {
+            table.key = key;
+            table.slots = vec![None; EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS * GRAPH_HEADINGS];
+        }
+        let cell = (d.0 + EDGE_REACH) as usize * EDGE_SPAN + (d.1 + EDGE_REACH) as usize;
+        let slot = (cell * GRAPH_HEADINGS + ha) * GRAPH_HEADINGS + hb;
+        if let Some(words) = &table.slots[slot] {
+            return words.clone();
+        }
+        let to = Vec2::new(d.0 as f64 * self.step, d.1 as f64 * self.step);
+        let (h1, h2) = (graph_heading(ha), graph_heading(hb));
+        let origin = Vec2::new(0.0, 0.0);
+        let words: Rc<[EdgeWord]> = words_by_length(origin, h1, to, h2, r)
+            .into_iter()
+            .filter_map(|(length, (a, b))| {
+                csc(origin, h1, to, h2, a, b, r, step, true).map(|c| EdgeWord { length, pts: c.1 })
+            })
+            .collect();
+        table.slots[slot] = Some(words.clone());
+        words
     }
 
     /// Distance from every node to `goal` through usable nodes (8-neighbour moves), m;
@@ -190,11 +252,9 @@ impl WaypointGrid {
                 (1, 0),
                 (1, 1),
             ] {
-                let (a, b) = (i + di, j + dj);
-                if a < 0 || b < 0 || a >= self.nx as i64 || b >= self.ny as i64 {
+                let Some(n) = self.index(i + di, j + dj) else {
                     continue;
-                }
-                let n = b as usize * self.nx + a as usize;
+                };
                 if !self.usable[n] {
                     continue;
                 }
@@ -210,6 +270,12 @@ impl WaypointGrid {
 
     fn node(&self, i: usize, j: usize) -> Vec2 {
         self.origin + Vec2::new(i as f64 * self.step, j as f64 * self.step)
+    }
+
+    /// Index of node (`i`, `j`), if on the grid.
+    fn index(&self, i: i64, j: i64) -> Option<usize> {
+        (i >= 0 && j >= 0 && (i as usize) < self.nx && (j as usize) < self.ny)
+            .then(|| j as usize * self.nx + i as usize)
     }
 
     /// Usable nodes within `radius` m of `p`: (index, position).
@@ -238,9 +304,32 @@ const HEURISTIC_WEIGHT: f64 = 1.5;
 /// Headings tried at every waypoint.
 const GRAPH_HEADINGS: usize = 8;
 
+/// Heading of heading index `k` of the waypoint graph, rad.
+fn graph_heading(k: usize) -> f64 {
+    k as f64 * TAU / GRAPH_HEADINGS as f64
+}
+
+/// Heading indices an edge along `dir` may arrive with: roughly along the way there (all but
+/// `from` when the edge starts and ends at one node).
+fn arrival_headings(dir: Vec2, from: Option<usize>) -> impl Iterator<Item = usize> {
+    (0..GRAPH_HEADINGS).filter(move |&hk| {
+        if dir.norm() > 1e-9 {
+            wrap_angle(graph_heading(hk) - dir.y.atan2(dir.x)).abs() <= 0.8
+        } else {
+            Some(hk) != from
+        }
+    })
+}
+
 /// A clear transit through several waypoints: A* over (waypoint, heading) states joined by
 /// clear CSC curves to the waypoints within two grid steps, from the start pose to the goal
 /// pose; at most `max_expansions` states are expanded. `None` when no clear way was found.
+///
+/// The search is lazy: a state is queued with the length of its edge's shortest word, and the
+/// edge's points are checked only when the state comes off the queue (then it is queued again
+/// with a longer word's length, or dropped when no word is clear), so each expansion checks
+/// one curve instead of the sixty it could reach. The edges between nodes come from the grid's
+/// [`EdgeTable`].
 #[allow(clippy::too_many_arguments)]
 pub fn route_graph(
     p1: Vec2,
@@ -254,91 +343,111 @@ pub fn route_graph(
     max_expansions: usize,
 ) -> Option<Vec<Vec2>> {
     use std::cmp::Reverse;
-    use std::collections::{BinaryHeap, HashMap};
-    let heading = |k: usize| k as f64 * TAU / GRAPH_HEADINGS as f64;
+    use std::collections::BinaryHeap;
+    const H: usize = GRAPH_HEADINGS;
+    /// The parent of the states joined to the start pose.
+    const START: u32 = u32::MAX;
     let reach = 2.0 * grid.step * std::f64::consts::SQRT_2 + 1e-6;
     // The heuristic: the distance to go through the grid (it knows the way around bays).
     let to_goal = grid.distances_to(&p2, 3.0 * grid.step);
+    let states = grid.usable.len() * H;
+    let cell = |s: usize| (s / H % grid.nx, s / H / grid.nx);
     let pose = |s: usize| {
-        (
-            grid.node(s / GRAPH_HEADINGS % grid.nx, s / GRAPH_HEADINGS / grid.nx),
-            heading(s % GRAPH_HEADINGS),
-        )
+        let (i, j) = cell(s);
+        (grid.node(i, j), graph_heading(s % H))
     };
-    let edge = |a: (Vec2, f64), b: (Vec2, f64)| -> Option<(f64, Vec<Vec2>)> {
-        match transit(a.0, a.1, b.0, b.1, r, step, clear) {
-            Some((pts, true)) => Some((crate::geo::polygon::polyline_length(&pts), pts)),
-            _ => None,
+    // The words of the edge parent → s, shortest first, with the point they are placed at.
+    let words_of = |parent: u32, s: usize| -> (Vec2, Rc<[EdgeWord]>) {
+        let (q, h) = pose(s);
+        if parent == START {
+            let words: Rc<[EdgeWord]> = words_by_length(p1, h1, q, h, r)
+                .into_iter()
+                .filter_map(|(length, (a, b))| {
+                    csc(p1, h1, q, h, a, b, r, step, true).map(|c| EdgeWord { length, pts: c.1 })
+                })
+                .collect();
+            return (Vec2::new(0.0, 0.0), words);
         }
+        let p = parent as usize;
+        let ((pi, pj), (si, sj)) = (cell(p), cell(s));
+        let d = (si as i64 - pi as i64, sj as i64 - pj as i64);
+        (pose(p).0, grid.edge_words(d, p % H, s % H, r, step))
     };
-    // States: waypoint index · GRAPH_HEADINGS + heading index; START is the start pose.
-    const START: usize = usize::MAX;
     let key = |f: f64| Reverse((f * 1000.0) as u64);
-    let mut best: HashMap<usize, (f64, usize)> = HashMap::new();
-    let mut heap: BinaryHeap<(Reverse<u64>, usize)> = BinaryHeap::new();
-    let relax = |from: usize,
-                 from_cost: f64,
-                 at: (Vec2, f64),
-                 best: &mut HashMap<usize, (f64, usize)>,
-                 heap: &mut BinaryHeap<(Reverse<u64>, usize)>| {
-        for (k, q) in grid.near(&at.0, reach) {
-            let dir = q - at.0;
-            for hk in 0..GRAPH_HEADINGS {
-                let h = heading(hk);
-                // Only headings roughly along the way there.
-                if dir.norm() > 1e-9 && wrap_angle(h - dir.y.atan2(dir.x)).abs() > 0.8 {
-                    continue;
-                }
-                let s = k * GRAPH_HEADINGS + hk;
-                if s == from {
-                    continue;
-                }
-                let Some((len, _)) = edge(at, (q, h)) else {
-                    continue;
-                };
-                let g = from_cost + len;
-                if best.get(&s).is_none_or(|b| g < b.0) {
-                    best.insert(s, (g, from));
-                    let to_go = to_goal[k];
-                    if to_go.is_finite() {
-                        heap.push((key(g + HEURISTIC_WEIGHT * to_go), s));
-                    }
-                }
-            }
-        }
-    };
-    relax(START, 0.0, (p1, h1), &mut best, &mut heap);
-    let mut done: HashMap<usize, ()> = HashMap::new();
-    let mut expansions = 0;
-    while let Some((_, s)) = heap.pop() {
-        if done.insert(s, ()).is_some() {
+    let mut done = vec![false; states];
+    let mut cost = vec![f64::INFINITY; states];
+    let mut parent = vec![START; states];
+    let mut word = vec![0u8; states];
+    let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::new();
+    // Queue the start's neighbours with their shortest words' lengths.
+    for (k, q) in grid.near(&p1, reach) {
+        if !to_goal[k].is_finite() {
             continue;
         }
+        for hk in arrival_headings(q - p1, None) {
+            if let Some(len) = csc_length(p1, h1, q, graph_heading(hk), r) {
+                heap.push((
+                    key(len + HEURISTIC_WEIGHT * to_goal[k]),
+                    (k * H + hk) as u32,
+                    START,
+                ));
+            }
+        }
+    }
+    let mut expansions = 0;
+    while let Some((Reverse(queued), s, from)) = heap.pop() {
+        let s = s as usize;
+        if done[s] {
+            continue;
+        }
+        // Check the edge now: its first clear word.
+        let (base, words) = words_of(from, s);
+        let Some((w, found)) = words
+            .iter()
+            .enumerate()
+            .find(|(_, w)| w.pts.iter().all(|q| clear(&(base + q))))
+        else {
+            continue;
+        };
+        let g = if from == START {
+            0.0
+        } else {
+            cost[from as usize]
+        } + found.length;
+        let f = g + HEURISTIC_WEIGHT * to_goal[s / H];
+        if key(f).0 > queued + 1 {
+            // A longer word than queued: back in the queue at its true cost.
+            heap.push((key(f), s as u32, from));
+            continue;
+        }
+        done[s] = true;
+        cost[s] = g;
+        parent[s] = from;
+        word[s] = w as u8;
         expansions += 1;
         if expansions > max_expansions {
             tracing::debug!(expansions, "no clear transit found through the waypoints");
             return None;
         }
-        let g = best.get(&s).map(|b| b.0)?;
         let at = pose(s);
         if (p2 - at.0).norm() <= 3.0 * grid.step {
-            if let Some((_, last)) = edge(at, (p2, h2)) {
-                // Rebuild the chain of poses back to the start, then its curves.
+            if let Some((last, true)) = transit(at.0, at.1, p2, h2, r, step, clear) {
+                // The chain of states back to the start, then its curves.
                 let mut chain = vec![s];
-                while let Some(&(_, parent)) = best.get(chain.last()?) {
-                    if parent == START {
+                while let Some(&c) = chain.last() {
+                    if parent[c] == START {
                         break;
                     }
-                    chain.push(parent);
+                    chain.push(parent[c] as usize);
                 }
                 chain.reverse();
                 let mut pts = vec![p1];
-                let mut from = (p1, h1);
+                let mut from = START;
                 for &c in &chain {
-                    let to = pose(c);
-                    let (_, piece) = edge(from, to)?;
-                    pts.extend(piece.into_iter().skip(1));
-                    from = to;
+                    let (base, words) = words_of(from, c);
+                    let piece = words.get(word[c] as usize)?;
+                    pts.extend(piece.pts.iter().skip(1).map(|q| base + q));
+                    from = c as u32;
                 }
                 pts.extend(last.into_iter().skip(1));
                 tracing::debug!(
@@ -349,7 +458,30 @@ pub fn route_graph(
                 return Some(pts);
             }
         }
-        relax(s, g, at, &mut best, &mut heap);
+        // Queue the neighbours with their shortest words' lengths.
+        let (i, j) = cell(s);
+        for di in -EDGE_REACH..=EDGE_REACH {
+            for dj in -EDGE_REACH..=EDGE_REACH {
+                let Some(k) = grid.index(i as i64 + di, j as i64 + dj) else {
+                    continue;
+                };
+                if !grid.usable[k] || !to_goal[k].is_finite() {
+                    continue;
+                }
+                let dir = Vec2::new(di as f64, dj as f64);
+                for hk in arrival_headings(dir, Some(s % H)) {
+                    let next = k * H + hk;
+                    if done[next] {
+                        continue;
+                    }
+                    let words = grid.edge_words((di, dj), s % H, hk, r, step);
+                    if let Some(first) = words.first() {
+                        let f = g + first.length + HEURISTIC_WEIGHT * to_goal[k];
+                        heap.push((key(f), next as u32, s as u32));
+                    }
+                }
+            }
+        }
     }
     None
 }
