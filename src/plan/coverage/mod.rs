@@ -6,6 +6,7 @@
 //! ISO 11783-10 TASKDATA into one). Every stage is a pure function of its inputs.
 
 pub mod bypass;
+mod clear_map;
 pub mod decompose;
 pub mod geometry;
 pub mod headland;
@@ -19,6 +20,7 @@ pub mod transit;
 pub use crate::plan::types::{Field, PlanSegment, SegmentKind};
 pub use runs::obstacle_size;
 
+use clear_map::ClearMap;
 use runs::drive_run;
 
 use crate::geo::{v2, vec_heading, wrap_angle, Direction, Vec2};
@@ -126,64 +128,6 @@ pub fn implement_clear(field: &Field, half: f64, q: &Vec2) -> bool {
             .obstacles
             .iter()
             .all(|o| !contains_point(o, q) && far(o))
-}
-
-/// [`implement_clear`] with a lazily filled grid of cells known to be clear throughout (their
-/// centre is clear by `half` plus half the cell's diagonal), so most checks are one lookup.
-struct ClearMap<'a> {
-    field: &'a Field,
-    half: f64,
-    origin: Vec2,
-    cell: f64,
-    nx: usize,
-    ny: usize,
-    /// 0 = not known yet, 1 = clear throughout, 2 = check each point.
-    state: std::cell::RefCell<Vec<u8>>,
-}
-
-impl<'a> ClearMap<'a> {
-    /// At most this many grid cells (a few MB).
-    const MAX_CELLS: f64 = 4.0e6;
-
-    fn new(field: &'a Field, half: f64) -> Self {
-        let (lo, hi) = crate::geo::polygon::bbox(field.boundary.iter())
-            .unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
-        let span = hi - lo;
-        let cell = (half.max(0.5)).max((span.x * span.y / Self::MAX_CELLS).sqrt());
-        let nx = (span.x / cell).ceil() as usize + 1;
-        let ny = (span.y / cell).ceil() as usize + 1;
-        ClearMap {
-            field,
-            half,
-            origin: lo,
-            cell,
-            nx,
-            ny,
-            state: std::cell::RefCell::new(vec![0; nx * ny]),
-        }
-    }
-
-    fn clear(&self, q: &Vec2) -> bool {
-        let i = ((q.x - self.origin.x) / self.cell).floor();
-        let j = ((q.y - self.origin.y) / self.cell).floor();
-        if i >= 0.0 && j >= 0.0 && (i as usize) < self.nx && (j as usize) < self.ny {
-            let k = j as usize * self.nx + i as usize;
-            let mut state = self.state.borrow_mut();
-            if state[k] == 0 {
-                let centre = self.origin + v2((i + 0.5) * self.cell, (j + 0.5) * self.cell);
-                let deep = self.half + self.cell * std::f64::consts::FRAC_1_SQRT_2;
-                state[k] = if implement_clear(self.field, deep, &centre) {
-                    1
-                } else {
-                    2
-                };
-            }
-            if state[k] == 1 {
-                return true;
-            }
-        }
-        implement_clear(self.field, self.half, q)
-    }
 }
 
 impl CoverageParams {

@@ -1,0 +1,260 @@
+//! [`super::implement_clear`] for every point a plan tries, made cheap: a lazily filled grid
+//! of cells that are clear throughout (one lookup), blocked throughout, or near an edge. A cell
+//! near an edge keeps the edges within reach of it and a reference point whose side of every
+//! ring is known, so a point there is checked against those few edges (its distance to each,
+//! and the parity of the edges crossed on the way to the reference point) instead of against
+//! every edge of the field: plan time on a boundary of many vertices no longer grows with them.
+
+use super::{implement_clear, Field};
+use crate::geo::polygon::{bbox, contains_point, point_segment_distance};
+use crate::geo::{cross, v2, Vec2};
+use std::cell::RefCell;
+use std::ops::Range;
+
+/// The edges of the rings near one cell.
+#[derive(Debug)]
+struct Local {
+    /// A point of the cell's circumscribed disc on no edge.
+    reference: Vec2,
+    /// Edges within reach of the cell, grouped by ring: (a, b).
+    edges: Vec<(Vec2, Vec2)>,
+    /// Rings with edges near the cell: (ring: 0 the boundary, k obstacle k − 1; the reference
+    /// inside it; its edges in `edges`).
+    rings: Vec<(usize, bool, Range<usize>)>,
+    /// The reference point is inside the boundary and outside the obstacles, as far as the
+    /// rings without edges near the cell tell (every point of the cell with it).
+    far_free: bool,
+}
+
+/// Cell states.
+const UNKNOWN: u32 = 0;
+const CLEAR: u32 = 1;
+const BLOCKED: u32 = 2;
+/// States from here on: near an edge, `locals[state - NEAR]`.
+const NEAR: u32 = 3;
+
+/// [`implement_clear`] of one field and half width through a grid of cells.
+pub(super) struct ClearMap<'a> {
+    field: &'a Field,
+    half: f64,
+    origin: Vec2,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    state: RefCell<Vec<u32>>,
+    locals: RefCell<Vec<Local>>,
+}
+
+impl<'a> ClearMap<'a> {
+    /// At most this many grid cells (a few MB).
+    const MAX_CELLS: f64 = 4.0e6;
+
+    pub(super) fn new(field: &'a Field, half: f64) -> Self {
+        let (lo, hi) = bbox(field.boundary.iter()).unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
+        let span = hi - lo;
+        let cell = (half.max(0.5)).max((span.x * span.y / Self::MAX_CELLS).sqrt());
+        let nx = (span.x / cell).ceil() as usize + 1;
+        let ny = (span.y / cell).ceil() as usize + 1;
+        ClearMap {
+            field,
+            half,
+            origin: lo,
+            cell,
+            nx,
+            ny,
+            state: RefCell::new(vec![UNKNOWN; nx * ny]),
+            locals: RefCell::new(Vec::new()),
+        }
+    }
+
+    /// Is the implement clear at `q` (inside the boundary, off the obstacles, `half` m from
+    /// every edge)? The same answer as [`implement_clear`].
+    pub(super) fn clear(&self, q: &Vec2) -> bool {
+        let i = ((q.x - self.origin.x) / self.cell).floor();
+        let j = ((q.y - self.origin.y) / self.cell).floor();
+        if !(i >= 0.0 && j >= 0.0 && (i as usize) < self.nx && (j as usize) < self.ny) {
+            return implement_clear(self.field, self.half, q);
+        }
+        let k = j as usize * self.nx + i as usize;
+        let known = self.state.borrow()[k];
+        let state = if known == UNKNOWN {
+            let centre = self.origin + v2((i + 0.5) * self.cell, (j + 0.5) * self.cell);
+            let s = self.classify(centre);
+            self.state.borrow_mut()[k] = s;
+            s
+        } else {
+            known
+        };
+        match state {
+            CLEAR => true,
+            BLOCKED => false,
+            s => self
+                .locals
+                .borrow()
+                .get((s - NEAR) as usize)
+                .is_none_or(|local| self.clear_near(local, q)),
+        }
+    }
+
+    /// The state of the cell about `centre`.
+    fn classify(&self, centre: Vec2) -> u32 {
+        // Every point of the cell lies within `reach` of its centre.
+        let reach = self.cell * std::f64::consts::FRAC_1_SQRT_2;
+        if implement_clear(self.field, self.half + reach, &centre) {
+            return CLEAR;
+        }
+        let rings = std::iter::once(&self.field.boundary).chain(self.field.obstacles.iter());
+        let mut edges = Vec::new();
+        let mut near_rings = Vec::new();
+        let mut far: Vec<(usize, &Vec<Vec2>)> = Vec::new();
+        for (r, ring) in rings.enumerate() {
+            let start = edges.len();
+            let n = ring.len();
+            for e in 0..n {
+                let (a, b) = (ring[e], ring[(e + 1) % n]);
+                // Edges a point of the cell could come within `half` of, or cross on its way
+                // to the reference point (both within `reach` of the centre).
+                if point_segment_distance(&centre, &a, &b) <= self.half + reach + 1e-6 {
+                    edges.push((a, b));
+                }
+            }
+            if edges.len() > start {
+                near_rings.push((r, ring, start..edges.len()));
+            } else {
+                far.push((r, ring));
+            }
+        }
+        if edges.is_empty() {
+            // No edge within reach and not clear at the centre: outside the field or inside an
+            // obstacle throughout.
+            return BLOCKED;
+        }
+        // A reference point on no edge (the centre, else a point nearby within the disc).
+        let off_edges = |p: &Vec2| {
+            edges
+                .iter()
+                .all(|(a, b)| point_segment_distance(p, a, b) > 1e-6 * (1.0 + self.cell))
+        };
+        let reference = (0..8)
+            .map(|t| {
+                let angle = 0.7 + t as f64 * 0.9;
+                centre + v2(angle.cos(), angle.sin()) * (t as f64 * 0.08 * reach)
+            })
+            .find(off_edges);
+        let Some(reference) = reference else {
+            // Nowhere to stand: check every point against every edge.
+            return self.push_local(Local {
+                reference: centre,
+                edges: Vec::new(),
+                rings: Vec::new(),
+                far_free: false,
+            });
+        };
+        let free_of = |r: usize, ring: &Vec<Vec2>| {
+            let inside = contains_point(ring, &reference);
+            if r == 0 {
+                inside
+            } else {
+                !inside
+            }
+        };
+        let far_free = far.iter().all(|&(r, ring)| free_of(r, ring));
+        let rings = near_rings
+            .into_iter()
+            .map(|(r, ring, range)| (r, contains_point(ring, &reference), range))
+            .collect();
+        self.push_local(Local {
+            reference,
+            edges,
+            rings,
+            far_free,
+        })
+    }
+
+    fn push_local(&self, local: Local) -> u32 {
+        let mut locals = self.locals.borrow_mut();
+        locals.push(local);
+        NEAR + (locals.len() - 1) as u32
+    }
+
+    /// [`implement_clear`] at `q` in a cell near an edge.
+    fn clear_near(&self, local: &Local, q: &Vec2) -> bool {
+        if local.rings.is_empty() {
+            return implement_clear(self.field, self.half, q);
+        }
+        if !local.far_free {
+            return false;
+        }
+        if local
+            .edges
+            .iter()
+            .any(|(a, b)| point_segment_distance(q, a, b) < self.half - 1e-6)
+        {
+            return false;
+        }
+        // The side of each near ring: the reference's, flipped by every edge crossed on the
+        // segment from `q` to it. Neither end lies on an edge; a vertex on the segment's line
+        // counts on one side only (the half-open rule), so a touch counts twice or not at all.
+        let r = local.reference;
+        let above = |p: &Vec2| cross(&(r - q), &(p - q)) > 0.0;
+        local.rings.iter().all(|(ring, inside, range)| {
+            let crossings = local.edges[range.clone()]
+                .iter()
+                .filter(|(a, b)| {
+                    above(a) != above(b)
+                        && (cross(&(b - a), &(q - a)) > 0.0) != (cross(&(b - a), &(r - a)) > 0.0)
+                })
+                .count();
+            let inside_q = *inside != (crossings % 2 == 1);
+            if *ring == 0 {
+                inside_q
+            } else {
+                !inside_q
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// The map answers as [`implement_clear`] does, point for point, on a concave field with
+    /// an obstacle, near its edges and vertices and outside it.
+    #[test]
+    fn the_map_agrees_with_the_direct_check() {
+        let field = Field {
+            boundary: vec![
+                v2(0.0, 0.0),
+                v2(120.0, 0.0),
+                v2(120.0, 80.0),
+                v2(70.0, 30.0),
+                v2(40.0, 90.0),
+                v2(0.0, 60.0),
+            ],
+            obstacles: vec![vec![
+                v2(20.0, 20.0),
+                v2(35.0, 22.0),
+                v2(30.0, 35.0),
+                v2(18.0, 30.0),
+            ]],
+        };
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        for half in [0.7, 3.0, 9.0] {
+            let map = ClearMap::new(&field, half);
+            let mut disagree = 0;
+            let mut clear = 0;
+            for _ in 0..20_000 {
+                let q = v2(rng.gen_range(-10.0..130.0), rng.gen_range(-10.0..100.0));
+                let want = implement_clear(&field, half, &q);
+                clear += usize::from(want);
+                disagree += usize::from(map.clear(&q) != want);
+            }
+            assert_eq!(disagree, 0, "half {half}");
+            assert!(clear > 2_000, "half {half}: {clear} clear points");
+            // Some cells near the edges were checked through their local edges.
+            assert!(!map.locals.borrow().is_empty());
+        }
+    }
+}
