@@ -7,6 +7,111 @@ use std::cell::RefCell;
 use std::f64::consts::TAU;
 use std::rc::Rc;
 
+/// One Dubins CSC curve: arc about `c1`, straight from `t1` along `theta`, arc about `c2`.
+struct Csc {
+    c1: Vec2,
+    c2: Vec2,
+    h1: f64,
+    s1: f64,
+    s2: f64,
+    theta: f64,
+    t1: Vec2,
+    /// Lengths of the first arc and of the straight, and the whole length, m.
+    l1: f64,
+    straight: f64,
+    length: f64,
+    r: f64,
+    /// The goal (the last point, exactly).
+    p2: Vec2,
+}
+
+impl Csc {
+    /// The Dubins CSC curve from (`p1`, heading `h1`) to (`p2`, heading `h2`) with turn senses
+    /// `s1`, `s2` (+1 left, −1 right) and radius `r`; `None` when the word has no solution.
+    #[allow(clippy::too_many_arguments)]
+    fn new(p1: Vec2, h1: f64, p2: Vec2, h2: f64, s1: f64, s2: f64, r: f64) -> Option<Self> {
+        let c1 = p1 + left_normal(&heading_vec(h1)) * (s1 * r);
+        let c2 = p2 + left_normal(&heading_vec(h2)) * (s2 * r);
+        let d = c2 - c1;
+        let dist = d.norm();
+        // Tangent direction of the straight.
+        let theta = if s1 == s2 {
+            if dist < 1e-9 {
+                return None;
+            }
+            d.y.atan2(d.x)
+        } else {
+            if dist < 2.0 * r {
+                return None;
+            }
+            let alpha = (2.0 * r / dist).asin();
+            d.y.atan2(d.x) + s1 * alpha
+        };
+        let sweep = |from: f64, to: f64, s: f64| {
+            let a = wrap_angle(to - from) * s;
+            if a < -1e-9 {
+                a + TAU
+            } else {
+                a.max(0.0)
+            }
+        };
+        let a1 = sweep(h1, theta, s1);
+        let a2 = sweep(theta, h2, s2);
+        // Tangent points.
+        let t1 = c1 - left_normal(&heading_vec(theta)) * (s1 * r);
+        let t2 = c2 - left_normal(&heading_vec(theta)) * (s2 * r);
+        let straight = (t2 - t1).norm();
+        if (t2 - t1).dot(&heading_vec(theta)) < -1e-6 {
+            return None;
+        }
+        Some(Csc {
+            c1,
+            c2,
+            h1,
+            s1,
+            s2,
+            theta,
+            t1,
+            l1: r * a1,
+            straight,
+            length: r * (a1 + a2) + straight,
+            r,
+            p2,
+        })
+    }
+
+    /// Points evenly spaced along the exact curve (arc, straight, arc), about `step` m apart,
+    /// the last one the goal: every point lies on the curve and the chords are all alike, so
+    /// three-point curvature never reads more than 1/r, even across the joins of the pieces.
+    /// Checked one by one as they are made: `None` at the first point where `clear` fails.
+    fn points(&self, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> Option<Vec<Vec2>> {
+        let n = (self.length / step).ceil().max(1.0) as usize;
+        let l2 = self.l1 + self.straight;
+        let r = self.r;
+        let on_arc = |c: Vec2, h0: f64, s: f64, along: f64| {
+            c - left_normal(&heading_vec(h0 + s * along / r)) * (s * r)
+        };
+        let mut pts = Vec::with_capacity(n + 1);
+        for k in 0..=n {
+            let at = self.length * k as f64 / n as f64;
+            let q = if k == n {
+                self.p2
+            } else if at <= self.l1 {
+                on_arc(self.c1, self.h1, self.s1, at)
+            } else if at <= l2 {
+                self.t1 + heading_vec(self.theta) * (at - self.l1)
+            } else {
+                on_arc(self.c2, self.theta, self.s2, at - l2)
+            };
+            if !clear(&q) {
+                return None;
+            }
+            pts.push(q);
+        }
+        Some(pts)
+    }
+}
+
 /// Points of the Dubins CSC path from (`p1`, heading `h1`) to (`p2`, heading `h2`) with turn
 /// senses `s1`, `s2` (+1 left, −1 right), about `step` m apart (none unless `points`); `None`
 /// when the word has no solution. Returns (length m, points).
@@ -22,68 +127,11 @@ fn csc(
     step: f64,
     points: bool,
 ) -> Option<(f64, Vec<Vec2>)> {
-    let c1 = p1 + left_normal(&heading_vec(h1)) * (s1 * r);
-    let c2 = p2 + left_normal(&heading_vec(h2)) * (s2 * r);
-    let d = c2 - c1;
-    let dist = d.norm();
-    // Tangent direction of the straight.
-    let theta = if s1 == s2 {
-        if dist < 1e-9 {
-            return None;
-        }
-        d.y.atan2(d.x)
-    } else {
-        if dist < 2.0 * r {
-            return None;
-        }
-        let alpha = (2.0 * r / dist).asin();
-        d.y.atan2(d.x) + s1 * alpha
-    };
-    let sweep = |from: f64, to: f64, s: f64| {
-        let a = wrap_angle(to - from) * s;
-        if a < -1e-9 {
-            a + TAU
-        } else {
-            a.max(0.0)
-        }
-    };
-    let a1 = sweep(h1, theta, s1);
-    let a2 = sweep(theta, h2, s2);
-    // Tangent points.
-    let t1 = c1 - left_normal(&heading_vec(theta)) * (s1 * r);
-    let t2 = c2 - left_normal(&heading_vec(theta)) * (s2 * r);
-    let straight = (t2 - t1).norm();
-    if (t2 - t1).dot(&heading_vec(theta)) < -1e-6 {
-        return None;
-    }
-    let length = r * (a1 + a2) + straight;
+    let curve = Csc::new(p1, h1, p2, h2, s1, s2, r)?;
     if !points {
-        return Some((length, Vec::new()));
+        return Some((curve.length, Vec::new()));
     }
-    // Points evenly spaced along the exact curve (arc, straight, arc): every point lies on
-    // the curve and the chords are all alike, so three-point curvature never reads more than
-    // 1/r, even across the joins of the pieces.
-    let n = (length / step).ceil().max(1.0) as usize;
-    let (l1, l2) = (r * a1, r * a1 + straight);
-    let on_arc = |c: Vec2, h0: f64, s: f64, along: f64| {
-        c - left_normal(&heading_vec(h0 + s * along / r)) * (s * r)
-    };
-    let mut pts: Vec<Vec2> = (0..=n)
-        .map(|k| {
-            let at = length * k as f64 / n as f64;
-            if at <= l1 {
-                on_arc(c1, h1, s1, at)
-            } else if at <= l2 {
-                t1 + heading_vec(theta) * (at - l1)
-            } else {
-                on_arc(c2, theta, s2, at - l2)
-            }
-        })
-        .collect();
-    if let Some(last) = pts.last_mut() {
-        *last = p2;
-    }
-    Some((length, pts))
+    Some((curve.length, curve.points(step, &|_| true)?))
 }
 
 /// The CSC words from (`p1`, `h1`) to (`p2`, `h2`) with radius `r` that have a solution,
@@ -117,16 +165,16 @@ pub fn transit(
     step: f64,
     clear: &dyn Fn(&Vec2) -> bool,
 ) -> Option<(Vec<Vec2>, bool)> {
-    // Lengths first; points only for the words tried, shortest first.
+    // Lengths first; points only for the words tried, shortest first, each given up at its
+    // first point that is not clear.
     let words = words_by_length(p1, h1, p2, h2, r);
-    let points = |(a, b): (f64, f64)| csc(p1, h1, p2, h2, a, b, r, step, true).map(|c| c.1);
-    for &(_, word) in &words {
-        let pts = points(word)?;
-        if pts.iter().all(clear) {
+    for &(_, (a, b)) in &words {
+        if let Some(pts) = Csc::new(p1, h1, p2, h2, a, b, r)?.points(step, clear) {
             return Some((pts, true));
         }
     }
-    Some((points(words.first()?.1)?, false))
+    let (_, (a, b)) = words.first()?;
+    Some((csc(p1, h1, p2, h2, *a, *b, r, step, true)?.1, false))
 }
 
 /// Clear waypoints on a square grid: the nodes of [`route_graph`].
