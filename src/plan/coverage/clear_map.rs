@@ -257,4 +257,50 @@ mod tests {
             assert!(!map.locals.borrow().is_empty());
         }
     }
+
+    /// The field of a failing case of tests/plan_guarantees.rs (a star with a square hole).
+    #[test]
+    fn the_map_agrees_on_a_star_with_a_hole() {
+        let size = 155.29840172620393;
+        let pts = [
+            (0.42661870111364264, 0.7),
+            (0.0, 0.7),
+            (0.0, 0.8400777438246129),
+            (0.0, 0.7),
+            (0.274301038943484, 0.938672995133783),
+            (0.5580423271939455, 0.8763936199343776),
+        ];
+        let n = pts.len() as f64;
+        let boundary: Vec<Vec2> = pts
+            .iter()
+            .enumerate()
+            .map(|(i, (u, r))| {
+                let a = std::f64::consts::TAU * (i as f64 + 0.05 + 0.9 * u) / n;
+                v2(size * r * a.cos(), size * r * a.sin())
+            })
+            .collect();
+        let a = std::f64::consts::TAU * 0.8947645902365421;
+        let (cx, cy, h) = (size * 0.12 * a.cos(), size * 0.12 * a.sin(), size * 0.0250323140638256);
+        let field = Field {
+            boundary,
+            obstacles: vec![vec![
+                v2(cx - h, cy - h),
+                v2(cx + h, cy - h),
+                v2(cx + h, cy + h),
+                v2(cx - h, cy + h),
+            ]],
+        };
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for half in [1.5, 16.98, 17.0, 17.1] {
+            let map = ClearMap::new(&field, half);
+            let mut disagree = Vec::new();
+            for _ in 0..100_000 {
+                let q = v2(rng.gen_range(-160.0..160.0), rng.gen_range(-160.0..160.0));
+                if map.clear(&q) != implement_clear(&field, half, &q) {
+                    disagree.push(q);
+                }
+            }
+            assert!(disagree.is_empty(), "half {half}: {} {:?}", disagree.len(), &disagree[..disagree.len().min(5)]);
+        }
+    }
 }
