@@ -2,7 +2,8 @@
 //! one obstacle (w = r_min = 6 m, 3 headland passes = 18 m), the whole plan at 10, 100 and
 //! 1000 ha to show how it scales with field size, and the whole plan of every real field of
 //! tools/fields/real/ up to 100 ha at widths 3, 6, 12 and 36 m and r_min 5 and 8 m with the
-//! configuration's other defaults (issue 17 point 6: plan only, metrics separate).
+//! configuration's other defaults (issue 17 point 6: plan only, metrics separate; thread CPU
+//! time, with a summary line of the median and the worst).
 //! `cargo bench --bench coverage -- coverage_real/FIELD` runs one field.
 
 use agsteer::geo::{v2, Vec2};
@@ -12,6 +13,10 @@ use agsteer::plan::coverage::{
 };
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use std::hint::black_box;
+
+#[path = "common/thread_cpu.rs"]
+mod thread_cpu;
+use thread_cpu::ThreadCpu;
 
 /// A convex irregular 12-gon of about `hectares` ha with a 20 × 14 m obstacle inside.
 fn twelve_gon(hectares: f64) -> Field {
@@ -113,7 +118,9 @@ fn scaling(c: &mut Criterion) {
     g.finish();
 }
 
-fn real_fields(c: &mut Criterion) {
+/// Every real field of tools/fields/real/ up to 100 ha at every width and turning radius:
+/// (name, field, params) in file order.
+fn real_cases() -> Vec<(String, Field, CoverageParams)> {
     let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tools/fields/real"));
     let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
         .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
@@ -121,10 +128,7 @@ fn real_fields(c: &mut Criterion) {
     files.retain(|p| p.extension().is_some_and(|e| e == "geojson"));
     files.sort();
     let cfg = agsteer::config::Config::default();
-    let mut g = c.benchmark_group("coverage_real");
-    g.sample_size(10);
-    g.measurement_time(std::time::Duration::from_secs(1));
-    g.warm_up_time(std::time::Duration::from_millis(200));
+    let mut cases = Vec::new();
     for path in files {
         let Ok(text) = std::fs::read_to_string(&path) else {
             continue;
@@ -139,21 +143,87 @@ fn real_fields(c: &mut Criterion) {
             .file_stem()
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default();
-        for w in [3.0, 6.0, 12.0, 36.0] {
-            for r in [5.0, 8.0] {
+        for w in REAL_WIDTHS {
+            for r in REAL_R_MINS {
                 let mut p = cfg.coverage_params();
                 p.line_width = w;
                 p.r_min = r;
-                g.bench_with_input(
-                    BenchmarkId::new(&name, format!("w{w}_r{r}")),
-                    &loaded.field,
-                    |b, f| b.iter(|| plan_field(black_box(f), &p)),
-                );
+                cases.push((name.clone(), loaded.field.clone(), p));
             }
         }
     }
-    g.finish();
+    cases
 }
 
-criterion_group!(benches, stages, scaling, real_fields);
-criterion_main!(benches);
+/// Implement widths and turning radii of the real-field group (issue 17 point 6), m.
+const REAL_WIDTHS: [f64; 4] = [3.0, 6.0, 12.0, 36.0];
+const REAL_R_MINS: [f64; 2] = [5.0, 8.0];
+
+/// Whole plans (no metrics) of every real field ≤ 100 ha at every width and r_min, in thread
+/// CPU time; prints the median and the worst case over them after the group. Under `cargo
+/// bench` every case; in test mode (`cargo test --benches`, nextest: each benchmark once)
+/// every field at one of the width × r_min pairs in turn, so all fields and all pairs still
+/// run, at an eighth of the cost.
+fn real_fields(c: &mut Criterion<ThreadCpu>) {
+    let args: Vec<String> = std::env::args().collect();
+    let full = args.iter().any(|a| a == "--bench") && !args.iter().any(|a| a == "--test");
+    let pairs = REAL_WIDTHS.len() * REAL_R_MINS.len();
+    let mut g = c.benchmark_group("coverage_real");
+    g.sample_size(10);
+    g.measurement_time(std::time::Duration::from_secs(1));
+    g.warm_up_time(std::time::Duration::from_millis(200));
+    // Per case: thread CPU time per plan of every sample, s.
+    let times: std::cell::RefCell<Vec<(String, Vec<f64>)>> = Default::default();
+    for (k, (name, field, p)) in real_cases().into_iter().enumerate() {
+        if !full && k % pairs != (k / pairs) % pairs {
+            continue;
+        }
+        let id = format!("w{}_r{}", p.line_width, p.r_min);
+        let slot = {
+            let mut t = times.borrow_mut();
+            t.push((format!("{name} {id}"), Vec::new()));
+            t.len() - 1
+        };
+        g.bench_with_input(BenchmarkId::new(&name, id), &field, |b, f| {
+            b.iter_custom(|iters| {
+                let start = thread_cpu::thread_cpu();
+                for _ in 0..iters {
+                    let _ = black_box(plan_field(black_box(f), &p));
+                }
+                let spent = thread_cpu::thread_cpu().saturating_sub(start);
+                times.borrow_mut()[slot]
+                    .1
+                    .push(spent.as_secs_f64() / iters.max(1) as f64);
+                spent
+            })
+        });
+    }
+    g.finish();
+    // The median sample of each case, then the median and the worst over the cases.
+    let mut per_case: Vec<(f64, String)> = times
+        .into_inner()
+        .into_iter()
+        .filter_map(|(id, mut t)| {
+            t.sort_by(f64::total_cmp);
+            t.get(t.len() / 2).map(|&m| (m, id))
+        })
+        .collect();
+    per_case.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if let (Some(mid), Some(worst)) = (per_case.get(per_case.len() / 2), per_case.last()) {
+        println!(
+            "coverage_real: {} plans, median {:.2} ms, worst {:.2} ms ({}), thread CPU time",
+            per_case.len(),
+            mid.0 * 1e3,
+            worst.0 * 1e3,
+            worst.1
+        );
+    }
+}
+
+criterion_group!(benches, stages, scaling);
+criterion_group! {
+    name = real;
+    config = Criterion::default().with_measurement(ThreadCpu);
+    targets = real_fields
+}
+criterion_main!(benches, real);
