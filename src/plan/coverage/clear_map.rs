@@ -280,7 +280,11 @@ mod tests {
             })
             .collect();
         let a = std::f64::consts::TAU * 0.8947645902365421;
-        let (cx, cy, h) = (size * 0.12 * a.cos(), size * 0.12 * a.sin(), size * 0.0250323140638256);
+        let (cx, cy, h) = (
+            size * 0.12 * a.cos(),
+            size * 0.12 * a.sin(),
+            size * 0.0250323140638256,
+        );
         let field = Field {
             boundary,
             obstacles: vec![vec![
@@ -300,7 +304,12 @@ mod tests {
                     disagree.push(q);
                 }
             }
-            assert!(disagree.is_empty(), "half {half}: {} {:?}", disagree.len(), &disagree[..disagree.len().min(5)]);
+            assert!(
+                disagree.is_empty(),
+                "half {half}: {} {:?}",
+                disagree.len(),
+                &disagree[..disagree.len().min(5)]
+            );
         }
     }
 }
