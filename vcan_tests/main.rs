@@ -3,6 +3,7 @@
 
 mod gnss;
 mod kill9;
+mod latency;
 mod support;
 
 use agsteer::can::bus::{CanBus, Filter, SocketCanBus};
