@@ -36,7 +36,13 @@ pub fn fix_latency(cap: &[(f64, u32, Vec<u8>)], stalls: &[Stall], dt: f64) -> Fi
         let Some(next) = cmds.get(ci) else { break };
         let before = ci.checked_sub(1).and_then(|i| cmds.get(i)).map(|c| t - c);
         let within_3ms = cmds[ci..].iter().take_while(|c| **c <= t + 0.003).count();
-        rows.push((next - t, gap_less_stalls(*t, *next, stalls), before, within_3ms, k));
+        rows.push((
+            next - t,
+            gap_less_stalls(*t, *next, stalls),
+            before,
+            within_3ms,
+            k,
+        ));
     }
     let mut raw: Vec<f64> = rows.iter().map(|r| r.0).collect();
     let mut net: Vec<f64> = rows.iter().map(|r| r.1).collect();
@@ -53,7 +59,11 @@ pub fn fix_latency(cap: &[(f64, u32, Vec<u8>)], stalls: &[Stall], dt: f64) -> Fi
     }
     let two = rows.iter().filter(|r| r.3 >= 2).count();
     // The fixes' arrival jitter: intervals between position frames less their median.
-    let fixes: Vec<f64> = cap.iter().filter(|c| is_position(c.1)).map(|c| c.0).collect();
+    let fixes: Vec<f64> = cap
+        .iter()
+        .filter(|c| is_position(c.1))
+        .map(|c| c.0)
+        .collect();
     let mut iv: Vec<f64> = fixes.windows(2).map(|w| w[1] - w[0]).collect();
     iv.sort_by(|a, b| a.total_cmp(b));
     let mid = pct(&iv, 0.5);

@@ -11,3 +11,4 @@ pub mod calibration;
 pub mod gnss;
 pub mod notify;
 pub mod run;
+pub mod tick;

@@ -10,11 +10,15 @@
 //! A control period runs on the timer every dt, and at once when a GNSS fix enters the node
 //! (issue 16 point 7: the command that follows a fix leaves within about a millisecond of its
 //! arrival instead of waiting up to dt for the timer); the timer then restarts from that
-//! period, so the periods stay dt apart and phase-lock to the fixes. Times given to the node
+//! period, so the periods stay dt apart and phase-lock to the fixes, and it holds back a period
+//! due just around the next expected fix ([`super::tick`]), which would otherwise run first and
+//! make the fix wait. Frames already read when the timer is due are taken first, so a fix
+//! among them runs the period. Times given to the node
 //! are whole microseconds ([`log_time`]), so that `--bus-log` records exactly what the node
 //! saw and `agsteer replay` reproduces its decisions.
 
 use super::bus_log::{BusLog, BusLogError, BusLogParams, BusLogStats};
+use super::tick::TickSchedule;
 use crate::can::bus::{monotonic_s, AsyncSocketCan, BusError, Filter};
 use crate::can::candump::log_time;
 use crate::can::{Frame, TimedFrame};
@@ -79,6 +83,10 @@ pub struct LoopStats {
     /// A fix's receive time to its command handed to the socket: last and largest, µs.
     pub fix_to_command_us: f64,
     pub max_fix_to_command_us: f64,
+    /// Timer periods held back for an expected fix ([`super::tick`]).
+    pub held_ticks: u64,
+    /// The fixes' period as learnt, ms (0: not learnt).
+    pub fix_period_ms: f64,
 }
 
 #[derive(Serialize)]
@@ -405,17 +413,68 @@ impl Outputs {
         node: &mut ControllerNode,
         t_fix: f64,
         stats: &mut LoopStats,
-        interval: &mut tokio::time::Interval,
+        schedule: &mut TickSchedule,
     ) {
         let start = std::time::Instant::now();
         let t = log_time(monotonic_s());
         self.step(node, t, stats);
-        interval.reset();
+        schedule.on_fix(t_fix, t);
+        stats.held_ticks = schedule.held;
+        stats.fix_period_ms = schedule.fix_period().unwrap_or(0.0) * 1e3;
         stats.fix_ticks += 1;
         stats.fix_to_command_us = (monotonic_s() - t_fix).max(0.0) * 1e6;
         stats.max_fix_to_command_us = stats.max_fix_to_command_us.max(stats.fix_to_command_us);
         stats.last_step_us = start.elapsed().as_secs_f64() * 1e6;
         stats.max_step_us = stats.max_step_us.max(stats.last_step_us);
+    }
+}
+
+/// Frames taken from the reader's queue when the timer is due, at most (a flood never delays
+/// the timer's period by more than this many frames' decoding).
+const DRAIN_AT_TICK: usize = 64;
+
+/// One event from the bus reader: a frame into the node (and the bus log), or the link down.
+/// The receive time when a GNSS fix entered the controller.
+fn on_bus_event(
+    ev: BusEvent,
+    node: &mut ControllerNode,
+    out: &mut Outputs,
+    stats: &mut LoopStats,
+    iface: &str,
+) -> Option<f64> {
+    match ev {
+        BusEvent::Frame(mut tf) => {
+            stats.frames_in += 1;
+            tf.t = log_time(tf.t);
+            if let Some(l) = &out.log {
+                l.record(tf.t, &tf.frame);
+            }
+            node.on_frame(&tf).then_some(tf.t)
+        }
+        BusEvent::Down(e) => {
+            if out.bus_up {
+                tracing::error!("CAN interface {iface}: {e}");
+                out.bus_up = false;
+                node.supervisor_mut().on_bus(false);
+            }
+            None
+        }
+    }
+}
+
+/// Set B / select job: planned here (an AB job is planned in microseconds), the book saved
+/// by its writer thread.
+fn apply_operator_request(
+    node: &mut ControllerNode,
+    resolved: &crate::config::Resolved,
+    configured: &crate::job::PreparedJob,
+    book: &mut crate::store::jobs_file::JobBook,
+    jobs_tx: &mpsc::SyncSender<crate::store::jobs_file::JobBook>,
+) {
+    if crate::job::operator::apply_request(node, resolved, configured, book)
+        && jobs_tx.try_send(book.clone()).is_err()
+    {
+        tracing::warn!("job book writer busy; this save is skipped");
     }
 }
 
@@ -531,8 +590,12 @@ async fn run_async(
     let mut gnss = ntrip_password.and_then(|password| super::gnss::spawn(&cfg, password, &local));
 
     let dt = resolved.control.dt;
-    let mut interval = tokio::time::interval(Duration::from_secs_f64(dt));
-    interval.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    // The schedule in monotonic seconds (the node's clock), the timer on tokio's.
+    let mut schedule = TickSchedule::new(dt, monotonic_s());
+    let anchor = (tokio::time::Instant::now(), monotonic_s());
+    let deadline = |at: f64| anchor.0 + Duration::from_secs_f64((at - anchor.1).max(0.0));
+    let timer = tokio::time::sleep_until(deadline(schedule.next()));
+    tokio::pin!(timer);
     let mut sigterm = signal(SignalKind::terminate()).map_err(DaemonError::Runtime)?;
     let mut sigint = signal(SignalKind::interrupt()).map_err(DaemonError::Runtime)?;
     let mut sighup = signal(SignalKind::hangup()).map_err(DaemonError::Runtime)?;
@@ -581,11 +644,29 @@ async fn run_async(
                             Err(e) => tracing::error!("SIGHUP: reading the configuration failed: {e}"),
                         }
                     }
-                    scheduled = interval.tick() => {
-                        let late = scheduled.elapsed().as_secs_f64();
+                    _ = &mut timer => {
+                        // Frames already read go first: a fix among them runs this period.
+                        let mut fix = None;
+                        for _ in 0..DRAIN_AT_TICK {
+                            let Ok(ev) = rx.try_recv() else { break };
+                            fix = on_bus_event(ev, &mut node, &mut out, &mut stats, &iface);
+                            if fix.is_some() {
+                                break;
+                            }
+                        }
+                        apply_operator_request(&mut node, &resolved, &configured, &mut book, &jobs_tx);
+                        if let Some(t_fix) = fix {
+                            out.on_fix(&mut node, t_fix, &mut stats, &mut schedule);
+                            timer.as_mut().reset(deadline(schedule.next()));
+                            continue;
+                        }
+                        let late = (monotonic_s() - schedule.next()).max(0.0);
                         let start = std::time::Instant::now();
                         let t = log_time(monotonic_s());
                         let had_events = out.step(&mut node, t, &mut stats);
+                        schedule.on_timer(t);
+                        stats.held_ticks = schedule.held;
+                        timer.as_mut().reset(deadline(schedule.next()));
                         if late > dt {
                             stats.deadline_misses += 1;
                         }
@@ -604,34 +685,14 @@ async fn run_async(
                         stats.max_step_us = stats.max_step_us.max(stats.last_step_us);
                         watchdog.period(late <= dt);
                     }
-                    ev = rx.recv() => match ev {
-                        Some(BusEvent::Frame(mut tf)) => {
-                            stats.frames_in += 1;
-                            tf.t = log_time(tf.t);
-                            if let Some(l) = &out.log {
-                                l.record(tf.t, &tf.frame);
-                            }
-                            if node.on_frame(&tf) {
-                                out.on_fix(&mut node, tf.t, &mut stats, &mut interval);
-                            }
-                            // Set B / select job: planned here (an AB job is planned in
-                            // microseconds), the book saved by its writer thread.
-                            if crate::job::operator::apply_request(
-                                &mut node, &resolved, &configured, &mut book,
-                            ) && jobs_tx.try_send(book.clone()).is_err()
-                            {
-                                tracing::warn!("job book writer busy; this save is skipped");
-                            }
+                    ev = rx.recv() => {
+                        let Some(ev) = ev else { break };
+                        if let Some(t_fix) = on_bus_event(ev, &mut node, &mut out, &mut stats, &iface) {
+                            out.on_fix(&mut node, t_fix, &mut stats, &mut schedule);
+                            timer.as_mut().reset(deadline(schedule.next()));
                         }
-                        Some(BusEvent::Down(e)) => {
-                            if out.bus_up {
-                                tracing::error!("CAN interface {iface}: {e}");
-                                out.bus_up = false;
-                                node.supervisor_mut().on_bus(false);
-                            }
-                        }
-                        None => break,
-                    },
+                        apply_operator_request(&mut node, &resolved, &configured, &mut book, &jobs_tx);
+                    }
                     input = async {
                         match gnss.as_mut() {
                             Some(g) => g.inputs.recv().await,
@@ -640,7 +701,8 @@ async fn run_async(
                     } => {
                         if let Some(i) = input {
                             if node.on_input(&i) {
-                                out.on_fix(&mut node, i.t(), &mut stats, &mut interval);
+                                out.on_fix(&mut node, i.t(), &mut stats, &mut schedule);
+                                timer.as_mut().reset(deadline(schedule.next()));
                             }
                         }
                     }
