@@ -29,7 +29,7 @@ use crate::sim::SimParams;
 use crate::track::law::LawParams;
 use crate::track::local_path::LocalPathParams;
 use crate::track::lost_motion::LostMotionParams;
-use crate::track::TrackerParams;
+use crate::track::{SteeringResponse, TrackerParams};
 use std::path::PathBuf;
 
 /// The whole configuration as its consumers take it, SI.
@@ -238,6 +238,7 @@ impl Config {
                 ld_min: t.ld_min_m,
                 ld_gain: t.ld_gain_s,
                 max_wheel_angle: self.max_wheel_angle(),
+                steering: self.steering_response(),
             },
             tracker_kind: t.kind,
             law: LawParams {
@@ -354,6 +355,22 @@ impl Config {
             self.vehicle.r_min_m.max(v * v / a)
         } else {
             self.vehicle.r_min_m
+        }
+    }
+    /// The steering's response as calibration measured it (`safety.actuator_*`), for the
+    /// default law's look-ahead schedule.
+    pub fn steering_response(&self) -> SteeringResponse {
+        let (f, v) = (&self.safety, &self.vehicle);
+        SteeringResponse {
+            lag: f.actuator_tau_s,
+            dead_time: (f.actuator_dead_time_s - self.track.lead_time_s).max(0.0),
+            rate: f
+                .actuator_rate_deg_s
+                .min(f.max_wheel_rate_deg_s)
+                .to_radians(),
+            sweep: (v.wheelbase_m / v.r_min_m)
+                .atan()
+                .min(self.max_wheel_angle()),
         }
     }
     /// Largest wheel angle, rad.

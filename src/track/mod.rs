@@ -38,6 +38,49 @@ pub struct TrackerParams {
     pub ld_gain: f64,
     /// Largest front-wheel angle, rad.
     pub max_wheel_angle: f64,
+    /// The steering's response the default law's look-ahead covers
+    /// ([`TrackerParams::response_time`]); 0 where not known.
+    pub steering: SteeringResponse,
+}
+
+/// What the controller knows of the steering actuator (the keys `agsteer calibrate` owns:
+/// `safety.actuator_dead_time_s`, `safety.actuator_tau_s`, `safety.actuator_rate_deg_s`), SI.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SteeringResponse {
+    /// First-order lag of the wheel angle behind the command, s.
+    pub lag: f64,
+    /// Dead time the prediction does not cover (the actuator's less `track.lead_time_s`), s.
+    pub dead_time: f64,
+    /// Rate limit of the wheel angle (the slower of the actuator and the command limit),
+    /// rad/s; 0 = none.
+    pub rate: f64,
+    /// The wheel angle swept out of the sharpest turn (atan(L / r_min)), rad.
+    pub sweep: f64,
+}
+
+impl TrackerParams {
+    /// The steering's response time, s: its lag, the dead time not predicted, and the time to
+    /// sweep the wheels out of the sharpest turn at its rate limit. Pure pursuit's loop is
+    /// second order with ωn = √2·v/Ld (linearised about a straight line): a look-ahead of
+    /// v·T puts its crossover near √2/T rad/s. The lag and dead time then cost about
+    /// ωn·(lag + dead) of phase, and a rate-limited steering whose slew lasts longer than the
+    /// look-ahead time cannot follow the command and turns the loop into a limit cycle (the
+    /// rate-limit weave of a 20°/s motor, issue 15). Holding T at least this long keeps both
+    /// small. Computed once at configuration.
+    pub fn response_time(&self) -> f64 {
+        let s = &self.steering;
+        let slew = if s.rate > 0.0 && s.rate.is_finite() {
+            s.sweep.max(0.0) / s.rate
+        } else {
+            0.0
+        };
+        let t = s.lag.max(0.0) + s.dead_time.max(0.0) + slew;
+        if t.is_finite() {
+            t
+        } else {
+            0.0
+        }
+    }
 }
 
 /// The tracker's result for one period.
@@ -86,6 +129,14 @@ pub fn steering_from_travel(out: TrackOutput, direction: Direction) -> TrackOutp
 #[inline]
 pub fn lookahead(params: &TrackerParams, speed: f64) -> f64 {
     params.ld_min.max(params.ld_gain * speed.abs())
+}
+
+/// The look-ahead distance at speed `v` scheduled on the steering's response, m:
+/// max([`lookahead`], |v|·`response_time`), the response time worked out once at
+/// configuration ([`TrackerParams::response_time`]).
+#[inline]
+pub fn scheduled_lookahead(params: &TrackerParams, response_time: f64, speed: f64) -> f64 {
+    lookahead(params, speed).max(response_time * speed.abs())
 }
 
 /// The point `distance` along the local path from sample `start` (extrapolated along the
@@ -165,6 +216,7 @@ mod tests {
             ld_min: 3.0,
             ld_gain: 1.0,
             max_wheel_angle: 35f64.to_radians(),
+            steering: SteeringResponse::default(),
         }
     }
 

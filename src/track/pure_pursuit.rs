@@ -5,13 +5,16 @@
 
 use super::law::{LawNeeds, SteeringLaw};
 use super::local_path::LocalPath;
-use super::{lookahead, point_along, TrackOutput, TrackerParams};
+use super::{lookahead, point_along, scheduled_lookahead, TrackOutput, TrackerParams};
 use crate::geo::{cross, heading_vec, Pose};
 
 /// Pure pursuit with what the controller feeds it chosen by `needs`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PurePursuit {
     pub needs: LawNeeds,
+    /// The look-ahead is scheduled on the steering's response
+    /// ([`scheduled_lookahead`]); `false`: the seed's `ld_min`/`ld_gain` alone.
+    pub scheduled: bool,
 }
 
 impl PurePursuit {
@@ -25,6 +28,7 @@ impl PurePursuit {
                 integral: true,
                 lost_motion: true,
             },
+            scheduled: true,
         }
     }
 
@@ -37,6 +41,7 @@ impl PurePursuit {
                 integral: false,
                 lost_motion: false,
             },
+            scheduled: false,
         }
     }
 }
@@ -53,7 +58,12 @@ impl SteeringLaw for PurePursuit {
         speed: f64,
         params: &TrackerParams,
     ) -> TrackOutput {
-        pure_pursuit(local, pose, speed, params)
+        let ld = if self.scheduled {
+            scheduled_lookahead(params, params.response_time(), speed)
+        } else {
+            lookahead(params, speed)
+        };
+        pure_pursuit_at(local, pose, ld, params)
     }
 }
 
@@ -66,7 +76,16 @@ pub fn pure_pursuit(
     speed: f64,
     params: &TrackerParams,
 ) -> TrackOutput {
-    let ld = lookahead(params, speed);
+    pure_pursuit_at(local, pose, lookahead(params, speed), params)
+}
+
+/// [`pure_pursuit`] with the look-ahead `ld` (m) given.
+pub fn pure_pursuit_at(
+    local: &LocalPath,
+    pose: &Pose,
+    ld: f64,
+    params: &TrackerParams,
+) -> TrackOutput {
     let points = local.points();
     let invalid = TrackOutput {
         wheel_angle: 0.0,
