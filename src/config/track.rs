@@ -114,7 +114,7 @@ impl Default for TrackConfig {
             observer_slip_limit_mps_per_deg: 0.05,
             observer_coast_max_s: 30.0,
             observer_robust: true,
-            position_process_m: 0.0,
+            position_process_m: 0.005,
             lost_motion_tau_s: 5.0,
             lost_motion_threshold_deg: 0.1,
             lost_motion_limit_deg: 1.0,

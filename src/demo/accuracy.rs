@@ -85,6 +85,9 @@ pub struct ScenarioResult {
     pub settle_max_m: Option<f64>,
     pub engaged_fraction: f64,
     pub disengagements: BTreeMap<String, u64>,
+    /// Engages refused for the line (`line_unfollowable`), see [`super::Report::refusals`].
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub refusals: BTreeMap<String, u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rtk_float: Option<FloatReport>,
 }
@@ -299,6 +302,7 @@ pub fn evaluate(
             settle_max_m: settle,
             engaged_fraction: r.engaged_fraction,
             disengagements: r.disengagements.clone(),
+            refusals: r.refusals.clone(),
             rtk_float,
         },
         series,

@@ -323,6 +323,10 @@ pub struct Verdict {
     pub reference_better: bool,
     /// The default is more than 20 % worse than the better reference.
     pub worse_than_reference: bool,
+    /// The default did not finish because the supervisor refused the line as unfollowable
+    /// (`line_unfollowable`: the engage gate, or the line given back as it started), and for
+    /// no other fault: physics, not the tracker (issue 15 point 3's named impossible cells).
+    pub refused_by_design: bool,
 }
 
 impl Cell {
@@ -349,11 +353,21 @@ impl Cell {
             .map(score)
             .fold(None, |b: Option<f64>, x| Some(b.map_or(x, |b| b.min(x))));
         let own = d.map_or(f64::INFINITY, score);
+        let refused_by_design = d.is_some_and(|r| {
+            const REFUSED: &str = "line_unfollowable";
+            !r.finished
+                && (r.refusals.contains_key(REFUSED) || r.disengagements.contains_key(REFUSED))
+                && r
+                    .disengagements
+                    .keys()
+                    .all(|k| k == REFUSED || k == "no_guidance")
+        });
         Verdict {
             meets_bounds,
             best_reference_rms_m: best,
             reference_better: best.is_some_and(|b| b < own),
             worse_than_reference: best.is_some_and(|b| own > 1.2 * b),
+            refused_by_design,
         }
     }
 
@@ -404,7 +418,8 @@ pub fn run_cell(variation: &str, scenario: &str, cfg: &Config, trackers: &[Track
 /// The envelope's Markdown table: rows variations, columns scenarios, each cell the default
 /// tracker's XTE RMS in cm; `*` where a reference tracker did better, `**` where the default
 /// is more than 20 % worse than it, `!` where a bound of the cell's class is not met, `✗`
-/// where the job did not finish.
+/// where the job did not finish, `⊘` where the supervisor refused the line as unfollowable
+/// (refused by design, [`Verdict::refused_by_design`]).
 pub fn markdown(cells: &[Cell], variations: &[&str], scenarios: &[&str]) -> String {
     use std::fmt::Write;
     let mut s = String::from("| variation |");
@@ -438,6 +453,9 @@ fn cell_text(c: &Cell) -> String {
         return "error".into();
     };
     let v = c.verdict();
+    if v.refused_by_design {
+        return "⊘".into();
+    }
     let mut t = format!("{:.2}", 100.0 * r.xte_rms_m);
     if !r.finished {
         t.push_str(" ✗");
@@ -519,7 +537,9 @@ pub fn heat_map_svg(cells: &[Cell], variations: &[&str], scenarios: &[&str]) -> 
                 continue;
             };
             let v = c.verdict();
-            let fill = if r.finished {
+            let fill = if v.refused_by_design {
+                "rgb(200,200,230)".into()
+            } else if r.finished {
                 heat(r.xte_rms_m)
             } else {
                 "rgb(150,150,150)".into()
@@ -528,7 +548,7 @@ pub fn heat_map_svg(cells: &[Cell], variations: &[&str], scenarios: &[&str]) -> 
                 s,
                 r#"<rect x="{x:.1}" y="{y:.1}" width="{CW}" height="{CH}" fill="{fill}" stroke="white"/>"#
             );
-            if !c.meets_targets() {
+            if !c.meets_targets() && !v.refused_by_design {
                 let _ = writeln!(
                     s,
                     r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="none" stroke="#c00000" stroke-width="2"/>"##,
@@ -548,7 +568,9 @@ pub fn heat_map_svg(cells: &[Cell], variations: &[&str], scenarios: &[&str]) -> 
                     y + 9.0
                 );
             }
-            let text = if r.finished {
+            let text = if v.refused_by_design {
+                "⊘".into()
+            } else if r.finished {
                 format!("{:.2}", 100.0 * r.xte_rms_m)
             } else {
                 "✗".into()
@@ -564,7 +586,7 @@ pub fn heat_map_svg(cells: &[Cell], variations: &[&str], scenarios: &[&str]) -> 
     let y = TOP + CH * variations.len() as f64 + 20.0;
     let _ = writeln!(
         s,
-        r#"<text x="10" y="{y:.1}">Colour: green ≤ 0.5 cm, yellow 2.5 cm, red ≥ 25 cm (log). Black corner: a reference tracker (pure pursuit or Stanley) did better. Red frame: a target missed. Grey ✗: unfinished.</text>"#
+        r#"<text x="10" y="{y:.1}">Colour: green ≤ 0.5 cm, yellow 2.5 cm, red ≥ 25 cm (log). Black corner: a reference tracker (pure pursuit or Stanley) did better. Red frame: a target missed. Grey ✗: unfinished. Blue-grey ⊘: refused as unfollowable (by design).</text>"#
     );
     s.push_str("</svg>\n");
     s

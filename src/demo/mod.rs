@@ -133,6 +133,10 @@ pub struct Report {
     pub frames: u64,
     /// Why agsteer stopped steering, by fault, counted per disengagement.
     pub disengagements: std::collections::BTreeMap<String, u64>,
+    /// Engages the supervisor refused for a reason about the line (`line_unfollowable`),
+    /// counted once per refusal that starts.
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub refusals: std::collections::BTreeMap<String, u64>,
     /// Segment jobs (field plans, manoeuvres): true |XTE| on every segment driven.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub segments: Vec<SegmentReport>,
@@ -480,6 +484,8 @@ pub fn run(
     let mut frames = 0u64;
     let mut disengagements = std::collections::BTreeMap::new();
     let mut disengage_events = Vec::new();
+    let mut refusals = std::collections::BTreeMap::new();
+    let mut last_refusal = crate::safety::FaultCode::None;
     let mut t = 0.0;
     let mut k: u64 = 0;
     let mut stopped = false;
@@ -535,6 +541,17 @@ pub fn run(
             disengage_events.push((t, name));
         }
         was_engaged = cmd.engaged;
+        let refusal = node.supervisor().last_refusal();
+        if refusal != last_refusal {
+            last_refusal = refusal;
+            if refusal == crate::safety::FaultCode::LineUnfollowable {
+                let name = serde_json::to_value(refusal)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_string))
+                    .unwrap_or_else(|| format!("{refusal:?}"));
+                *refusals.entry(name).or_insert(0) += 1;
+            }
+        }
 
         if node.controller().guidance().has_events() {
             on_progress(&node.controller().guidance().progress());
@@ -711,6 +728,7 @@ pub fn run(
         engaged_fraction: engaged_ticks as f64 / k.max(1) as f64,
         frames,
         disengagements,
+        refusals,
         segments,
         goal_position_error_m,
         goal_heading_error_deg,

@@ -12,7 +12,8 @@
 //! itself. On a work line it also watches the tracking itself ([`tracking`]): a weave is
 //! `tracking_unstable`, a persistent offset `off_line`, both held until the line changes or the
 //! operator disengages; a line the vehicle cannot follow at its speed is refused at engage
-//! (`line_unfollowable`).
+//! and, engaged, given back as soon as the line (or the speed on it) makes it so
+//! (`line_unfollowable`, held like the tracking faults).
 
 pub mod tracking;
 
@@ -56,8 +57,9 @@ pub enum FaultCode {
     TrackingUnstable = 18,
     /// |XTE| beyond `safety.off_line_m` for `safety.off_line_time_s` on a work line.
     OffLine = 19,
-    /// Engage refused: the line's sharpest curve cannot be followed at this speed with these
-    /// limits and this steering rate.
+    /// The line's sharpest curve cannot be followed at this speed with these limits and this
+    /// steering rate: engage refused, or, engaged, steering given back (a line that starts while
+    /// engaged, or a speed-up on it).
     LineUnfollowable = 20,
 }
 
@@ -567,6 +569,10 @@ impl Supervisor {
             && fault == FaultCode::None
             && self.work_line.is_some()
         {
+            // Engaged, the line stays under the engage gate's check: one that starts while
+            // engaged, or that the speed has made unfollowable since the engage, is given back
+            // at once rather than weaved on until it is `off_line`.
+            let unfollowable = self.line_unfollowable();
             let p = &self.params;
             // The wheels' swings tell a weave on a straight line only: a line whose sharpest
             // bend asks for half the band or more moves them by design.
@@ -582,6 +588,7 @@ impl Supervisor {
                 self.speed,
             );
             let code = match verdict {
+                _ if unfollowable => FaultCode::LineUnfollowable,
                 TrackingVerdict::Ok => FaultCode::None,
                 TrackingVerdict::Unstable => FaultCode::TrackingUnstable,
                 TrackingVerdict::OffLine => FaultCode::OffLine,

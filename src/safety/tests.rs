@@ -321,3 +321,86 @@ fn a_line_too_sharp_for_the_speed_is_refused() {
             .engaged
     );
 }
+
+/// Engaged on a straight line at 25 km/h, the next line is an R 15 m curve (3.2 m/s²): it is
+/// given back as it starts, before any XTE builds up, held on that line and cleared by the
+/// next one.
+#[test]
+fn an_unfollowable_line_starting_while_engaged_is_given_back_at_once() {
+    let mut s = Supervisor::new(SafetyParams::default());
+    let mut t = 0.0;
+    let feed = |s: &mut Supervisor, t: f64| {
+        s.on_gnss(t, FixQuality::RtkFixed);
+        s.on_wheel_angle(t, 0.0, false, false);
+        s.on_speed(t, 25.0 / 3.6);
+    };
+    s.set_line(Some(1), 0.0);
+    feed(&mut s, t);
+    s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    s.request_engage();
+    t += DT;
+    feed(&mut s, t);
+    assert!(s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
+    for _ in 0..50 {
+        t += DT;
+        feed(&mut s, t);
+        assert!(s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
+    }
+    s.set_line(Some(2), 1.0 / 15.0);
+    t += DT;
+    feed(&mut s, t);
+    let c = s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    assert!(!c.engaged);
+    assert_eq!(c.fault, FaultCode::LineUnfollowable);
+    // Held on that line: the operator's engage is not taken.
+    s.request_engage();
+    t += DT;
+    feed(&mut s, t);
+    assert!(!s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
+    // A straight line clears it.
+    s.set_line(Some(3), 0.0);
+    for _ in 0..3 {
+        t += DT;
+        feed(&mut s, t);
+        s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    }
+    s.request_engage();
+    t += DT;
+    feed(&mut s, t);
+    assert!(s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
+}
+
+/// Engaged at 10 km/h on an R 15 m line, the tractor speeds up to 25 km/h: given back as
+/// `line_unfollowable` once v²/R passes `a_lat_max` (2 m/s² at 19.7 km/h), not later.
+#[test]
+fn speeding_up_on_a_curve_past_the_lateral_limit_gives_the_steering_back() {
+    let mut s = Supervisor::new(SafetyParams::default());
+    s.set_line(Some(1), 1.0 / 15.0);
+    let mut t = 0.0;
+    let mut v: f64 = 10.0 / 3.6;
+    let feed = |s: &mut Supervisor, t: f64, v: f64| {
+        s.on_gnss(t, FixQuality::RtkFixed);
+        s.on_wheel_angle(t, (3.0f64 / 15.0).atan(), false, false);
+        s.on_speed(t, v);
+    };
+    feed(&mut s, t, v);
+    s.step(t, Some(0.2), Some(0.0), Some(0.0));
+    s.request_engage();
+    t += DT;
+    feed(&mut s, t, v);
+    assert!(s.step(t, Some(0.2), Some(0.0), Some(0.0)).engaged);
+    let mut given_back_at = None;
+    while t < 20.0 {
+        t += DT;
+        v = (v + 0.5 * DT).min(25.0 / 3.6);
+        feed(&mut s, t, v);
+        let c = s.step(t, Some(0.2), Some(0.0), Some(0.0));
+        if !c.engaged {
+            assert_eq!(c.fault, FaultCode::LineUnfollowable);
+            given_back_at = Some(v);
+            break;
+        }
+    }
+    let v = given_back_at.expect("given back") * 3.6;
+    assert!((19.7..19.9).contains(&v), "at {v} km/h");
+}

@@ -301,9 +301,13 @@ pub fn run_envelope(a: &EnvelopeArgs) -> Result<u8> {
         let p = a.out.join(file);
         std::fs::write(&p, body).with_context(|| format!("writing {}", p.display()))?;
     }
+    let refused = cells
+        .iter()
+        .filter(|c| c.verdict().refused_by_design)
+        .count();
     let failed: Vec<String> = cells
         .iter()
-        .filter(|c| !c.meets_targets())
+        .filter(|c| !c.meets_targets() && !c.verdict().refused_by_design)
         .map(|c| format!("{}/{}", c.variation, c.scenario))
         .collect();
     if a.json {
@@ -311,8 +315,8 @@ pub fn run_envelope(a: &EnvelopeArgs) -> Result<u8> {
     } else {
         print!("{table}");
         println!(
-            "\n{} of {} cells meet the targets ({} s); missed: {}",
-            cells.len() - failed.len(),
+            "\n{} of {} cells meet the targets, {refused} refused by design (line_unfollowable) ({} s); missed: {}",
+            cells.len() - failed.len() - refused,
             cells.len(),
             start.elapsed().as_secs(),
             if failed.is_empty() {
