@@ -357,8 +357,7 @@ impl Cell {
             const REFUSED: &str = "line_unfollowable";
             !r.finished
                 && (r.refusals.contains_key(REFUSED) || r.disengagements.contains_key(REFUSED))
-                && r
-                    .disengagements
+                && r.disengagements
                     .keys()
                     .all(|k| k == REFUSED || k == "no_guidance")
         });
