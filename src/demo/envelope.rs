@@ -200,7 +200,11 @@ pub const MATRIX: &[Variation] = &[
     ),
     v("speed_1", "1 km/h", &["control.speed_kmh=1"]),
     v("speed_20", "20 km/h", &["control.speed_kmh=20"]),
-    v("speed_25", "25 km/h", &["control.speed_kmh=25"]),
+    v(
+        "speed_25",
+        "25 km/h (the supervisor's speed limit raised from its 25 km/h default to 30)",
+        &["control.speed_kmh=25", "safety.max_speed_kmh=30"],
+    ),
     v(
         "tractor_a",
         "all at once: firm tyres, slow steering (20°/s, 0.1 s dead, 0.3 s lag, 0.5° play), \
