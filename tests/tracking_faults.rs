@@ -81,7 +81,11 @@ fn an_uncalibrated_slow_steering_weaves_and_the_supervisor_disengages() {
     // A 0.6 s steering lag the controller was not told of (it assumes 0.15 s): the default
     // tracker's look-ahead is scheduled on the lag it knows, too short for this one. (Told,
     // `safety.actuator_tau_s=0.6`, it holds the line: tests/envelope_subset.rs, lag_0.6.)
-    check("steering lag 0.6 s, uncalibrated", &["sim.actuator_tau_s=0.6"], 10.0);
+    check(
+        "steering lag 0.6 s, uncalibrated",
+        &["sim.actuator_tau_s=0.6"],
+        10.0,
+    );
 }
 
 #[test]

@@ -3,7 +3,8 @@
 //! controller's model, one way at a time and a few all at once — scored for every tracker.
 //!
 //! A variation is a list of `--set` overrides of `[sim]` keys (the true vehicle, its sensors
-//! and actuator) and of `control.speed_kmh`, applied on top of each scenario file, so any cell
+//! and actuator) and of `control.speed_kmh` (with the supervisor's speed limit where the speed
+//! reaches it), applied on top of each scenario file, so any cell
 //! is reproduced with `agsteer accuracy --config tools/scenarios/S.toml --set …`. The
 //! controller keeps its nominal configuration except the keys that calibration owns
 //! ([`Calibration`]).
