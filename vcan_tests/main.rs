@@ -1,6 +1,7 @@
 //! Tests that need a real CAN interface. They run inside the qemu VM (`tools/vcan-vm`) with
 //! `AGSTEER_VCAN=vcan0`; elsewhere each test prints "skipped" and passes.
 
+mod calibrate;
 mod gnss;
 mod kill9;
 mod latency;
