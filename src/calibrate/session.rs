@@ -59,8 +59,9 @@ pub const REPETITIONS: usize = 2;
 /// Drive holds: settle, then measure, s.
 const HOLD_SETTLE: f64 = 4.0;
 const HOLD_MEASURE: f64 = 12.0;
-/// Sensed angles held on the drive, × `hold_angle`.
-const HOLDS: [f64; 5] = [0.0, 1.0, -1.0, 0.5, -0.5];
+/// Sensed angles held on the drive, × `hold_angle`: one way across, so that each move is a
+/// small one (half `hold_angle`) and settles quickly.
+const HOLDS: [f64; 5] = [1.0, 0.5, 0.0, -0.5, -1.0];
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Phase {

@@ -133,9 +133,9 @@ pub fn calibrate_live(live: &Live, out: Option<&Path>) -> Result<u8> {
             .to_string();
         if state == "running" {
             let c = c.clone().unwrap_or_default();
+            let phase = c["phase"].as_str().unwrap_or("?");
             let line = format!(
-                "{}: {}",
-                c["phase"].as_str().unwrap_or("?"),
+                "{phase}: {}",
                 match c["instruction"].as_str() {
                     Some("drive") => format!(
                         "drive ahead at about {:.0} km/h, hands off the wheel",
