@@ -214,6 +214,45 @@ struct EdgeTable {
     key: (u64, u64),
     /// Words shortest first per (di, dj, ha, hb); `None` until first needed.
     slots: Vec<Option<Rc<[EdgeWord]>>>,
+    /// Length of each edge's shortest word, m; infinite where the edge arrives against its
+    /// direction (see [`arrival_headings`]) or has no word.
+    shortest: Vec<f64>,
+}
+
+impl EdgeTable {
+    /// The table's slot of the edge from heading index `ha` to the node `d` steps away with
+    /// heading index `hb`.
+    fn slot(d: (i64, i64), ha: usize, hb: usize) -> usize {
+        let cell = (d.0 + EDGE_REACH) as usize * EDGE_SPAN + (d.1 + EDGE_REACH) as usize;
+        (cell * GRAPH_HEADINGS + ha) * GRAPH_HEADINGS + hb
+    }
+
+    /// Ready for radius `r`, point spacing `step` and grid spacing `grid_step`: the shortest
+    /// lengths solved, the words emptied.
+    fn prepare(&mut self, r: f64, step: f64, grid_step: f64) {
+        let key = (r.to_bits(), step.to_bits());
+        if self.key == key && !self.slots.is_empty() {
+            return;
+        }
+        let n = EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS * GRAPH_HEADINGS;
+        self.key = key;
+        self.slots = vec![None; n];
+        self.shortest = vec![f64::INFINITY; n];
+        for di in -EDGE_REACH..=EDGE_REACH {
+            for dj in -EDGE_REACH..=EDGE_REACH {
+                let to = Vec2::new(di as f64 * grid_step, dj as f64 * grid_step);
+                for ha in 0..GRAPH_HEADINGS {
+                    let from = (di == 0 && dj == 0).then_some(ha);
+                    for hb in arrival_headings(to, from) {
+                        let (h1, h2) = (graph_heading(ha), graph_heading(hb));
+                        if let Some(l) = csc_length(Vec2::new(0.0, 0.0), h1, to, h2, r) {
+                            self.shortest[Self::slot((di, dj), ha, hb)] = l;
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 impl WaypointGrid {
@@ -250,13 +289,8 @@ impl WaypointGrid {
     /// steps away with heading index `hb`, shortest first, points `step` m apart.
     fn edge_words(&self, d: (i64, i64), ha: usize, hb: usize, r: f64, step: f64) -> Rc<[EdgeWord]> {
         let mut table = self.edges.borrow_mut();
-        let key = (r.to_bits(), step.to_bits());
-        if table.key != key || table.slots.is_empty() {
-            table.key = key;
-            table.slots = vec![None; EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS * GRAPH_HEADINGS];
-        }
-        let cell = (d.0 + EDGE_REACH) as usize * EDGE_SPAN + (d.1 + EDGE_REACH) as usize;
-        let slot = (cell * GRAPH_HEADINGS + ha) * GRAPH_HEADINGS + hb;
+        table.prepare(r, step, self.step);
+        let slot = EdgeTable::slot(d, ha, hb);
         if let Some(words) = &table.slots[slot] {
             return words.clone();
         }
@@ -508,6 +542,8 @@ pub fn route_graph(
         }
         // Queue the neighbours with their shortest words' lengths.
         let (i, j) = cell(s);
+        let mut table = grid.edges.borrow_mut();
+        table.prepare(r, step, grid.step);
         for di in -EDGE_REACH..=EDGE_REACH {
             for dj in -EDGE_REACH..=EDGE_REACH {
                 let Some(k) = grid.index(i as i64 + di, j as i64 + dj) else {
@@ -516,16 +552,12 @@ pub fn route_graph(
                 if !grid.usable[k] || !to_goal[k].is_finite() {
                     continue;
                 }
-                let dir = Vec2::new(di as f64, dj as f64);
-                for hk in arrival_headings(dir, Some(s % H)) {
+                let h_to_go = HEURISTIC_WEIGHT * to_goal[k];
+                for hk in 0..H {
                     let next = k * H + hk;
-                    if done[next] {
-                        continue;
-                    }
-                    let words = grid.edge_words((di, dj), s % H, hk, r, step);
-                    if let Some(first) = words.first() {
-                        let f = g + first.length + HEURISTIC_WEIGHT * to_goal[k];
-                        heap.push((key(f), next as u32, s as u32));
+                    let length = table.shortest[EdgeTable::slot((di, dj), s % H, hk)];
+                    if length.is_finite() && !done[next] {
+                        heap.push((key(g + length + h_to_go), next as u32, s as u32));
                     }
                 }
             }
