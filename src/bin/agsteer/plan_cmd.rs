@@ -203,21 +203,7 @@ where
         .with_context(|| format!("field {}", field_path.display()))?;
     let (plan, plan_time) = timed("planning", || planner(&loaded.field, &params));
     let plan = plan.with_context(|| format!("planning {}", field_path.display()))?;
-    if plan.swaths == 0 {
-        let area = (
-            loaded.field.boundary.clone(),
-            loaded.field.obstacles.clone(),
-        );
-        let width = agsteer::plan::coverage::geometry::inscribed_width(&area);
-        let reason = headland::no_swath_fits(width, &params)
-            .map(|n| n.to_string())
-            .unwrap_or_else(|| {
-                format!(
-                    "no swath fits the field ({width:.1} m wide at its widest, implement {:.1} m, turn diameter {:.1} m)",
-                    params.line_width,
-                    2.0 * params.r_min
-                )
-            });
+    if let Some(reason) = refusal(&loaded.field, &params, &plan, None) {
         eprintln!("error: {}: {reason}", field_path.display());
         return Ok(agsteer::exit::Exit::NoSwath.code());
     }
@@ -233,6 +219,15 @@ where
         );
         (m, f)
     });
+    if let Some(reason) = refusal(
+        &loaded.field,
+        &params,
+        &plan,
+        Some(metrics.covered_fraction),
+    ) {
+        eprintln!("error: {}: {reason}", field_path.display());
+        return Ok(agsteer::exit::Exit::NoSwath.code());
+    }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let title = loaded
         .name
@@ -310,6 +305,53 @@ where
     Ok(0)
 }
 
+/// A plan without swaths worked by headland passes alone is accepted when they work at least
+/// this fraction of the field (issue 17's "every plan ≥ 97 %"); below it, and for a plan with
+/// no working pass at all, `agsteer plan` refuses with the reason and the numbers (exit 5).
+pub const HEADLAND_ONLY_MIN_WORKED: f64 = 0.97;
+
+/// Why `plan` is refused, if it is: no swath and no headland pass; or no swath, and the
+/// headland passes work less than [`HEADLAND_ONLY_MIN_WORKED`] of the field (`worked`, when
+/// the metrics are known). The reason names the field's width, the implement's, the turn
+/// diameter and the largest width that fits.
+fn refusal(
+    field: &Field,
+    params: &CoverageParams,
+    plan: &FieldPlan,
+    worked: Option<f64>,
+) -> Option<String> {
+    use agsteer::plan::coverage::SegmentKind;
+    if plan.swaths > 0 {
+        return None;
+    }
+    let passes = plan
+        .segments
+        .iter()
+        .any(|s| s.kind == SegmentKind::Headland);
+    let short = match worked {
+        None if passes => return None,
+        Some(f) if f >= HEADLAND_ONLY_MIN_WORKED => return None,
+        Some(f) => format!(
+            "; headland passes alone would work {:.1} % of it (< {:.0} %)",
+            100.0 * f,
+            100.0 * HEADLAND_ONLY_MIN_WORKED
+        ),
+        None => String::new(),
+    };
+    let area = (field.boundary.clone(), field.obstacles.clone());
+    let width = agsteer::plan::coverage::geometry::inscribed_width(&area);
+    let reason = headland::no_swath_fits(width, params)
+        .map(|n| n.to_string())
+        .unwrap_or_else(|| {
+            format!(
+                "no swath fits the field ({width:.1} m wide at its widest, implement {:.1} m, turn diameter {:.1} m)",
+                params.line_width,
+                2.0 * params.r_min
+            )
+        });
+    Some(format!("{reason}{short}"))
+}
+
 /// One plan of a sweep, by the independent metrics. Fractions 0–1, lengths m, areas m².
 #[derive(Debug, Clone, Serialize)]
 struct SweepRow {
@@ -320,6 +362,9 @@ struct SweepRow {
     headland_passes: usize,
     /// The planner's error, if it gave no plan.
     error: Option<String>,
+    /// Why `agsteer plan` refuses this plan (exit 5: no swath fits and headland passes alone
+    /// do not work the field); refused plans are counted apart, not as 0 % worked.
+    refused: Option<String>,
     swaths: usize,
     covered_fraction: f64,
     working_area_covered_fraction: f64,
@@ -425,6 +470,7 @@ where
                     r_min_m: r,
                     headland_passes: agsteer::plan::coverage::headland::passes(&params),
                     error: None,
+                    refused: None,
                     swaths: 0,
                     covered_fraction: 0.0,
                     working_area_covered_fraction: 0.0,
@@ -453,6 +499,8 @@ where
                         let m = plan_metrics(&loaded.field, &plan, w);
                         let v = check_plan(&loaded.field, &plan, w, r);
                         let count = |k: ViolationKind| v.iter().filter(|x| x.kind == k).count();
+                        row.refused =
+                            refusal(&loaded.field, &params, &plan, Some(m.covered_fraction));
                         row.swaths = plan.swaths;
                         row.covered_fraction = m.covered_fraction;
                         row.working_area_covered_fraction = m.working_area_covered_fraction;
@@ -469,9 +517,10 @@ where
                         row.max_curvature_ratio = m.max_curvature * r;
                     }
                 }
-                let worked = match &row.error {
-                    Some(e) => format!("error: {e}"),
-                    None => format!("{:.2}", 100.0 * row.covered_fraction),
+                let worked = match (&row.error, &row.refused) {
+                    (Some(e), _) => format!("error: {e}"),
+                    (None, Some(_)) => format!("({:.2})", 100.0 * row.covered_fraction),
+                    (None, None) => format!("{:.2}", 100.0 * row.covered_fraction),
                 };
                 println!(
                     "{:<28} {:>6.2} {:>4} {:>3} {:>2} {:>8} {:>7.4} {:>9.1} {:>9.1} {:>8.1} {:>7.1} {:>7.1} {:>5} {:>7.1}",
@@ -490,14 +539,27 @@ where
                     row.curvature_violations,
                     row.plan_time_ms
                 );
+                if let Some(r) = &row.refused {
+                    println!("{:<28} refused: {r}", "");
+                }
                 rows.push(row);
             }
         }
     }
-    let mut worked: Vec<f64> = rows.iter().map(|r| r.covered_fraction).collect();
+    let planned = |r: &&SweepRow| r.error.is_none() && r.refused.is_none();
+    let mut worked: Vec<f64> = rows
+        .iter()
+        .filter(planned)
+        .map(|r| r.covered_fraction)
+        .collect();
     let min = worked.iter().copied().fold(f64::INFINITY, f64::min);
     let med = median(&mut worked);
-    let max_overlap = rows.iter().map(|r| r.overlap_fraction).fold(0.0, f64::max);
+    let max_overlap = rows
+        .iter()
+        .filter(planned)
+        .map(|r| r.overlap_fraction)
+        .fold(0.0, f64::max);
+    let refused = rows.iter().filter(|r| r.refused.is_some()).count();
     let errors = rows.iter().filter(|r| r.error.is_some()).count();
     let violating = rows
         .iter()
@@ -514,13 +576,16 @@ where
         .filter(|r| r.field_ha <= 100.0)
         .max_by(|a, b| a.plan_time_ms.total_cmp(&b.plan_time_ms));
     println!(
-        "{} plans: field worked median {:.2} %, min {:.2} %; overlap max {:.2} %; {} plans with violations; {} errors",
+        "{} plans: {} refused (no swath fits, headland passes alone < {:.0} %), {} errors; of the {} planned: field worked median {:.2} %, min {:.2} %; overlap max {:.2} %; {} plans with violations",
         rows.len(),
+        refused,
+        100.0 * HEADLAND_ONLY_MIN_WORKED,
+        errors,
+        rows.len() - refused - errors,
         100.0 * med,
         100.0 * min,
         100.0 * max_overlap,
-        violating,
-        errors
+        violating
     );
     if let Some(w) = worst {
         println!(

@@ -486,6 +486,46 @@ fn concave_kinks(areas: &[Area], spacing: f64, r_min: f64) -> Vec<(Vec2, Vec2)> 
     out
 }
 
+/// The closed tracks, each whole when every point is clear, else cut into its clear stretches
+/// (open, at least 3 points), each cut reported in `warnings` with its place.
+pub fn clear_stretches(
+    tracks: Vec<Vec<Vec2>>,
+    clear: &dyn Fn(&Vec2) -> bool,
+    warnings: &std::cell::RefCell<Vec<String>>,
+) -> Vec<Vec<Vec2>> {
+    let mut out = Vec::new();
+    for track in tracks {
+        let ok: Vec<bool> = track.iter().map(clear).collect();
+        let Some(first_bad) = ok.iter().position(|c| !c) else {
+            out.push(track);
+            continue;
+        };
+        // The closed track without its repeated last point, walked from a blocked point.
+        let m = track.len() - 1;
+        let mut stretch: Vec<Vec2> = Vec::new();
+        let mut dropped = 0;
+        for k in 1..=m {
+            let i = (first_bad + k) % m;
+            if ok[i] {
+                stretch.push(track[i]);
+            } else {
+                dropped += 1;
+                if stretch.len() >= 3 {
+                    out.push(std::mem::take(&mut stretch));
+                } else {
+                    stretch.clear();
+                }
+            }
+        }
+        let q = track[first_bad];
+        warnings.borrow_mut().push(format!(
+            "headland pass cut at ({:.1}, {:.1}): {dropped} of its {m} points would put the implement over the edge or an obstacle",
+            q.x, q.y
+        ));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,6 +11,7 @@ pub mod decompose;
 pub mod geometry;
 pub mod headland;
 pub mod metrics;
+pub mod narrow;
 pub mod rings;
 mod runs;
 pub mod swath_angle;
@@ -184,7 +185,17 @@ const BYPASS_SLACK_M: f64 = 0.05;
 /// Plan the whole field: headland passes (outermost first), then the cells in a short order,
 /// each swept by its runs of swaths with turns, joined by transits; with
 /// [`HeadlandOrder::Last`] the cells first, then the headland passes innermost first.
+///
+/// When no swath fits inside the configured headland, the field is planned with the fewest
+/// passes the turns need, or else worked by headland passes alone as far in as they go
+/// ([`narrow`]); each says so in [`FieldPlan::warnings`]. A plan with no working pass at all is
+/// the caller's to refuse ([`headland::no_swath_fits`] gives the numbers).
 pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> {
+    narrow::plan_field(field, p, plan_once)
+}
+
+/// [`plan_field`] with the configured headland passes as they are.
+fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> {
     p.validate()?;
     if field.boundary.len() < 3 || crate::geo::polygon::signed_area(&field.boundary) <= 0.0 {
         return Err(PlanError::Invalid {
@@ -296,12 +307,12 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     // A pass is worked only where its implement is clear (a guarantee): a pass that is not
     // clear throughout is cut into its clear stretches, and the cut is reported.
     let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
-        clear_stretches(field_passes, &clear, &warnings).into();
+        headland::clear_stretches(field_passes, &clear, &warnings).into();
     if p.headland_order == HeadlandOrder::Last {
         // Worked last, from the inside out: the outermost pass along the edge ends the job.
         field_tracks.make_contiguous().reverse();
     }
-    let mut obstacle_tracks = clear_stretches(obstacle_passes, &clear, &warnings);
+    let mut obstacle_tracks = headland::clear_stretches(obstacle_passes, &clear, &warnings);
 
     let tp = p.turn_params();
     let mut cache = crate::plan::turns::TurnCache::default();
@@ -415,7 +426,8 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         }
         let (pts, cut_prev, cut_next) = match found {
             Some(x) => x,
-            // No way inside the field: the shortest direct curve, reported.
+            // No way inside the field: the shortest direct curve, reported (the plan then
+            // breaks a guarantee there, and `agsteer plan` exits 4 naming the place).
             None => {
                 warnings.borrow_mut().push(format!(
                     "no transit inside the field from ({:.1}, {:.1}) to ({:.1}, {:.1}): the shortest curve is planned and leaves it",
@@ -522,6 +534,34 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         for run in swaths::runs(&lines) {
             swath_total += run.len();
             pending.push((ci, *angle, run, lines.clone()));
+        }
+    }
+    // A field in parts a tractor cannot drive between inside the boundary: the largest part
+    // is planned, the others are dropped and named (each can be planned as a field of its own).
+    let parts = narrow::parts(field);
+    if parts.len() > 1 {
+        let mut dropped = vec![(0usize, 0usize); parts.len()];
+        let mut keep = |q: &Vec2, swaths: usize| match narrow::part_of(&parts, q) {
+            0 => true,
+            k => {
+                dropped[k].0 += usize::from(swaths == 0);
+                dropped[k].1 += swaths;
+                false
+            }
+        };
+        field_tracks.retain(|t| keep(&t[0], 0));
+        obstacle_tracks.retain(|t| keep(&t[0], 0));
+        pending.retain(|(_, angle, run, lines)| {
+            let (line, (x0, _)) = run[0];
+            keep(&swaths::unrotate(v2(x0, lines.ys[line]), *angle), run.len())
+        });
+        for (k, &(passes, runs)) in dropped.iter().enumerate().skip(1) {
+            swath_total -= runs;
+            if passes + runs > 0 {
+                warnings
+                    .borrow_mut()
+                    .push(narrow::dropped_part(&parts[k], passes, runs));
+            }
         }
     }
     // The headland passes before or after the swaths.
@@ -674,46 +714,6 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         turn_shapes_solved: cache.solved,
         warnings: warnings.into_inner(),
     })
-}
-
-/// The closed tracks, each whole when every point is clear, else cut into its clear stretches
-/// (open, at least 3 points), each cut reported in `warnings` with its place.
-fn clear_stretches(
-    tracks: Vec<Vec<Vec2>>,
-    clear: &dyn Fn(&Vec2) -> bool,
-    warnings: &std::cell::RefCell<Vec<String>>,
-) -> Vec<Vec<Vec2>> {
-    let mut out = Vec::new();
-    for track in tracks {
-        let ok: Vec<bool> = track.iter().map(clear).collect();
-        let Some(first_bad) = ok.iter().position(|c| !c) else {
-            out.push(track);
-            continue;
-        };
-        // The closed track without its repeated last point, walked from a blocked point.
-        let m = track.len() - 1;
-        let mut stretch: Vec<Vec2> = Vec::new();
-        let mut dropped = 0;
-        for k in 1..=m {
-            let i = (first_bad + k) % m;
-            if ok[i] {
-                stretch.push(track[i]);
-            } else {
-                dropped += 1;
-                if stretch.len() >= 3 {
-                    out.push(std::mem::take(&mut stretch));
-                } else {
-                    stretch.clear();
-                }
-            }
-        }
-        let q = track[first_bad];
-        warnings.borrow_mut().push(format!(
-            "headland pass cut at ({:.1}, {:.1}): {dropped} of its {m} points would put the implement over the edge or an obstacle",
-            q.x, q.y
-        ));
-    }
-    out
 }
 
 #[cfg(test)]

@@ -1,0 +1,117 @@
+//! Fields too narrow for a swath inside the configured headland (issue 17 point 3): a farmer
+//! with a wide implement on a small field first drops headland passes his turns do not need,
+//! and where no swath fits even then, works the field round and round from the edge in.
+//! Whatever is planned says so in the plan's warnings; a plan with no working pass at all is
+//! refused by the caller with the numbers of [`super::headland::no_swath_fits`].
+
+use super::{headland, CoverageParams, Field, FieldPlan, SegmentKind};
+use crate::plan::types::PlanError;
+
+/// Headland passes at most planned when the field is worked by headland passes alone.
+const MAX_FILL_PASSES: usize = 64;
+
+/// `plan_once` with `p`; when that plan has no swath: with the fewest headland passes the turns
+/// need ([`headland::passes`] of no configured passes) if that lets swaths fit; else with as many
+/// headland passes as fit in the field (each pass that no longer fits is simply absent).
+pub fn plan_field(
+    field: &Field,
+    p: &CoverageParams,
+    plan_once: impl Fn(&Field, &CoverageParams) -> Result<FieldPlan, PlanError>,
+) -> Result<FieldPlan, PlanError> {
+    let plan = plan_once(field, p)?;
+    if plan.swaths > 0 {
+        return Ok(plan);
+    }
+    let configured = headland::passes(p);
+    let fewest = CoverageParams {
+        headland_passes: 0,
+        ..p.clone()
+    };
+    let needed = headland::passes(&fewest);
+    if needed < configured {
+        let mut q = plan_once(field, &fewest)?;
+        if q.swaths > 0 {
+            q.warnings.push(format!(
+                "no swath fits inside {configured} headland passes of {:.1} m: planned with {needed}, the fewest the turns need (r_min {:.1} m)",
+                p.line_width, p.r_min
+            ));
+            return Ok(q);
+        }
+    }
+    // Headland passes from the edge in, as many as fit: the field's half width (its bounding
+    // box's smaller half side bounds it) in passes, plus one.
+    let (lo, hi) = crate::geo::polygon::bbox(field.boundary.iter())
+        .unwrap_or((crate::geo::v2(0.0, 0.0), crate::geo::v2(0.0, 0.0)));
+    let half_width = 0.5 * (hi - lo).x.min((hi - lo).y);
+    let fill_passes =
+        ((half_width / p.line_width).ceil() as usize + 1).clamp(configured, MAX_FILL_PASSES);
+    let fill = CoverageParams {
+        headland_passes: fill_passes,
+        ..p.clone()
+    };
+    let mut q = plan_once(field, &fill)?;
+    let rings = |f: &FieldPlan| {
+        f.segments
+            .iter()
+            .filter(|s| s.kind == SegmentKind::Headland)
+            .count()
+    };
+    if q.swaths == 0 && rings(&q) > rings(&plan) {
+        q.warnings.push(format!(
+            "no swath fits at {:.1} m and r_min {:.1} m: the field is worked by headland passes alone, from the edge in",
+            p.line_width, p.r_min
+        ));
+        return Ok(q);
+    }
+    if q.swaths > 0 {
+        return Ok(q);
+    }
+    Ok(plan)
+}
+
+/// The parts of a field that a tractor cannot drive between inside the boundary (joined only
+/// by necks narrower than twice [`super::TRANSIT_CLEARANCE_M`]), when there are several: the
+/// field with its holes shrunk by that clearance, as areas, largest first.
+pub fn parts(field: &Field) -> Vec<super::geometry::Area> {
+    let whole = (field.boundary.clone(), field.obstacles.clone());
+    let mut parts = super::geometry::offset(&[whole], -super::TRANSIT_CLEARANCE_M);
+    if parts.len() > 1 {
+        parts.sort_by(|a, b| super::geometry::area_m2(b).total_cmp(&super::geometry::area_m2(a)));
+    }
+    parts
+}
+
+/// Index of the part of `parts` nearest `q` (0 when there are none).
+pub fn part_of(parts: &[super::geometry::Area], q: &crate::geo::Vec2) -> usize {
+    use crate::geo::polygon::{contains_point, point_segment_distance};
+    let distance = |(outer, holes): &super::geometry::Area| {
+        let inside = contains_point(outer, q) && !holes.iter().any(|h| contains_point(h, q));
+        if inside {
+            return 0.0;
+        }
+        std::iter::once(outer)
+            .chain(holes.iter())
+            .flat_map(|r| {
+                let n = r.len();
+                (0..n).map(move |i| point_segment_distance(q, &r[i], &r[(i + 1) % n]))
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    (0..parts.len())
+        .min_by(|&i, &j| distance(&parts[i]).total_cmp(&distance(&parts[j])))
+        .unwrap_or(0)
+}
+
+/// The warning for a part of the field dropped from the plan with its headland passes (or
+/// stretches of them) and swaths.
+pub fn dropped_part(part: &super::geometry::Area, passes: usize, swaths: usize) -> String {
+    let ring = &part.0;
+    let c = ring.iter().fold(crate::geo::v2(0.0, 0.0), |a, q| a + q) / ring.len().max(1) as f64;
+    format!(
+        "part of the field dropped: the part about ({:.1}, {:.1}), {:.2} ha, joins the planned part only by necks narrower than {:.1} m (no way inside the boundary): its {passes} headland pass(es) and {swaths} swath(s) are not planned; plan it as a field of its own",
+        c.x,
+        c.y,
+        super::geometry::area_m2(part) / 1e4,
+        2.0 * super::TRANSIT_CLEARANCE_M
+    )
+}
