@@ -28,7 +28,8 @@ pub fn obstacle_size(ring: &[Vec2]) -> f64 {
 
 /// Split a straight work piece where the implement would touch a small obstacle: the work
 /// stops `lead` points before the blocked stretch, a detour goes round it and the work resumes
-/// `lead` points after. Pieces that cannot be split are returned whole.
+/// `lead` points after. Where no detour is clear, the work stops before the blocked stretch and
+/// resumes after it, with an empty `Transit` piece between: the caller joins them by a transit.
 fn split_for_detours(
     pts: Vec<Vec2>,
     lead: usize,
@@ -81,7 +82,14 @@ fn split_for_detours(
             .and_then(|i| candidates.into_iter().nth(i))
             .map(|(_, a, b, way)| (a, b, way));
         let Some((a, b, way)) = found else {
-            return vec![(SegmentKind::Work, pts)];
+            // No clear detour: the blocked stretch is not worked (the implement would be over
+            // the obstacle); a transit joins the two pieces (a piece of no points marks it).
+            if b0 > start + 1 {
+                out.push((SegmentKind::Work, pts[start..b0].to_vec()));
+            }
+            out.push((SegmentKind::Transit, Vec::new()));
+            start = (b1 + 1).min(n - 1);
+            continue;
         };
         out.push((SegmentKind::Work, pts[start..=a].to_vec()));
         out.push((SegmentKind::Detour, way));
@@ -227,12 +235,17 @@ pub(super) fn drive_run(
     // Drive: transit to the first swath, then the pieces in order.
     let mut first = true;
     for (kind, direction, mut pts) in pieces {
+        if kind == SegmentKind::Transit && pts.is_empty() {
+            // A stretch left unworked: the next piece is reached by a transit.
+            first = true;
+            continue;
+        }
         if pts.len() < 2 {
             continue;
         }
         if first {
             let cut = go_to(segments, at, &pts, cell);
-            pts.drain(..cut);
+            pts.drain(..cut.min(pts.len().saturating_sub(2)));
             first = false;
         }
         let n = pts.len();
