@@ -12,17 +12,22 @@ use std::time::{Duration, Instant};
 const GNSS_LINK: &str = "/tmp/gnss-receiver";
 const GNSS_UDP_PORT: u16 = 9999;
 
-struct JobRun {
+pub(super) struct JobRun {
     /// (rms, p95, max, samples, samples expected), m.
-    xte: (f64, f64, f64, usize, f64),
-    finished: bool,
-    reengaged: u32,
-    capture: Vec<String>,
-    status: serde_json::Value,
+    pub(super) xte: (f64, f64, f64, usize, f64),
+    pub(super) finished: bool,
+    pub(super) reengaged: u32,
+    pub(super) capture: Vec<String>,
+    pub(super) status: serde_json::Value,
 }
 
 /// The AB job of config/vcan.toml, closed-loop, until finished (150 s at most).
-fn run_job(iface: &str, label: &str, daemon_extra: &[&str], sim_extra: &[&str]) -> JobRun {
+pub(super) fn run_job(
+    iface: &str,
+    label: &str,
+    daemon_extra: &[&str],
+    sim_extra: &[&str],
+) -> JobRun {
     let traj = format!("/tmp/agsteer-trajectory-{label}.csv");
     let daemon = start_daemon(daemon_extra);
     let dump = Candump::start(iface);

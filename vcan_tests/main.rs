@@ -3,6 +3,7 @@
 
 mod calibrate;
 mod gnss;
+mod isobus;
 mod kill9;
 mod latency;
 mod support;
@@ -144,6 +145,8 @@ fn a_closed_loop_job_on_vcan() {
     println!(
         "VCAN-JOB-XTE rms_m={rms:.4} p95_m={p95:.4} max_m={max:.4} samples={n} of ~{expected:.0}"
     );
+    // The wheel-angle reference of the steer-ready loop's test (isobus.rs).
+    let _ = std::fs::write(isobus::ANGLE_XTE_FILE, format!("{rms} {p95}\n"));
     // The simulator samples every 50 ms of its monotonic time; guest stalls skip samples.
     assert!(
         n as f64 > 0.6 * expected,
