@@ -519,20 +519,18 @@ fn not_available_codes_on_the_bus() {
     );
 }
 
-/// A magnetic compass on the GNSS's own source: every 127250 of the simulator copied with the
-/// reference magnetic, the heading turned 90° and a variation of 0 (so `apply_variation` would
-/// take it as a true heading). Refused by default (`sources.magnetic_heading = "refuse"`): the
-/// node steers on the true headings, no jump.
+/// A magnetic compass at 0x1E, the heading source the integrator pinned
+/// (`sources.heading = "0x1E"`): it sends every 127250 heading of the simulator's, turned 90°,
+/// with the reference magnetic and a variation of 0 (so `apply_variation` would take it as a
+/// true heading). Refused by default (`sources.magnetic_heading = "refuse"`): the node has no
+/// heading source and steers on the course from its fixes, the compass listed but not selected.
+/// (The simulator's own true headings at 0x1C are ignored: the heading is pinned to 0x1E.)
 #[test]
 fn magnetic_heading_refused_by_default() {
     let Some(iface) = vcan() else { return };
-    let (_daemon, _sim) = engaged(&iface, &[]);
-    let dump = Candump::start(&iface);
-    let t_before = wall_s();
-    let before = watch(Duration::from_secs(2));
-    let t_on = wall_s();
-    let relay = Relay::start(&iface, &[ID_HEADING], |f| {
-        let mut g = *f;
+    const COMPASS: u32 = 0x1E;
+    let compass = Relay::start(&iface, &[ID_HEADING], |f| {
+        let mut g = Frame::new((f.id & !0xFF) | COMPASS, f.payload());
         let h = u16::from_le_bytes([f.data[1], f.data[2]]);
         // 0.0001 rad units, 0..2π (62 832).
         let turned = (u32::from(h) + 15_708) % 62_832;
@@ -541,37 +539,46 @@ fn magnetic_heading_refused_by_default() {
         g.data[7] = (f.data[7] & !0x03) | 0x01;
         (h <= 62_831).then_some(g)
     });
+    let (_daemon, _sim) = engaged(&iface, &["--set", "sources.heading=\"0x1E\""]);
+    let dump = Candump::start(&iface);
     let during = watch(Duration::from_secs(4));
     let st = status().unwrap();
-    let sent = relay.stop();
-    let t_off = wall_s();
+    let sent = compass.stop();
     let cap = parse_candump(&dump.stop());
     let magnetic = cap
         .iter()
-        .filter(|(_, id, d)| *id == ID_HEADING && d.get(7).is_some_and(|b| b & 0x03 == 1))
+        .filter(|(_, id, d)| *id as u8 == COMPASS as u8 && d.get(7).is_some_and(|b| b & 0x03 == 1))
         .count();
-    let (step_before, step_during) = (
-        largest_command_step(&cap, t_before, t_on),
-        largest_command_step(&cap, t_on, t_off),
-    );
+    let seen = st["sources"]["seen"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let listed = seen
+        .iter()
+        .find(|s| s["source"] == json!({"can": COMPASS}))
+        .cloned()
+        .unwrap_or_default();
     println!(
-        "VCAN-MAGNETIC {sent} magnetic headings sent ({magnetic} in the capture), 90° off; \
-         engaged {}/{} samples; max heading error {:.2}° before, {:.2}° during; max |XTE| \
-         {:.4} / {:.4} m; largest command step {step_before:.2}° / {step_during:.2}°; heading \
-         source {}",
+        "VCAN-MAGNETIC compass 0x1E: {sent} magnetic headings 90° off ({magnetic} in the last \
+         4 s); engaged {}/{} samples; max heading error {:.2}°, max |XTE| {:.4} m; heading \
+         source {}; 0x1E listed as {listed}",
         during.samples - during.disengaged,
         during.samples,
-        before.max_heading_error_deg,
         during.max_heading_error_deg,
-        before.max_xte_m,
         during.max_xte_m,
         st["sources"]["heading"]
     );
-    assert!(sent > 25 && magnetic as u64 >= sent / 2, "{sent} sent");
+    assert!(magnetic > 25, "{magnetic} magnetic headings in 4 s");
+    assert_eq!(
+        st["sources"]["heading"],
+        Value::Null,
+        "no heading source taken"
+    );
+    assert_eq!(listed["sends"], json!(["heading"]), "{listed}");
+    assert_eq!(listed["selected_for"], json!([]), "{listed}");
     assert_eq!(during.disengaged, 0, "steered throughout");
     assert!(during.max_heading_error_deg < 3.0);
     assert!(during.max_xte_m < 0.05, "XTE {}", during.max_xte_m);
-    assert!(step_during <= (2.0 * step_before).max(0.5));
 }
 
 /// Where `a_closed_loop_job_on_vcan` records its true XTE (RMS, p95) for the steer-ready loop.

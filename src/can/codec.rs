@@ -449,9 +449,52 @@ pub fn frames_markdown() -> String {
             sigs.join("; ")
         ));
     }
+    s.push_str(&network_management_markdown());
     s.push_str("\nNotes:\n\n");
     for m in MESSAGES {
         s.push_str(&format!("- **{}**: {}\n", m.name, m.comment));
+    }
+    s
+}
+
+/// The ISO 11783-5 frames agsteer sends besides the DBC's (built and read by `can::isobus`),
+/// for the frames table; identifiers from agsteer's default address 0x2A.
+fn network_management_markdown() -> String {
+    use super::isobus::{
+        address_claimed, request, Name, NULL_ADDRESS, PGN_ADDRESS_CLAIMED, PGN_REQUEST,
+    };
+    let sa = 0x2A;
+    let rows = [
+        (
+            "Request for Address Claimed",
+            request(PGN_ADDRESS_CLAIMED, NULL_ADDRESS, 0xFF).id,
+            PGN_REQUEST,
+            "at start-up and when the link comes back",
+            "the PGN requested, 3 bytes (`00EE00`)",
+        ),
+        (
+            "Address Claimed",
+            address_claimed(Name(0), sa).id,
+            PGN_ADDRESS_CLAIMED,
+            "after the Request and 250 ms of listening; on a Request to the global or its own address; again on a claim of its address by a higher NAME; at another address of `isobus.address_range` (the first free one) after losing its address to a lower NAME",
+            "agsteer's NAME, 8 bytes (`[isobus]`)",
+        ),
+        (
+            "Cannot Claim",
+            address_claimed(Name(0), NULL_ADDRESS).id,
+            PGN_ADDRESS_CLAIMED,
+            "when no address can be claimed (then nothing else), and on a Request",
+            "agsteer's NAME",
+        ),
+    ];
+    let mut s = String::from(
+        "\nISO 11783-5 network management (not in the DBC; `agsteer dbc decode` names them and prints the NAME's fields):\n\n| frame | id | PGN | when | from | data |\n|---|---|---|---|---|---|\n",
+    );
+    for (name, id, pgn, when, data) in rows {
+        s.push_str(&format!(
+            "| {name} | `{id:08X}` | {pgn} (0x{pgn:X}) | {when} | AGSTEER (0x{:02X}) | {data} |\n",
+            id & 0xFF
+        ));
     }
     s
 }
