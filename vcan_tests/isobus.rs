@@ -462,7 +462,7 @@ fn not_available_codes_on_the_bus() {
     let (mut daemon, _sim) = engaged(&iface, &[]);
     let dump = Candump::start(&iface);
     let t_before = wall_s();
-    let before = watch(Duration::from_secs(2));
+    let before = watch(Duration::from_millis(1500));
     let t_on = wall_s();
     let relay = Relay::start(&iface, &[ID_POSITION, ID_COG_SOG, ID_HEADING], |f| {
         let mut g = *f;
@@ -473,7 +473,7 @@ fn not_available_codes_on_the_bus() {
         }
         Some(g)
     });
-    let during = watch(Duration::from_secs(4));
+    let during = watch(Duration::from_secs(3));
     let sent = relay.stop();
     let t_off = wall_s();
     let lines = dump.stop();
@@ -519,35 +519,77 @@ fn not_available_codes_on_the_bus() {
     );
 }
 
-/// A magnetic compass at 0x1E, the heading source the integrator pinned
-/// (`sources.heading = "0x1E"`): it sends every 127250 heading of the simulator's, turned 90°,
-/// with the reference magnetic and a variation of 0 (so `apply_variation` would take it as a
-/// true heading). Refused by default (`sources.magnetic_heading = "refuse"`): the node has no
-/// heading source and steers on the course from its fixes, the compass listed but not selected.
-/// (The simulator's own true headings at 0x1C are ignored: the heading is pinned to 0x1E.)
+/// A magnetic compass at 0x1E (`cangen`: 127250 every 100 ms, heading East, reference
+/// magnetic, variation 0 — so `apply_variation` would take it as a true heading), on the bus
+/// before the simulator's receiver, which heads North with true headings. Refused by default
+/// (`sources.magnetic_heading = "refuse"`): automatic selection takes the receiver's headings,
+/// the compass is listed but never selected, and the node steers as usual. The control: with
+/// `apply_variation` the same compass is the heading source taken first (90° off).
 #[test]
 fn magnetic_heading_refused_by_default() {
     let Some(iface) = vcan() else { return };
     const COMPASS: u32 = 0x1E;
-    let compass = Relay::start(&iface, &[ID_HEADING], |f| {
-        let mut g = Frame::new((f.id & !0xFF) | COMPASS, f.payload());
-        let h = u16::from_le_bytes([f.data[1], f.data[2]]);
-        // 0.0001 rad units, 0..2π (62 832).
-        let turned = (u32::from(h) + 15_708) % 62_832;
-        g.data[1..3].copy_from_slice(&(turned as u16).to_le_bytes());
-        g.data[5..7].copy_from_slice(&[0, 0]);
-        g.data[7] = (f.data[7] & !0x03) | 0x01;
-        (h <= 62_831).then_some(g)
+    let frame = run_ok(
+        "agsteer",
+        &[
+            "dbc",
+            "encode",
+            "VesselHeading",
+            "Sid=0",
+            "Heading=1.5708",
+            "Deviation=0",
+            "Variation=0",
+            "Reference=1",
+            "--source",
+            "0x1E",
+        ],
+    );
+    let (id, data) = frame.trim().split_once('#').expect("ID#DATA");
+    let compass_on = || {
+        Proc::spawn(
+            "cangen",
+            &[&iface, "-e", "-I", id, "-L", "8", "-D", data, "-g", "100"],
+        )
+    };
+    let compass_seen = |s: &Value| {
+        s["sources"]["seen"]
+            .as_array()
+            .is_some_and(|a| a.iter().any(|x| x["source"] == json!({"can": COMPASS})))
+    };
+    // The control: a policy that takes magnetic headings locks the compass.
+    let daemon = start_daemon(&["--set", "sources.magnetic_heading=\"apply_variation\""]);
+    let compass = compass_on();
+    let taken = wait_status(Duration::from_secs(3), |s| {
+        compass_seen(s) && s["sources"]["heading"] == json!({"can": COMPASS})
     });
-    let (_daemon, _sim) = engaged(&iface, &["--set", "sources.heading=\"0x1E\""]);
+    assert!(
+        taken.is_some(),
+        "control: apply_variation takes the compass: {:?}",
+        status()
+    );
+    drop((compass, daemon));
+    // The default.
+    let _daemon = start_daemon(&[]);
+    let _compass = compass_on();
+    assert!(
+        wait_status(Duration::from_secs(3), compass_seen).is_some(),
+        "{:?}",
+        status()
+    );
+    let _sim = start_sim(&iface, &[]);
+    let mut term = Terminal::new(&iface);
+    assert!(
+        term.engage(Duration::from_secs(10)),
+        "engaged: {:?}",
+        status()
+    );
     let dump = Candump::start(&iface);
-    let during = watch(Duration::from_secs(4));
+    let during = watch(Duration::from_secs(3));
     let st = status().unwrap();
-    let sent = compass.stop();
     let cap = parse_candump(&dump.stop());
     let magnetic = cap
         .iter()
-        .filter(|(_, id, d)| *id as u8 == COMPASS as u8 && d.get(7).is_some_and(|b| b & 0x03 == 1))
+        .filter(|(_, id, _)| *id == (0x09F1_1200 | COMPASS))
         .count();
     let seen = st["sources"]["seen"]
         .as_array()
@@ -559,20 +601,23 @@ fn magnetic_heading_refused_by_default() {
         .cloned()
         .unwrap_or_default();
     println!(
-        "VCAN-MAGNETIC compass 0x1E: {sent} magnetic headings 90° off ({magnetic} in the last \
-         4 s); engaged {}/{} samples; max heading error {:.2}°, max |XTE| {:.4} m; heading \
-         source {}; 0x1E listed as {listed}",
+        "VCAN-MAGNETIC compass 0x1E heading East, magnetic ({magnetic} frames in 3 s); with \
+         apply_variation the heading source is {}; by default {} and the compass is listed as \
+         {listed}; engaged {}/{} samples, max heading error {:.2}°, max |XTE| {:.4} m",
+        taken
+            .map(|s| s["sources"]["heading"].clone())
+            .unwrap_or_default(),
+        st["sources"]["heading"],
         during.samples - during.disengaged,
         during.samples,
         during.max_heading_error_deg,
         during.max_xte_m,
-        st["sources"]["heading"]
     );
-    assert!(magnetic > 25, "{magnetic} magnetic headings in 4 s");
+    assert!(magnetic > 20, "{magnetic} compass frames in 3 s");
     assert_eq!(
         st["sources"]["heading"],
-        Value::Null,
-        "no heading source taken"
+        json!({"can": 28}),
+        "the receiver's true headings"
     );
     assert_eq!(listed["sends"], json!(["heading"]), "{listed}");
     assert_eq!(listed["selected_for"], json!([]), "{listed}");
