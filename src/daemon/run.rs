@@ -64,6 +64,10 @@ pub enum DaemonError {
     ProgressNotSaved(#[source] progress_file::ProgressFileError),
 }
 
+/// Upper edges of [`LoopStats::fix_to_command_counts`], µs.
+pub const FIX_TO_COMMAND_EDGES_US: [f64; 7] =
+    [100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0, 10000.0];
+
 /// Control-loop timing, for the status socket.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
 pub struct LoopStats {
@@ -83,6 +87,10 @@ pub struct LoopStats {
     /// A fix's receive time to its command handed to the socket: last and largest, µs.
     pub fix_to_command_us: f64,
     pub max_fix_to_command_us: f64,
+    /// Fixes by receive-to-command time, µs: counts up to each of
+    /// [`FIX_TO_COMMAND_EDGES_US`] and beyond the last (the daemon's own share of the
+    /// latency, without the wait before the frame is read).
+    pub fix_to_command_counts: [u64; FIX_TO_COMMAND_EDGES_US.len() + 1],
     /// Timer periods held back for an expected fix ([`super::tick`]).
     pub held_ticks: u64,
     /// The fixes' period as learnt, ms (0: not learnt).
@@ -424,6 +432,13 @@ impl Outputs {
         stats.fix_ticks += 1;
         stats.fix_to_command_us = (monotonic_s() - t_fix).max(0.0) * 1e6;
         stats.max_fix_to_command_us = stats.max_fix_to_command_us.max(stats.fix_to_command_us);
+        let bucket = FIX_TO_COMMAND_EDGES_US
+            .iter()
+            .position(|e| stats.fix_to_command_us <= *e)
+            .unwrap_or(FIX_TO_COMMAND_EDGES_US.len());
+        if let Some(c) = stats.fix_to_command_counts.get_mut(bucket) {
+            *c += 1;
+        }
         stats.last_step_us = start.elapsed().as_secs_f64() * 1e6;
         stats.max_step_us = stats.max_step_us.max(stats.last_step_us);
     }
