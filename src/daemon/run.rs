@@ -660,13 +660,23 @@ async fn run_async(
                         }
                     }
                     _ = &mut timer => {
-                        // Frames already read go first: a fix among them runs this period.
+                        // Frames and GNSS inputs already read go first: a fix among them runs
+                        // this period.
                         let mut fix = None;
                         for _ in 0..DRAIN_AT_TICK {
                             let Ok(ev) = rx.try_recv() else { break };
                             fix = on_bus_event(ev, &mut node, &mut out, &mut stats, &iface);
                             if fix.is_some() {
                                 break;
+                            }
+                        }
+                        if let Some(g) = gnss.as_mut().filter(|_| fix.is_none()) {
+                            for _ in 0..DRAIN_AT_TICK {
+                                let Ok(i) = g.inputs.try_recv() else { break };
+                                if node.on_input(&i) {
+                                    fix = Some(i.t());
+                                    break;
+                                }
                             }
                         }
                         apply_operator_request(&mut node, &resolved, &configured, &mut book, &jobs_tx);
