@@ -368,7 +368,7 @@ impl Config {
                 .actuator_rate_deg_s
                 .min(f.max_wheel_rate_deg_s)
                 .to_radians(),
-            sweep: (v.wheelbase_m / v.r_min_m)
+            sweep: (v.wheelbase_m / self.turn_radius())
                 .atan()
                 .min(self.max_wheel_angle()),
         }

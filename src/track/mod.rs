@@ -54,27 +54,37 @@ pub struct SteeringResponse {
     /// Rate limit of the wheel angle (the slower of the actuator and the command limit),
     /// rad/s; 0 = none.
     pub rate: f64,
-    /// The wheel angle swept out of the sharpest turn (atan(L / r_min)), rad.
+    /// The wheel angle swept out of the planned turns (atan(L / turn radius)), rad.
     pub sweep: f64,
 }
 
+/// The lag's phase budget: a look-ahead time of at least this many times the steering's lag
+/// (and unpredicted dead time) keeps the lag's phase at pure pursuit's natural frequency
+/// ωn = √2/T below atan(√2/2.66) ≈ 28°. Measured on the envelope's lag_0.6 row (15 km/h): 2.0
+/// weaves (11 cm RMS, 3 m max), 2.66 holds 2.9 cm, 3.5 and 4.5 converge slower (3.0, 10.9).
+pub const LAG_PHASE_BUDGET: f64 = 2.66;
+
 impl TrackerParams {
-    /// The steering's response time, s: its lag, the dead time not predicted, and the time to
-    /// sweep the wheels out of the sharpest turn at its rate limit. Pure pursuit's loop is
-    /// second order with ωn = √2·v/Ld (linearised about a straight line): a look-ahead of
-    /// v·T puts its crossover near √2/T rad/s. The lag and dead time then cost about
-    /// ωn·(lag + dead) of phase, and a rate-limited steering whose slew lasts longer than the
-    /// look-ahead time cannot follow the command and turns the loop into a limit cycle (the
-    /// rate-limit weave of a 20°/s motor, issue 15). Holding T at least this long keeps both
-    /// small. Computed once at configuration.
+    /// The look-ahead time the steering needs, s: the larger of
+    /// - [`LAG_PHASE_BUDGET`] × (lag + the dead time not predicted): pure pursuit's loop is
+    ///   second order with ωn = √2·v/Ld (linearised about a straight line), so a look-ahead of
+    ///   v·T puts it at √2/T rad/s, where a lag τ costs atan(√2·τ/T) of phase;
+    /// - lag + dead time + the time to sweep the wheels out of the planned turn at the rate
+    ///   limit: a rate-limited steering that is still slewing when the look-ahead has been
+    ///   driven cannot follow the command, and the loop turns into a limit cycle (the
+    ///   rate-limit weave of a 20°/s motor, issue 15).
+    ///
+    /// The default law's look-ahead is at least v·T ([`scheduled_lookahead`]). Computed once at
+    /// configuration.
     pub fn response_time(&self) -> f64 {
         let s = &self.steering;
+        let delay = s.lag.max(0.0) + s.dead_time.max(0.0);
         let slew = if s.rate > 0.0 && s.rate.is_finite() {
             s.sweep.max(0.0) / s.rate
         } else {
             0.0
         };
-        let t = s.lag.max(0.0) + s.dead_time.max(0.0) + slew;
+        let t = (LAG_PHASE_BUDGET * delay).max(delay + slew);
         if t.is_finite() {
             t
         } else {
@@ -377,6 +387,41 @@ mod tests {
             Direction::Reverse,
         );
         assert!(mirrored.wheel_angle < 0.0, "{mirrored:?}");
+    }
+
+    #[test]
+    fn the_default_look_ahead_covers_the_steering_response() {
+        let mut p = params();
+        // Nothing known of the steering: the configured look-ahead.
+        assert_eq!(p.response_time(), 0.0);
+        assert_eq!(scheduled_lookahead(&p, p.response_time(), 5.0), 5.0);
+        // The nominal steering (0.15 s lag, 30°/s, out of a 5 m turn with L = 3 m): the slew
+        // (1.03 s) + lag, under the 1.2 s of `track.ld_gain_s`.
+        let sweep = (3.0f64 / 5.0).atan();
+        p.steering = SteeringResponse {
+            lag: 0.15,
+            dead_time: 0.0,
+            rate: 30f64.to_radians(),
+            sweep,
+        };
+        let t = p.response_time();
+        assert!(
+            (t - (0.15 + sweep / 30f64.to_radians())).abs() < 1e-12,
+            "{t}"
+        );
+        assert!(t < 1.2);
+        // A 20°/s motor: 1.70 s, the look-ahead at 10 km/h from 2.78 to 4.7 m.
+        p.steering.rate = 20f64.to_radians();
+        assert!((p.response_time() - 1.70).abs() < 0.01);
+        assert!((scheduled_lookahead(&p, p.response_time(), 2.78) - 4.72).abs() < 0.02);
+        // A 0.6 s lag at 90°/s: the phase budget, 2.66 × 0.6 s.
+        p.steering.rate = 90f64.to_radians();
+        p.steering.lag = 0.6;
+        assert!((p.response_time() - LAG_PHASE_BUDGET * 0.6).abs() < 1e-12);
+        // Nonsense stays finite.
+        p.steering.rate = 0.0;
+        p.steering.lag = f64::INFINITY;
+        assert_eq!(p.response_time(), 0.0);
     }
 
     #[test]
