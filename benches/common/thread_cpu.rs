@@ -1,6 +1,6 @@
 //! Criterion measurement in the benchmark thread's CPU time (`CLOCK_THREAD_CPUTIME_ID`), not
 //! wall time: on a shared 2-core host under load, wall time counts the other processes' turns
-//! too. (benches/gnss_parse.rs has its own copy.)
+//! too. Used by benches/coverage.rs and benches/gnss_parse.rs.
 
 use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use std::time::Duration;
