@@ -15,6 +15,10 @@ pub(super) type GoTo<'a> =
 /// A clear path between two poses (position, heading) around a small obstacle.
 pub(super) type Detour<'a> = dyn Fn(Vec2, f64, Vec2, f64) -> Option<Vec<Vec2>> + 'a;
 
+/// An asymmetric (Dubins) turn between swath ends is taken when it is at most this many times
+/// the length of a half circle plus the straight legs it replaces (no loops round the field).
+const ASYMMETRIC_TURN_MAX_LENGTH: f64 = 1.5;
+
 /// Largest dimension of an obstacle (greatest distance between two of its vertices), m.
 pub fn obstacle_size(ring: &[Vec2]) -> f64 {
     let mut size: f64 = 0.0;
@@ -165,7 +169,45 @@ pub(super) fn drive_run(
             let tries = ((outer - inner).abs() + 4.0 * p.r_min + 2.0 * p.line_width) as usize;
             let d = swaths::unrotate(v2(dir, 0.0), angle);
             let mut best = None;
+            // A turn that the swath ends cannot share (a headland edge slanted to the
+            // swaths): the Dubins curve from this swath's end to the next one's start, each
+            // pulled back as little as makes it clear, before the symmetric turn is pulled
+            // back to the shorter end (which left a strip of the longer swath unworked).
+            let far2 = if forward { a2 } else { b2 };
+            let dubins = |t: f64| {
+                let (e_t, s2) = (e - dir * t, end2 - dir * t);
+                if (e_t - s) * dir <= 0.0 || (s2 - far2) * dir <= 0.0 {
+                    return None;
+                }
+                let (h1, h2) = (vec_heading(&d), vec_heading(&(-d)));
+                let (q1, q2) = (world(e_t, y), world(s2, y2));
+                match transit::transit(q1, h1, q2, h2, p.r_min, p.point_spacing, clear) {
+                    Some((pts, true))
+                        if crate::geo::polygon::polyline_length(&pts)
+                            <= ASYMMETRIC_TURN_MAX_LENGTH
+                                * (std::f64::consts::PI * p.r_min
+                                    + (y2 - y).abs()
+                                    + (end2 - e).abs()) =>
+                    {
+                        Some((
+                            vec![crate::plan::turns::TurnPart {
+                                direction: Direction::Forward,
+                                points: pts,
+                            }],
+                            e_t,
+                            s2,
+                        ))
+                    }
+                    _ => None,
+                }
+            };
             for t in 0..=tries {
+                if t > 0 {
+                    if let Some(found) = dubins((t - 1) as f64) {
+                        best = Some(found);
+                        break;
+                    }
+                }
                 let apex = outer - dir * t as f64;
                 let e_new = if forward { e.min(apex) } else { e.max(apex) };
                 let start2 = if forward {
