@@ -121,7 +121,7 @@ fn a_closed_loop_job_on_vcan() {
     let cpu = proc_cpu_s(daemon.pid()) - cpu0;
     let (rss, hwm) = proc_rss_kb(daemon.pid());
     let last = status().unwrap_or_default();
-    let lines = dump.stop();
+    let (lines, dropped) = dump.stop_counting_drops();
     let stalls = probe.stop();
     println!(
         "VCAN-JOB reengaged={reengaged} most_frozen_ms_per_freshness_window={:.0}",
@@ -154,7 +154,7 @@ fn a_closed_loop_job_on_vcan() {
     );
     assert!(rms < 0.05, "true XTE RMS {rms}");
     // Every gap, less the time the whole guest was frozen (see `StallProbe`), within 2·dt.
-    capture_checks(&lines, &stalls, 0.01, 1.0);
+    capture_checks(&lines, dropped, &stalls, 0.01, 1.0);
 }
 
 /// (b) A candump capture of a closed-loop run at the default dt = 20 ms decodes with zero
@@ -170,18 +170,21 @@ fn b_capture_decodes_and_commands_come_every_dt() {
     let probe = StallProbe::start();
     let dump = Candump::start(&iface);
     std::thread::sleep(Duration::from_secs(20));
-    let lines = dump.stop();
+    let (lines, dropped) = dump.stop_counting_drops();
     let stalls = probe.stop();
     // Every gap within 2·dt is what the daemon does on an idle machine (seen: max 23.6 ms);
     // the emulated VM on a shared 2-core host freezes now and then for tens of ms, which the
     // stall probe measures and the check subtracts: every gap less those within 2·dt.
-    capture_checks(&lines, &stalls, 0.02, 1.0);
+    capture_checks(&lines, dropped, &stalls, 0.02, 1.0);
 }
 
 /// The capture decodes with `agsteer dbc decode` with zero unknown or invalid frames, and
 /// at least `share` of the gaps between command frames, less guest stalls, are within 2·dt.
-/// Also prints the raw gaps and the GNSS-to-command latency.
-fn capture_checks(lines: &[String], stalls: &[Stall], dt: f64, share: f64) {
+/// Also prints the raw gaps and the GNSS-to-command latency. `dropped` frames were lost by the
+/// capture itself (candump's socket overflowed): each can make the next frame of its id look
+/// like a counter error and widen one gap, so up to that many of each are the capture's, not
+/// the daemon's, and are reported as such.
+fn capture_checks(lines: &[String], dropped: u64, stalls: &[Stall], dt: f64, share: f64) {
     std::fs::write("/tmp/agsteer-capture.log", lines.join("\n") + "\n").unwrap();
     let out = run_ok("agsteer", &["dbc", "decode", "/tmp/agsteer-capture.log"]);
     let objs: Vec<serde_json::Value> = out
@@ -200,16 +203,20 @@ fn capture_checks(lines: &[String], stalls: &[Stall], dt: f64, share: f64) {
         .iter()
         .filter(|o| o.get("error").is_some() && !network_management(o))
         .collect();
+    let (counter, other): (Vec<&serde_json::Value>, Vec<&serde_json::Value>) = bad
+        .iter()
+        .partition(|o| o["error"].as_str() == Some("bad counter"));
     println!(
-        "CAPTURE frames={} decoded_objects={} errors={}",
+        "CAPTURE frames={} decoded_objects={} errors={} (counter {}) capture_dropped={dropped}",
         lines.len(),
         objs.len(),
-        bad.len()
+        bad.len(),
+        counter.len()
     );
     assert!(objs.len() >= lines.len());
     assert!(
-        bad.is_empty(),
-        "invalid frames: {:?}",
+        other.is_empty() && counter.len() as u64 <= dropped,
+        "invalid frames (the capture dropped {dropped}): {:?}",
         &bad[..bad.len().min(5)]
     );
     let cap = parse_candump(lines);
@@ -246,9 +253,12 @@ fn capture_checks(lines: &[String], stalls: &[Stall], dt: f64, share: f64) {
         within,
         gaps.len()
     );
+    // A frame the capture dropped widens one gap it cannot tell from a late command.
+    let lost_share = dropped as f64 / gaps.len() as f64;
     assert!(
-        within >= share,
-        "gaps less guest stalls within 2·dt: {within} (max {max_net} s)"
+        within >= share - lost_share,
+        "gaps less guest stalls within 2·dt: {within} (max {max_net} s; the capture dropped \
+         {dropped} frames)"
     );
     // GNSS position frame arrival → next command frame: the daemon computes the command on
     // the fix's arrival (issue 16 point 7: within 1 ms, p99 ≤ 2 ms at dt 10 ms), so the

@@ -50,7 +50,11 @@ pub fn link(iface: &str, up: bool) {
     );
 }
 
-/// A running `candump -L` capture.
+/// A running `candump -L` capture. Its socket has a large receive buffer (8 MiB, about ten
+/// seconds of this suite's traffic) because a starved guest once let the default one (~200 kB,
+/// a quarter of a second) overflow: the capture then missed frames and the next frame of each
+/// id looked like a counter error. Losses that still happen are reported by candump (`-d`) and
+/// kept apart from the frames (`Candump::dropped`).
 pub struct Candump {
     child: Child,
     lines: Arc<Mutex<Vec<String>>>,
@@ -60,7 +64,7 @@ pub struct Candump {
 impl Candump {
     pub fn start(iface: &str) -> Candump {
         let mut child = Command::new("candump")
-            .args(["-L", iface])
+            .args(["-L", "-d", "-r", "8388608", iface])
             .stdout(Stdio::piped())
             .spawn()
             .expect("candump");
@@ -72,20 +76,59 @@ impl Candump {
                 l2.lock().unwrap().push(line);
             }
         });
+        // A starved guest can take longer to start candump than a test's window (once more
+        // than the 0.5 s of `e_sigterm_disengages_last`): wait, up to 5 s, until it holds its
+        // CAN socket (created just before it is bound), then a little longer.
+        let fds = format!("/proc/{}/fd", child.id());
+        let has_socket = || {
+            std::fs::read_dir(&fds).is_ok_and(|d| {
+                d.flatten().any(|e| {
+                    std::fs::read_link(e.path())
+                        .is_ok_and(|l| l.to_string_lossy().starts_with("socket:"))
+                })
+            })
+        };
+        let t0 = Instant::now();
+        while !has_socket() && t0.elapsed() < Duration::from_secs(5) {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        std::thread::sleep(Duration::from_millis(20));
         Candump {
             child,
             lines,
             reader: Some(reader),
         }
     }
-    pub fn stop(mut self) -> Vec<String> {
+    /// The captured frame lines (candump's drop reports left out).
+    pub fn stop(self) -> Vec<String> {
+        self.stop_counting_drops().0
+    }
+    /// The captured frame lines and the number of frames the capture's socket dropped.
+    pub fn stop_counting_drops(mut self) -> (Vec<String>, u64) {
         let _ = self.child.kill();
         let _ = self.child.wait();
         if let Some(r) = self.reader.take() {
             let _ = r.join();
         }
-        let v = self.lines.lock().unwrap().clone();
-        v
+        let all = self.lines.lock().unwrap().clone();
+        let (reports, frames): (Vec<String>, Vec<String>) =
+            all.into_iter().partition(|l| l.starts_with("DROPCOUNT"));
+        (frames, Candump::dropped(&reports))
+    }
+    /// Total drops from candump's last "DROPCOUNT: dropped N CAN frames on 'x' socket (total
+    /// drops M)" report (0 without one).
+    fn dropped(reports: &[String]) -> u64 {
+        reports
+            .iter()
+            .filter_map(|l| {
+                l.rsplit_once("total drops ")?
+                    .1
+                    .trim_end_matches(')')
+                    .parse()
+                    .ok()
+            })
+            .max()
+            .unwrap_or(0)
     }
 }
 
