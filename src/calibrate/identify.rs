@@ -59,8 +59,6 @@ pub struct SteeringFit {
     pub fastest: f64,
 }
 
-/// The model's Euler step, s.
-pub const MODEL_STEP: f64 = 0.001;
 /// Highest rate the fit considers, rad/s (beyond it a steering is rate-unlimited here).
 const RATE_CEILING: f64 = 3.5;
 
@@ -102,15 +100,7 @@ pub fn fit_steering_from(
     }
     let mut pred = vec![0.0; n];
     let cost = |m: &SteeringModel, pred: &mut [f64]| -> f64 {
-        simulate(
-            m,
-            &rec.commands,
-            &times,
-            start,
-            rec.approach,
-            MODEL_STEP,
-            pred,
-        );
+        simulate(m, &rec.commands, &times, start, rec.approach, pred);
         pred.iter().zip(&meas).map(|(p, y)| (p - y) * (p - y)).sum()
     };
     // Start: the best of a grid over dead time and lag, with the rate at the fastest sensed
@@ -161,7 +151,6 @@ pub fn fit_steering_from(
         &times,
         start,
         rec.approach,
-        MODEL_STEP,
         &mut pred,
     );
     // The fastest motion of the fitted response (the sensed one carries the noise).
@@ -187,15 +176,7 @@ pub fn fit_steering_from(
             deadband: p[3].max(0.0),
             backlash: p[4].max(0.0),
         };
-        simulate(
-            &m,
-            &rec.commands,
-            &times,
-            start,
-            rec.approach,
-            MODEL_STEP,
-            out,
-        );
+        simulate(&m, &rec.commands, &times, start, rec.approach, out);
         for (o, y) in out.iter_mut().zip(&meas) {
             *o = y - *o;
         }
@@ -245,7 +226,7 @@ mod tests {
         }
         let times: Vec<f64> = (0..(t * 100.0) as usize).map(|i| i as f64 * 0.01).collect();
         let mut out = vec![0.0; times.len()];
-        simulate(m, &commands, &times, 0.0, 0.0, 0.0005, &mut out);
+        simulate(m, &commands, &times, 0.0, 0.0, &mut out);
         let samples = times
             .iter()
             .zip(&out)
