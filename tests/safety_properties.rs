@@ -5,7 +5,9 @@
 //!    measured angle at engage, lateral acceleration);
 //! 2. no engage happens without an operator engage after a fault (or any disengage);
 //! 3. a disengage always follows within one period after any timeout (GNSS, wheel angle);
-//! 4. the counter and CRC of every emitted frame are right (through the controller node).
+//! 4. the counter and CRC of every emitted frame are right (through the controller node);
+//! 5. no engaged command once the GNSS heading has disagreed with the course over ground
+//!    (beyond the limit, above the minimum speed) for the configured time.
 //!
 //! Inputs are random sequences of events and times, including garbage payloads on every known
 //! identifier, time jumps, NaN and infinite demands, and fast-packets out of order.
@@ -25,7 +27,11 @@ use agsteer::config::Config;
 use agsteer::control::node::ControllerNode;
 use agsteer::geo::v2;
 use agsteer::geo::wgs84::EnuFrame;
-use agsteer::safety::{CheckedInput, FixQuality, SafetyParams, SafetyState, Supervisor};
+use agsteer::geo::wrap_angle;
+use agsteer::safety::heading::expected_course;
+use agsteer::safety::{
+    CheckedInput, FixQuality, HeadingCheckParams, SafetyParams, SafetyState, Supervisor,
+};
 use proptest::prelude::*;
 use proptest::test_runner::{Config as PtConfig, RngSeed, TestRunner};
 
@@ -105,6 +111,20 @@ fn configurations() -> Vec<(&'static str, SafetyParams)> {
                 max_engage_heading_error: 170f64.to_radians(),
                 wheel_angle_timeout: 0.5,
                 override_time: 0.1,
+                ..d.clone()
+            },
+        ),
+        (
+            // A quick heading check, an antenna far ahead of the axle (a large crab in turns).
+            "quick heading check",
+            SafetyParams {
+                heading: HeadingCheckParams {
+                    limit: 15f64.to_radians(),
+                    time: 0.1,
+                    min_speed: 0.5,
+                    antenna_forward: 2.5,
+                    antenna_left: -0.4,
+                },
                 ..d
             },
         ),
@@ -132,6 +152,12 @@ enum Ev {
     Bus(bool),
     /// A stop for a change of direction (a cusp) starts or ends.
     DirectionChange(bool),
+    /// A GNSS heading and course over ground (rad) with the speed over ground (m/s).
+    Heading {
+        heading: f64,
+        course: f64,
+        sog: f64,
+    },
     /// The work line driven (None: a turn), with its sharpest curvature.
     Line {
         line: Option<u64>,
@@ -172,6 +198,10 @@ fn event() -> impl Strategy<Value = Ev> {
         1 => Just(Ev::Disengage),
         1 => prop::bool::weighted(0.8).prop_map(Ev::Bus),
         1 => prop::bool::ANY.prop_map(Ev::DirectionChange),
+        // Headings near the course (crab, noise) or far from it (a wrong heading).
+        4 => (-3.2f64..3.2, prop_oneof![3 => -0.2f64..0.2, 2 => 0.5f64..3.1, 1 => special_f64()],
+              prop_oneof![4 => 0.0f64..6.0, 1 => special_f64()])
+            .prop_map(|(course, off, sog)| Ev::Heading { heading: course + off, course, sog }),
         1 => (prop::option::weighted(0.8, 0u64..3), special_f64())
             .prop_map(|(line, curvature)| Ev::Line { line, curvature }),
         10 => (special_f64(), special_f64(), special_f64())
@@ -208,6 +238,9 @@ struct Oracle {
     last_step_t: Option<f64>,
     speed: f64,
     stopping_since: Option<f64>,
+    heading: Option<(f64, f64)>,
+    course: Option<(f64, f64, f64)>,
+    mismatch_since: Option<f64>,
 }
 
 fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseError> {
@@ -263,6 +296,20 @@ fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseEr
                 // Off at once: the next engagement starts again from the measured angle.
                 o.was_engaged = false;
             }
+            Ev::Heading {
+                heading,
+                course,
+                sog,
+            } => {
+                s.on_heading(o.t, *heading);
+                s.on_course(o.t, *course, *sog);
+                if heading.is_finite() {
+                    o.heading = Some((o.t, *heading));
+                }
+                if course.is_finite() && sog.is_finite() {
+                    o.course = Some((o.t, *course, sog.abs()));
+                }
+            }
             Ev::Bus(up) => s.on_bus(*up),
             Ev::Line { line, curvature } => s.set_line(*line, *curvature),
             Ev::DirectionChange(active) => {
@@ -296,6 +343,26 @@ fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseEr
                         heading_error,
                     } => (*demand, *xte, *heading_error),
                     _ => unreachable!(),
+                };
+                // (5) the heading check's own judgement, from the same inputs.
+                let h = &p.heading;
+                let fresh = |tx: f64| o.t - tx <= p.gnss_timeout && tx - o.t <= 1.0;
+                let judged = match (o.heading, o.course) {
+                    (Some((th, hd)), Some((tc, c, v)))
+                        if h.limit > 0.0
+                            && fresh(th)
+                            && fresh(tc)
+                            && (th - tc).abs() <= p.gnss_timeout
+                            && v >= h.min_speed =>
+                    {
+                        let want = expected_course(h, hd, o.measured, p.wheelbase, o.speed < 0.0);
+                        Some(wrap_angle(c - want).abs() > h.limit)
+                    }
+                    _ => None,
+                };
+                o.mismatch_since = match judged {
+                    Some(true) => Some(o.mismatch_since.unwrap_or(o.t)),
+                    _ => None,
                 };
                 let cmd = s.step(o.t, Some(demand), Some(xte), Some(heading_error));
                 let dt = o
@@ -354,6 +421,11 @@ fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseEr
                                 .is_some_and(|since| o.t - since <= p.max_stop_time + 1e-9),
                         "engaged at {} m/s, below the minimum, outside a direction change",
                         o.speed
+                    );
+                    prop_assert!(
+                        !o.mismatch_since.is_some_and(|since| o.t - since >= h.time),
+                        "engaged with the heading {:?} s off the course",
+                        o.mismatch_since.map(|since| o.t - since)
                     );
                     o.last_engaged_cmd = Some((o.t, cmd.wheel_angle));
                     ENGAGED_STEPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);

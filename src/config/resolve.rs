@@ -401,6 +401,8 @@ impl Config {
             actuator_tau: f.actuator_tau_s,
             actuator_rate: f.actuator_rate_deg_s.to_radians(),
             tracking: f.tracking_params(),
+            heading: f
+                .heading_check_params(self.vehicle.antenna_forward_m, self.vehicle.antenna_left_m),
         }
     }
 }

@@ -52,6 +52,13 @@ pub struct SafetyConfig {
     pub unstable_swings: u32,
     pub unstable_window_s: f64,
     pub unstable_wheel_mean_s: f64,
+    /// Heading against course over ground: above heading_mismatch_min_speed_kmh, a GNSS
+    /// heading whose course over ground (allowing for the antenna's crab in a turn and for
+    /// reversing) is more than heading_mismatch_deg off (0 = off) for heading_mismatch_time_s
+    /// is `heading_mismatch`.
+    pub heading_mismatch_deg: f64,
+    pub heading_mismatch_time_s: f64,
+    pub heading_mismatch_min_speed_kmh: f64,
 }
 
 impl Default for SafetyConfig {
@@ -80,6 +87,9 @@ impl Default for SafetyConfig {
             unstable_swings: 4,
             unstable_window_s: 40.0,
             unstable_wheel_mean_s: 2.0,
+            heading_mismatch_deg: 30.0,
+            heading_mismatch_time_s: 1.0,
+            heading_mismatch_min_speed_kmh: 2.0,
         }
     }
 }
@@ -96,6 +106,21 @@ impl SafetyConfig {
             unstable_swings: self.unstable_swings as usize,
             unstable_window: self.unstable_window_s,
             wheel_mean_tau: self.unstable_wheel_mean_s,
+        }
+    }
+
+    /// The heading check, SI, for an antenna at (`antenna_forward`, `antenna_left`) m.
+    pub fn heading_check_params(
+        &self,
+        antenna_forward: f64,
+        antenna_left: f64,
+    ) -> crate::safety::HeadingCheckParams {
+        crate::safety::HeadingCheckParams {
+            limit: self.heading_mismatch_deg.to_radians(),
+            time: self.heading_mismatch_time_s,
+            min_speed: self.heading_mismatch_min_speed_kmh / 3.6,
+            antenna_forward,
+            antenna_left,
         }
     }
 
@@ -183,6 +208,31 @@ impl SafetyConfig {
             f.unstable_wheel_mean_s,
             0.1,
             60.0,
+        );
+        c.range(
+            "safety.heading_mismatch_deg",
+            f.heading_mismatch_deg,
+            0.0,
+            180.0,
+        );
+        if f.heading_mismatch_deg > 0.0 && f.heading_mismatch_deg < 5.0 {
+            c.push(
+                "safety.heading_mismatch_deg",
+                fmt_num(f.heading_mismatch_deg),
+                "must be 0 (off) or at least 5 (course noise and tyre slip reach a few degrees)",
+            );
+        }
+        c.range(
+            "safety.heading_mismatch_time_s",
+            f.heading_mismatch_time_s,
+            0.0,
+            60.0,
+        );
+        c.range(
+            "safety.heading_mismatch_min_speed_kmh",
+            f.heading_mismatch_min_speed_kmh,
+            0.5,
+            50.0,
         );
     }
 }

@@ -73,6 +73,10 @@ pub struct SimConfig {
     pub slip_mps: f64,
     /// Wheel-angle sensor bias, degrees.
     pub was_bias_deg: f64,
+    /// A wrong GNSS heading: from `heading_bias_at_s` on, the reported heading (not the
+    /// course over ground) is this far off, degrees (a receiver's heading 90° off).
+    pub heading_bias_deg: f64,
+    pub heading_bias_at_s: f64,
     /// Actuator deadband (half-width), degrees, and backlash (total play), degrees.
     pub actuator_deadband_deg: f64,
     pub actuator_backlash_deg: f64,
@@ -150,6 +154,8 @@ impl Default for SimConfig {
             slip_per_roll_mps_per_deg: 0.0,
             slip_mps: 0.0,
             was_bias_deg: 0.0,
+            heading_bias_deg: 0.0,
+            heading_bias_at_s: 0.0,
             actuator_deadband_deg: 0.0,
             actuator_backlash_deg: 0.0,
             speed_min_kmh: 4.0,
@@ -255,6 +261,8 @@ impl SimConfig {
         );
         c.range("sim.slip_mps", s.slip_mps, -2.0, 2.0);
         c.range("sim.was_bias_deg", s.was_bias_deg, -10.0, 10.0);
+        c.range("sim.heading_bias_deg", s.heading_bias_deg, -180.0, 180.0);
+        c.range("sim.heading_bias_at_s", s.heading_bias_at_s, 0.0, 1e6);
         c.range(
             "sim.actuator_deadband_deg",
             s.actuator_deadband_deg,
@@ -421,6 +429,8 @@ impl super::Config {
                 slip_per_roll: s.slip_per_roll_mps_per_deg.to_degrees(),
                 slip: s.slip_mps,
                 was_bias: s.was_bias_deg.to_radians(),
+                heading_bias: s.heading_bias_deg.to_radians(),
+                heading_bias_at: s.heading_bias_at_s,
                 deadband: s.actuator_deadband_deg.to_radians(),
                 backlash: s.actuator_backlash_deg.to_radians(),
             },

@@ -351,8 +351,14 @@ impl ControllerNode {
                     self.roll = Some((a.t, roll));
                 }
             }
-            Input::Heading(h) => self.heading = Some((h.t, h.heading)),
+            Input::Heading(h) => {
+                self.heading = Some((h.t, h.heading));
+                self.supervisor.on_heading(h.t, h.heading);
+            }
             Input::CourseSpeed(c) => {
+                if let (Some(course), Some(sog)) = (c.course, c.speed_mps) {
+                    self.supervisor.on_course(c.t, course, sog);
+                }
                 if let Some(sog) = c.speed_mps {
                     if self.heading.is_none() {
                         // SOG has no sign: keep the direction the wheel-speed frame reported.

@@ -15,8 +15,10 @@
 //! and, engaged, given back as soon as the line (or the speed on it) makes it so
 //! (`line_unfollowable`, held like the tracking faults).
 
+pub mod heading;
 pub mod tracking;
 
+pub use heading::{HeadingCheck, HeadingCheckParams};
 use serde::Serialize;
 pub use tracking::{TrackingMonitor, TrackingParams, TrackingVerdict};
 
@@ -61,11 +63,16 @@ pub enum FaultCode {
     /// steering rate: engage refused, or, engaged, steering given back (a line that starts while
     /// engaged, or a speed-up on it).
     LineUnfollowable = 20,
+    /// Moving above `safety.heading_mismatch_min_speed_kmh`, the GNSS heading's course over
+    /// ground (crab in turns and reversing allowed for) is more than
+    /// `safety.heading_mismatch_deg` off for `safety.heading_mismatch_time_s`: the heading is
+    /// wrong, and every steering decision with it ([`heading`]).
+    HeadingMismatch = 21,
 }
 
 impl FaultCode {
     /// Every code, in bus order.
-    pub const ALL: [FaultCode; 21] = [
+    pub const ALL: [FaultCode; 22] = [
         FaultCode::None,
         FaultCode::GnssTimeout,
         FaultCode::FixQuality,
@@ -87,6 +94,7 @@ impl FaultCode {
         FaultCode::TrackingUnstable,
         FaultCode::OffLine,
         FaultCode::LineUnfollowable,
+        FaultCode::HeadingMismatch,
     ];
 }
 
@@ -165,6 +173,8 @@ pub struct SafetyParams {
     pub actuator_rate: f64,
     /// Tracking supervision on work lines (oscillation, offset, unfollowable lines).
     pub tracking: TrackingParams,
+    /// Heading against course over ground.
+    pub heading: HeadingCheckParams,
 }
 
 impl Default for SafetyParams {
@@ -189,6 +199,7 @@ impl Default for SafetyParams {
             actuator_tau: 0.15,
             actuator_rate: 30f64.to_radians(),
             tracking: TrackingParams::default(),
+            heading: HeadingCheckParams::default(),
         }
     }
 }
@@ -246,6 +257,7 @@ pub struct Supervisor {
     tracking: TrackingMonitor,
     /// A tracking fault held until the line changes or the operator disengages.
     tracking_latch: Option<FaultCode>,
+    heading_check: HeadingCheck,
 }
 
 const HISTORY: usize = 64;
@@ -281,6 +293,7 @@ impl Supervisor {
             line_curvature: 0.0,
             tracking: TrackingMonitor::new(),
             tracking_latch: None,
+            heading_check: HeadingCheck::new(),
         }
     }
 
@@ -394,6 +407,22 @@ impl Supervisor {
         self.wheel_angle = angle;
         self.override_bit = override_bit;
         self.actuator_fault = fault_bit;
+    }
+
+    /// A GNSS heading (rad, CCW from East) arrived at `t`, for the heading check.
+    pub fn on_heading(&mut self, t: f64, heading: f64) {
+        self.heading_check.on_heading(t, heading);
+    }
+
+    /// A GNSS course (rad, CCW from East) and speed over ground (m/s) arrived at `t`, for the
+    /// heading check.
+    pub fn on_course(&mut self, t: f64, course: f64, speed: f64) {
+        self.heading_check.on_course(t, course, speed);
+    }
+
+    /// The latest mismatch between the heading's expected course and the course, rad.
+    pub fn heading_mismatch(&self) -> f64 {
+        self.heading_check.mismatch()
     }
 
     /// A stop for a change of direction (a cusp) starts (`true`) or ends at `t`: while it
@@ -539,6 +568,18 @@ impl Supervisor {
         let t = if t.is_finite() { t } else { f64::NEG_INFINITY };
         let mut fault = self.input_fault(t);
         let demand = demand.filter(|d| d.is_finite());
+        let p = &self.params;
+        let mismatch = self.heading_check.update(
+            &p.heading,
+            t,
+            p.gnss_timeout,
+            self.wheel_angle,
+            p.wheelbase,
+            self.speed < 0.0,
+        );
+        if fault == FaultCode::None && mismatch {
+            fault = FaultCode::HeadingMismatch;
+        }
         if fault == FaultCode::None && demand.is_none() {
             fault = FaultCode::NoGuidance;
         }

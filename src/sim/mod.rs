@@ -336,7 +336,12 @@ impl Simulator {
             ant.y + normal(&mut self.rng, sigma),
         );
         let heading_noise = normal(&mut self.rng, self.p.heading_sigma);
-        let heading = wrap_angle(self.body.heading + heading_noise);
+        let bias = if now >= self.p.dist.heading_bias_at {
+            self.p.dist.heading_bias
+        } else {
+            0.0
+        };
+        let heading = wrap_angle(self.body.heading + heading_noise + bias);
         let course = wrap_angle(self.body.antenna_course(&self.p) + heading_noise);
         let speed = self.body.speed + normal(&mut self.rng, self.p.speed_sigma);
         let in_float = self.in_float_window(now);

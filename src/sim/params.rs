@@ -158,6 +158,10 @@ pub struct Disturbances {
     /// controller, which closes its position loop on that sensor, holds the wheels at the
     /// command minus the bias (so a tracker that trusts the sensor steers off by the bias).
     pub was_bias: f64,
+    /// A wrong heading: from `heading_bias_at` (s) on, the reported heading (not the course
+    /// over ground) is `heading_bias` (rad) off.
+    pub heading_bias: f64,
+    pub heading_bias_at: f64,
     /// Actuator deadband: no motion while the delayed command is within this of the actuator
     /// position, rad (half-width).
     pub deadband: f64,
@@ -274,6 +278,7 @@ impl SimParams {
             ("antenna_forward", p.antenna_forward),
             ("antenna_left", p.antenna_left),
             ("antenna_up", p.antenna_up),
+            ("heading_bias", p.dist.heading_bias),
         ] {
             check(n, v, true, "must be finite")?;
         }
@@ -291,6 +296,7 @@ impl SimParams {
             ("imu_noise", p.dist.imu_noise),
             ("deadband", p.dist.deadband),
             ("backlash", p.dist.backlash),
+            ("heading_bias_at", p.dist.heading_bias_at),
         ] {
             check(n, v, v >= 0.0, "must be >= 0")?;
         }

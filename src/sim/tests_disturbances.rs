@@ -383,6 +383,8 @@ fn disturbed_runs_are_deterministic_by_seed() {
                 slip_per_roll: 1.0,
                 slip: 0.01,
                 was_bias: 0.01,
+                heading_bias: 0.0,
+                heading_bias_at: 0.0,
                 deadband: 0.002,
                 backlash: 0.01,
             },
