@@ -14,7 +14,9 @@ use rand_chacha::ChaCha8Rng;
 /// The true plant: what calibration identifies, drawn from the envelope's ranges (issue 15
 /// point 2): dead time 0–0.25 s, lag 0.05–0.6 s, rate 10–90°/s, deadband and backlash up to
 /// 1° (each present half the time), WAS noise up to 0.5°, gain ±10 %, offset up to 2°, GNSS
-/// σ 0.5–5 cm. The geometry is the configured one (calibration does not measure it).
+/// σ 0.5–5 cm, GNSS latency 0–0.3 s, the antenna up to 0.3 m left or right of where the
+/// configuration says (heading σ 0.1°, as the default receiver). The wheelbase and the antenna's forward position
+/// are the configured ones (calibration does not measure them).
 #[derive(Debug, Clone, Copy)]
 struct Plant {
     dead_time: f64,
@@ -26,6 +28,10 @@ struct Plant {
     was_gain: f64,
     was_offset_deg: f64,
     gnss_sigma_m: f64,
+    gnss_latency_s: f64,
+    /// The true antenna's lateral offset less the configured one, m.
+    antenna_left_error_m: f64,
+    heading_sigma_deg: f64,
     seed: u64,
 }
 
@@ -48,6 +54,10 @@ impl Plant {
             was_gain: rng.gen_range(0.9..1.1),
             was_offset_deg: rng.gen_range(-2.0..2.0),
             gnss_sigma_m: rng.gen_range(0.005..0.05),
+            gnss_latency_s: rng.gen_range(0.0..0.3),
+            antenna_left_error_m: rng.gen_range(-0.3..0.3),
+            // The default receiver's heading (the envelope does not vary it).
+            heading_sigma_deg: 0.1,
             seed,
         }
     }
@@ -63,8 +73,15 @@ impl Plant {
         p.was_gain = self.was_gain;
         p.dist.was_bias = self.was_offset_deg.to_radians();
         p.gnss_sigma = self.gnss_sigma_m;
+        p.gnss_latency = self.gnss_latency_s;
+        p.antenna_left = cfg.vehicle.antenna_left_m + self.antenna_left_error_m;
+        p.heading_sigma = self.heading_sigma_deg.to_radians();
         p.seed = self.seed;
         p
+    }
+
+    fn antenna_left_m(&self, cfg: &Config) -> f64 {
+        cfg.vehicle.antenna_left_m + self.antenna_left_error_m
     }
 }
 
@@ -90,10 +107,20 @@ fn calibrate(plant: &Plant, operator: &Operator) -> Result<Calibration, Calibrat
     )
 }
 
+/// The GNSS latency within 10 ms or 10 %, whichever is larger.
+const LATENCY_TOLERANCE_S: f64 = 0.010;
+/// The antenna's lateral offset within 2 cm: the two-way pass reads it from two lines fitted
+/// to 20 s of 10 Hz fixes each; with white GNSS noise σ up to 5 cm each line's value is known
+/// to σ/√200 ≈ 0.35 cm, the offset (half the difference) to 0.25 cm, so 2 cm leaves room for
+/// what the fit's σ does not see: the simulated operator's wheels not exactly in the same
+/// track both ways (pure pursuit behind the plant's steering) and the position frames'
+/// resolution (1e-7°, ≈ 1 cm).
+const ANTENNA_TOLERANCE_M: f64 = 0.02;
+
 /// Every identified parameter within the issue's tolerances: 10 % (deadband and backlash
-/// also within 0.1°, for small ones), offset within 0.1°, dead time within 10 ms. A rate
-/// limit the tests never reached is reported as a lower bound, which must hold. (The WAS gain
-/// is held to 1 %.)
+/// also within 0.1°, for small ones), offset within 0.1°, dead time within 10 ms, GNSS
+/// latency within 10 ms (or 10 %), antenna lateral offset within 2 cm. A rate limit the tests
+/// never reached is reported as a lower bound, which must hold. (The WAS gain is held to 1 %.)
 fn misses(p: &Plant, f: &Figures) -> Vec<String> {
     let mut m = Vec::new();
     let mut check = |name: &str, got: f64, truth: f64, ok: bool| {
@@ -145,6 +172,33 @@ fn misses(p: &Plant, f: &Figures) -> Vec<String> {
         p.was_offset_deg,
         (f.was_offset_deg.value - p.was_offset_deg).abs() <= 0.1,
     );
+    match f.gnss_latency_ms {
+        Some(l) => {
+            let got = l.value / 1000.0;
+            check(
+                "GNSS latency s",
+                got,
+                p.gnss_latency_s,
+                (got - p.gnss_latency_s).abs() <= LATENCY_TOLERANCE_S.max(0.1 * p.gnss_latency_s),
+            );
+        }
+        None => check(
+            "GNSS latency (not measured)",
+            f64::NAN,
+            p.gnss_latency_s,
+            false,
+        ),
+    }
+    let truth = p.antenna_left_m(&config());
+    match f.antenna_left_m {
+        Some(a) => check(
+            "antenna left m",
+            a.value,
+            truth,
+            (a.value - truth).abs() <= ANTENNA_TOLERANCE_M,
+        ),
+        None => check("antenna left (not measured)", f64::NAN, truth, false),
+    }
     m
 }
 
@@ -175,8 +229,10 @@ fn twenty_random_plants_are_identified_within_the_tolerances() {
     });
     let mut failed = Vec::new();
     let mut unreached = 0;
-    // Worst errors: dead time ms, lag %, rate % (reached), lost motion °, gain %, offset °.
-    let mut worst = [0.0f64; 6];
+    // Worst errors: dead time ms, lag %, rate % (reached), lost motion °, gain %, offset °,
+    // GNSS latency ms, antenna left cm.
+    let mut worst = [0.0f64; 8];
+    let cfg = config();
     for (p, r) in &results {
         match r {
             Ok(c) => {
@@ -194,7 +250,26 @@ fn twenty_random_plants_are_identified_within_the_tolerances() {
                         .abs(),
                     100.0 * (c.was_gain.value / p.was_gain - 1.0).abs(),
                     (c.was_offset.value.to_degrees() - p.was_offset_deg).abs(),
+                    c.gnss_latency.map_or(f64::INFINITY, |l| {
+                        1000.0 * (l.value - p.gnss_latency_s).abs()
+                    }),
+                    c.antenna_left.map_or(f64::INFINITY, |a| {
+                        100.0 * (a.value - p.antenna_left_m(&cfg)).abs()
+                    }),
                 ];
+                eprintln!(
+                    "plant {}: latency {:.1} ms (truth {:.1}) ± {:.1}, antenna left {:.3} m \
+                     (truth {:.3}) ± {:.3}",
+                    p.seed,
+                    c.gnss_latency.map_or(f64::NAN, |l| 1000.0 * l.value),
+                    1000.0 * p.gnss_latency_s,
+                    c.gnss_latency
+                        .and_then(|l| l.sd)
+                        .map_or(f64::NAN, |s| 1000.0 * s),
+                    c.antenna_left.map_or(f64::NAN, |a| a.value),
+                    p.antenna_left_m(&cfg),
+                    c.antenna_left.and_then(|a| a.sd).unwrap_or(f64::NAN),
+                );
                 for (w, x) in worst.iter_mut().zip(e) {
                     *w = w.max(x);
                 }
@@ -209,8 +284,8 @@ fn twenty_random_plants_are_identified_within_the_tolerances() {
     eprintln!("rate limit not reached by the tests on {unreached} of 20 plants");
     eprintln!(
         "worst errors: dead time {:.1} ms, lag {:.1} %, rate {:.1} %, lost motion {:.3}°, \
-         WAS gain {:.2} %, WAS offset {:.3}°",
-        worst[0], worst[1], worst[2], worst[3], worst[4], worst[5]
+         WAS gain {:.2} %, WAS offset {:.3}°, GNSS latency {:.1} ms, antenna left {:.2} cm",
+        worst[0], worst[1], worst[2], worst[3], worst[4], worst[5], worst[6], worst[7]
     );
     assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
@@ -226,6 +301,9 @@ fn nominal() -> Plant {
         was_gain: 1.05,
         was_offset_deg: 1.0,
         gnss_sigma_m: 0.01,
+        gnss_latency_s: 0.08,
+        antenna_left_error_m: -0.15,
+        heading_sigma_deg: 0.1,
         seed: 7,
     }
 }
@@ -243,6 +321,8 @@ fn the_fragment_names_the_keys_the_controller_reads() {
         ("track", "lost_motion_initial_deg"),
         ("vehicle", "was_gain"),
         ("vehicle", "was_offset_deg"),
+        ("track", "gnss_latency_s"),
+        ("vehicle", "antenna_left_m"),
     ] {
         assert!(table[t].get(k).is_some(), "{t}.{k} missing:\n{frag}");
     }
@@ -324,6 +404,8 @@ struct DaemonRig {
     t: f64,
     replies: Vec<agsteer::can::codec::OperatorReplyResult>,
     engaged: bool,
+    /// The operator on the two-way pass.
+    driver: agsteer::demo::calibrate::LineDriver,
 }
 
 impl DaemonRig {
@@ -350,6 +432,7 @@ impl DaemonRig {
             t: 0.0,
             replies: Vec::new(),
             engaged: false,
+            driver: Default::default(),
         }
     }
 
@@ -398,6 +481,12 @@ impl DaemonRig {
                     self.replies.extend(r.result);
                 }
             }
+            // The operator steers the two-way pass by hand.
+            match self.node.calibration_progress().map(|p| p.instruction) {
+                Some("line") => self.driver.steer_line(self.sim.sim_mut()),
+                Some("turn") => self.driver.steer_turn(self.sim.sim_mut()),
+                _ => {}
+            }
         }
     }
 
@@ -431,7 +520,7 @@ fn the_daemon_mode_calibrates_within_the_tolerances_and_saves_the_result() {
     assert!(rig.engaged, "steering tests engaged: {}", rig.status());
     assert_eq!(rig.status()["instruction"], "stop");
     let mut drove = false;
-    rig.run(200.0, |r| {
+    rig.run(400.0, |r| {
         r.replies.len() > 1 || r.node.calibration_progress().is_none() && !r.node.calibrating()
     });
     drove |= rig.sim.sim().true_state().pose.pos.norm() > 10.0;

@@ -46,6 +46,12 @@ pub struct Figures {
     pub was_offset_deg: Figure,
     /// RMS of the steering fit's residuals, degrees.
     pub fit_rms_deg: f64,
+    /// GNSS latency, ms (`None`: not measured).
+    #[serde(default)]
+    pub gnss_latency_ms: Option<Figure>,
+    /// Antenna lateral offset, m, positive left (`None`: no two-way pass).
+    #[serde(default)]
+    pub antenna_left_m: Option<Figure>,
 }
 
 impl Calibration {
@@ -63,6 +69,8 @@ impl Calibration {
             was_gain: Figure::of(&self.was_gain, 1.0),
             was_offset_deg: Figure::of(&self.was_offset, deg),
             fit_rms_deg: self.steering_rms * deg,
+            gnss_latency_ms: self.gnss_latency.as_ref().map(|e| Figure::of(e, 1000.0)),
+            antenna_left_m: self.antenna_left.as_ref().map(|e| Figure::of(e, 1.0)),
         }
     }
 }
@@ -78,6 +86,14 @@ impl Figures {
                 self.rate_deg_s.value
             )
         };
+        let latency = self
+            .gnss_latency_ms
+            .map_or("not measured".to_string(), |f| f.show("ms", 1));
+        let antenna = self
+            .antenna_left_m
+            .map_or("not measured (no two-way pass)".to_string(), |f| {
+                f.show("m (left of the centre line)", 3)
+            });
         format!(
             "dead time      {}\n\
              lag            {}\n\
@@ -87,7 +103,9 @@ impl Figures {
              lost motion    {:.2} ° (deadband + half the backlash)\n\
              WAS gain       {}\n\
              WAS offset     {}\n\
-             fit residual   {:.3} ° RMS\n",
+             fit residual   {:.3} ° RMS\n\
+             GNSS latency   {latency}\n\
+             antenna left   {antenna}\n",
             self.dead_time_ms.show("ms", 1),
             self.lag_ms.show("ms", 1),
             self.deadband_deg.show("°", 2),

@@ -10,15 +10,21 @@
 //!   squares, with standard deviations; the two repetitions of the tests are fitted apart and
 //!   must agree;
 //! * the wheel-angle sensor ([`was`]): gain and zero offset against the GNSS yaw rate on the
-//!   drive.
+//!   drive;
+//! * the GNSS latency ([`latency`]): the delay of the GNSS heading's swing against the yaw
+//!   rate the sensor predicts, on a slalom;
+//! * the antenna's lateral offset ([`antenna`]): half the difference between the two ways of a
+//!   pass over the same ground line.
 //!
 //! [`Calibration::toml_fragment`] writes the keys the controller and the supervisor read. Pure:
 //! no I/O, no clock; the driving of a bus is the caller's (`agsteer calibrate`,
 //! [`crate::demo::calibrate`]).
 
+pub mod antenna;
 pub mod figures;
 pub mod fit;
 pub mod identify;
+pub mod latency;
 pub mod model;
 pub mod session;
 pub mod was;
@@ -53,6 +59,8 @@ pub struct CalibrationParams {
     /// quiet sensor only: a hold too short for the steering to settle shows as inconsistent
     /// responses and is refused.
     pub time_scale: f64,
+    /// Run the two-way pass for the antenna's lateral offset (the operator steers it).
+    pub antenna_pass: bool,
     pub geometry: Geometry,
 }
 
@@ -69,6 +77,7 @@ impl Default for CalibrationParams {
             follow_tolerance: 3f64.to_radians(),
             wait_timeout: 60.0,
             time_scale: 1.0,
+            antenna_pass: true,
             geometry: Geometry {
                 wheelbase: 3.0,
                 antenna_forward: 0.0,
@@ -118,6 +127,11 @@ pub struct Calibration {
     /// Sensor gain (sensed / true) and offset (sensed angle of straight driving, rad).
     pub was_gain: Estimate,
     pub was_offset: Estimate,
+    /// GNSS latency, s (`None`: no slalom heading to time; the reason in `latency_note`).
+    pub gnss_latency: Option<Estimate>,
+    pub latency_note: Option<&'static str>,
+    /// Antenna lateral offset, m, positive left (`None`: no two-way pass).
+    pub antenna_left: Option<Estimate>,
     /// RMS of the steering fit's residuals, rad.
     pub steering_rms: f64,
     /// The fit in the sensor's terms and the sensor fit, as found.
@@ -256,6 +270,58 @@ impl Session {
         }
         let g = was.gain;
         let m = fit.model.to_true(g);
+        let geo = &self.params.geometry;
+        let lat = latency::fit_latency(&self.slalom, geo, g, was.offset);
+        let (gnss_latency, latency_note) = match lat {
+            Some(l) if (l.scale - 1.0).abs() > 0.3 => {
+                return Err(CalibrationError::Inconsistent(format!(
+                    "the GNSS heading turned {:.2} × as much as the wheel angles say on the                      slalom (tyres slipping, or the wheelbase wrong)",
+                    l.scale
+                )))
+            }
+            Some(l) => (
+                Some(Estimate {
+                    value: l.latency,
+                    sd: Some(l.sd),
+                }),
+                None,
+            ),
+            None => (None, Some("no slalom with GNSS headings recorded")),
+        };
+        // The sensor's zero: the holds' line and the slalom's drift, weighted by their
+        // variances.
+        let was_offset = match lat {
+            Some(l) if l.offset_correction_sd > 0.0 && was.offset_sd > 0.0 => {
+                let (w1, w2) = (
+                    1.0 / was.offset_sd.powi(2),
+                    1.0 / l.offset_correction_sd.powi(2),
+                );
+                Estimate {
+                    value: (w1 * was.offset + w2 * (was.offset + l.offset_correction)) / (w1 + w2),
+                    sd: Some((1.0 / (w1 + w2)).sqrt()),
+                }
+            }
+            _ => Estimate {
+                value: was.offset,
+                sd: Some(was.offset_sd),
+            },
+        };
+        let antenna_left = if self.params.antenna_pass {
+            let a = antenna::fit_antenna_left(&self.pass_out, &self.pass_back)
+                .map_err(|e| CalibrationError::Inconsistent(format!("two-way pass: {e}")))?;
+            if a.rms > 0.15 {
+                return Err(CalibrationError::Inconsistent(format!(
+                    "two-way pass: the passes wander {:.2} m RMS off a straight line",
+                    a.rms
+                )));
+            }
+            Some(Estimate {
+                value: a.left,
+                sd: Some(a.sd),
+            })
+        } else {
+            None
+        };
         let est = |value: f64, i: usize, scale: f64| Estimate {
             value,
             sd: fit.sigma[i].map(|s| s * scale),
@@ -282,10 +348,10 @@ impl Session {
                 value: g,
                 sd: Some(was.gain_sd),
             },
-            was_offset: Estimate {
-                value: was.offset,
-                sd: Some(was.offset_sd),
-            },
+            was_offset,
+            gnss_latency,
+            latency_note,
+            antenna_left,
             steering_rms: fit.rms,
             steering_fit: fit,
             was_fit: was,
@@ -308,6 +374,23 @@ impl Calibration {
         } else {
             "not reached by the tests: the fastest motion seen, a lower bound".to_string()
         };
+        let latency = match &self.gnss_latency {
+            Some(e) => format!(
+                "# The GNSS latency (slalom); NMEA 0183 / UBX with a disciplined clock carry \
+                 their own.\ngnss_latency_s = {:.3}  # {}\n",
+                e.value.clamp(0.0, 0.5),
+                sd(e, 1.0, 3)
+            ),
+            None => String::new(),
+        };
+        let antenna = match &self.antenna_left {
+            Some(e) => format!(
+                "antenna_left_m = {:.3}  # {} (two-way pass)\n",
+                e.value,
+                sd(e, 1.0, 3)
+            ),
+            None => String::new(),
+        };
         format!(
             "# Written by `agsteer calibrate`: copy each key into its table of the configuration.\n\
              [safety]\n\
@@ -319,9 +402,11 @@ impl Calibration {
              lead_time_s = {:.3}\n\
              # Lost motion = deadband {:.2}° ({}) + half the backlash {:.2}° ({}).\n\
              lost_motion_initial_deg = {:.2}\n\
+             {latency}\
              \n[vehicle]\n\
              was_gain = {:.4}  # {}\n\
-             was_offset_deg = {:.2}  # {}\n",
+             was_offset_deg = {:.2}  # {}\n\
+             {antenna}",
             self.dead_time.value,
             sd(&self.dead_time, 1.0, 3),
             self.tau.value,

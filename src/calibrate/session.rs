@@ -10,13 +10,25 @@
 //! 3. **Drive**: the operator drives ahead at about `drive_speed`; the wheels are held at a
 //!    sensed 0, ±`hold_angle`, ±`hold_angle`/2 in turn, settling then measuring the yaw rate
 //!    (the WAS gain and zero, [`super::was`]).
+//! 4. **Slalom**, driving on: the wheels swing ±`hold_angle` with a period of 4 s; the GNSS
+//!    heading's delay against the sensor's yaw rate is the GNSS latency ([`super::latency`]).
+//! 5. **Two-way pass** (unless `antenna_pass` is off): the operator steers by hand along a
+//!    straight line marked on the ground (a string, a wheel track) for `PASS_TIME`, turns
+//!    round, and drives back over the same line, the wheels in the same tracks; the antenna's
+//!    lateral offset changes sign with the direction ([`super::antenna`]). The way back is
+//!    taken once the heading is reversed (within 15°) and the antenna within 2 m of the out
+//!    line, and recorded until it has passed the start of the out pass.
 //!
 //! Refused, with the reason: moving faster than allowed in a phase, the operator taking the
 //! wheel (override status, a disengage), the wheels held away from the command, no response.
 
+use super::antenna::MIN_OVERLAP_M;
 use super::identify::SteeringRecord;
+use super::latency::Slalom;
 use super::was::Hold;
 use super::{CalibrationError, CalibrationParams};
+use crate::geo::wgs84::{EnuFrame, LatLon};
+use crate::geo::{left_normal, vec_heading, wrap_angle, Vec2};
 use crate::input::{Input, OperatorCommand, SensorStatus};
 
 /// What the operator is asked to do.
@@ -26,6 +38,11 @@ pub enum Instruction {
     Stop,
     /// Drive ahead at this speed, m/s, on open ground (hands off the wheel).
     Drive(f64),
+    /// Steer by hand along the straight line marked on the ground at about this speed, m/s.
+    Line(f64),
+    /// Turn round (by hand) and drive back over the same line, the wheels in the same
+    /// tracks, at about this speed, m/s.
+    TurnBack(f64),
     /// Done: take over.
     Finished,
 }
@@ -62,6 +79,17 @@ const HOLD_MEASURE: f64 = 12.0;
 /// Sensed angles held on the drive, × `hold_angle`: one way across, so that each move is a
 /// small one (half `hold_angle`) and settles quickly.
 const HOLDS: [f64; 5] = [1.0, 0.5, 0.0, -0.5, -1.0];
+/// The slalom: period (s, not scaled: the swing must stay within what a slow steering
+/// follows) and number of periods (scaled, at least 3).
+const SLALOM_PERIOD: f64 = 4.0;
+const SLALOM_PERIODS: f64 = 8.0;
+/// The two-way pass: settling after the operator takes the wheel, s (not scaled), and the out
+/// pass recorded, s (scaled, at least 8 s).
+const PASS_SETTLE: f64 = 8.0;
+const PASS_TIME: f64 = 24.0;
+/// The way back starts within this heading (rad) and distance (m) of the out line reversed.
+const BACK_HEADING: f64 = 0.26;
+const BACK_DISTANCE: f64 = 2.0;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Phase {
@@ -69,7 +97,20 @@ enum Phase {
     Steering,
     WaitDrive { since: Option<f64> },
     Holds,
+    Slalom,
+    PassOut,
+    TurnBack { since: Option<f64> },
+    PassBack,
     Done,
+}
+
+/// The out pass's line: where it starts, its direction and its stretch (along-track from
+/// `origin`, m), once the out pass is recorded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OutLine {
+    origin: Vec2,
+    u: Vec2,
+    start: f64,
 }
 
 /// The procedure's time scale, kept in a sane range (a non-finite or non-positive value is 1).
@@ -93,6 +134,15 @@ pub struct Session {
     pub(super) markers: Vec<(f64, f64)>,
     pub(super) steering: SteeringRecord,
     pub(super) holds: Vec<Hold>,
+    pub(super) slalom: Slalom,
+    /// Antenna positions (time s, local ENU m) of the out and the back pass.
+    pub(super) pass_out: Vec<(f64, Vec2)>,
+    pub(super) pass_back: Vec<(f64, Vec2)>,
+    out_line: Option<OutLine>,
+    enu: Option<EnuFrame>,
+    position: Option<Vec2>,
+    /// The latest heading, or course over ground without a heading receiver, rad.
+    direction: Option<f64>,
     last_command: Option<f64>,
     speed: Option<(f64, f64)>,
     wheel_speed: Option<(f64, f64)>,
@@ -128,6 +178,13 @@ impl Session {
                 ..Default::default()
             },
             holds: Vec::new(),
+            slalom: Slalom::default(),
+            pass_out: Vec::new(),
+            pass_back: Vec::new(),
+            out_line: None,
+            enu: None,
+            position: None,
+            direction: None,
             last_command: None,
             speed: None,
             wheel_speed: None,
@@ -148,9 +205,29 @@ impl Session {
         (HOLD_SETTLE * k, (HOLD_SETTLE + HOLD_MEASURE) * k)
     }
 
-    /// The procedure's duration once the tractor is stopped and driving when asked, s.
+    /// The slalom's duration, s (whole periods).
+    fn slalom_duration(&self) -> f64 {
+        (SLALOM_PERIODS * time_scale(&self.params)).round().max(3.0) * SLALOM_PERIOD
+    }
+
+    /// The out pass: settling, then recording, s.
+    fn pass_times(&self) -> (f64, f64) {
+        (PASS_SETTLE, (PASS_TIME * time_scale(&self.params)).max(8.0))
+    }
+
+    /// The procedure's duration once the tractor is stopped and driving when asked, s (the
+    /// way back not counted: it depends on the operator's turn).
     pub fn nominal_duration(&self) -> f64 {
-        self.steering_duration() + HOLDS.len() as f64 * self.hold_times().1
+        let (settle, pass) = self.pass_times();
+        let passes = if self.params.antenna_pass {
+            2.0 * (settle + pass)
+        } else {
+            0.0
+        };
+        self.steering_duration()
+            + HOLDS.len() as f64 * self.hold_times().1
+            + self.slalom_duration()
+            + passes
     }
 
     /// The command actually sent at `t` (sensor terms, rad), when something between the
@@ -187,14 +264,20 @@ impl Session {
                                 h.sensed.push((w.t, a));
                             }
                         }
+                        Phase::Slalom => self.slalom.sensed.push((w.t, a)),
                         _ => {}
                     }
                 }
             }
-            Input::Heading(h) => {
+            Input::Heading(h) if h.heading.is_finite() => {
                 self.heading_seen = true;
+                self.slalom.course = false;
+                self.direction = Some(h.heading);
                 if let Some(hold) = self.measuring_hold(h.t) {
                     hold.heading.push((h.t, h.heading));
+                }
+                if self.phase == Phase::Slalom {
+                    self.slalom.heading.push((h.t, h.heading));
                 }
             }
             Input::CourseSpeed(c) => {
@@ -203,11 +286,37 @@ impl Session {
                     if let Some(hold) = self.measuring_hold(c.t) {
                         hold.speed.push((c.t, v));
                     }
+                    if self.phase == Phase::Slalom {
+                        self.slalom.speed.push((c.t, v));
+                    }
                 }
-                // Without a heading receiver the course over ground turns at the same rate.
-                if !self.heading_seen {
-                    if let (Some(course), Some(hold)) = (c.course, self.measuring_hold(c.t)) {
+                // Without a heading receiver the course over ground turns at the same rate
+                // (on a steady turn; in the slalom its crab is allowed for).
+                if let Some(course) = c.course.filter(|c| c.is_finite() && !self.heading_seen) {
+                    self.direction = Some(course);
+                    if let Some(hold) = self.measuring_hold(c.t) {
                         hold.heading.push((c.t, course));
+                    }
+                    if self.phase == Phase::Slalom {
+                        self.slalom.course = true;
+                        self.slalom.heading.push((c.t, course));
+                    }
+                }
+            }
+            Input::Position(p) => {
+                let ll = LatLon {
+                    lat_deg: p.lat_deg,
+                    lon_deg: p.lon_deg,
+                };
+                if ll.lat_deg.is_finite() && ll.lon_deg.is_finite() {
+                    let pos = self.enu.get_or_insert_with(|| EnuFrame::new(ll)).to_enu(ll);
+                    self.position = Some(pos);
+                    match self.phase {
+                        Phase::PassOut if self.pass_recording(p.t) => {
+                            self.pass_out.push((p.t, pos))
+                        }
+                        Phase::PassBack => self.pass_back.push((p.t, pos)),
+                        _ => {}
                     }
                 }
             }
@@ -233,7 +342,25 @@ impl Session {
     }
 
     fn active(&self) -> bool {
-        matches!(self.phase, Phase::Steering | Phase::Holds)
+        matches!(self.phase, Phase::Steering | Phase::Holds | Phase::Slalom)
+    }
+
+    /// Whether the out pass is being recorded at `t` (past its settling, within its time).
+    fn pass_recording(&self, t: f64) -> bool {
+        let (settle, pass) = self.pass_times();
+        let into = t - self.phase_start;
+        self.phase == Phase::PassOut && into >= settle && into < settle + pass
+    }
+
+    /// The out pass recorded: its line.
+    fn out_line(&self) -> Option<OutLine> {
+        let (first, last) = (self.pass_out.first()?.1, self.pass_out.last()?.1);
+        let d = last - first;
+        (d.norm() > 1.0).then(|| OutLine {
+            origin: first,
+            u: d / d.norm(),
+            start: 0.0,
+        })
     }
 
     /// The hold being measured at `t`, if any (the settling part is not recorded).
@@ -270,6 +397,22 @@ impl Session {
             phase,
             speed_kmh: speed * 3.6,
             limit_kmh: limit * 3.6,
+        }
+    }
+
+    /// On the drive: not faster than allowed, not slower than needed.
+    fn check_drive_speed(&self, speed: Option<f64>) -> Result<(), CalibrationError> {
+        let p = &self.params;
+        match speed {
+            Some(v) if v > p.drive_speed_max => {
+                Err(self.too_fast("the drive", v, p.drive_speed_max))
+            }
+            Some(v) if v < p.drive_speed_min => Err(CalibrationError::NoData(format!(
+                "the tractor slowed to {:.1} km/h during the drive (at least {:.1})",
+                v * 3.6,
+                p.drive_speed_min * 3.6
+            ))),
+            _ => Ok(()),
         }
     }
 
@@ -386,19 +529,7 @@ impl Session {
                 }
             }
             Phase::Holds => {
-                match speed {
-                    Some(v) if v > p.drive_speed_max => {
-                        return Err(self.too_fast("the drive", v, p.drive_speed_max))
-                    }
-                    Some(v) if v < p.drive_speed_min => {
-                        return Err(CalibrationError::NoData(format!(
-                            "the tractor slowed to {:.1} km/h during the drive (at least {:.1})",
-                            v * 3.6,
-                            p.drive_speed_min * 3.6
-                        )))
-                    }
-                    _ => {}
-                }
+                self.check_drive_speed(speed)?;
                 let (settle, span) = self.hold_times();
                 let into = t - self.phase_start;
                 let i = (into / span).floor() as usize;
@@ -427,9 +558,106 @@ impl Session {
                         }
                     }
                     None => {
+                        self.enter(Phase::Slalom, t);
+                        let n = (self.slalom_duration() * 200.0) as usize + 64;
+                        self.slalom.sensed.reserve(n);
+                        self.slalom.heading.reserve(n / 10);
+                        self.slalom.speed.reserve(n / 10);
+                        return self.tick(t);
+                    }
+                }
+            }
+            Phase::Slalom => {
+                self.check_drive_speed(speed)?;
+                let into = t - self.phase_start;
+                if into >= self.slalom_duration() {
+                    if !p.antenna_pass {
                         self.enter(Phase::Done, t);
                         return self.tick(t);
                     }
+                    self.enter(Phase::PassOut, t);
+                    let n = (self.pass_times().1 * 50.0) as usize + 64;
+                    self.pass_out.reserve(n);
+                    self.pass_back.reserve(4 * n);
+                    return self.tick(t);
+                }
+                // From and back to the last hold's side (−hold_angle): a cosine.
+                let phase = 2.0 * std::f64::consts::PI * into / SLALOM_PERIOD;
+                Tick {
+                    command: Some(limit(-p.hold_angle * phase.cos())),
+                    instruction: Instruction::Drive(p.drive_speed),
+                    phase: "drive: slalom (GNSS latency)",
+                }
+            }
+            Phase::PassOut => {
+                if let Some(v) = speed.filter(|v| *v > p.drive_speed_max) {
+                    return Err(self.too_fast("the two-way pass", v, p.drive_speed_max));
+                }
+                let (settle, pass) = self.pass_times();
+                if t - self.phase_start >= settle + pass {
+                    self.out_line = self.out_line();
+                    if self.out_line.is_none() {
+                        return Err(CalibrationError::NoData(
+                            "the tractor did not move along the line".into(),
+                        ));
+                    }
+                    self.enter(Phase::TurnBack { since: None }, t);
+                    return self.tick(t);
+                }
+                Tick {
+                    command: None,
+                    instruction: Instruction::Line(p.drive_speed),
+                    phase: "two-way pass: out along the line",
+                }
+            }
+            Phase::TurnBack { since } => {
+                if let Some(v) = speed.filter(|v| *v > p.drive_speed_max) {
+                    return Err(self.too_fast("the two-way pass", v, p.drive_speed_max));
+                }
+                let back = match (self.out_line, self.position, self.direction) {
+                    (Some(l), Some(pos), Some(dir)) => {
+                        let across = (pos - l.origin).dot(&left_normal(&l.u));
+                        let heading_back = wrap_angle(dir - vec_heading(&(-l.u))).abs();
+                        across.abs() < BACK_DISTANCE && heading_back < BACK_HEADING
+                    }
+                    _ => false,
+                };
+                let since = if back { since.or(Some(t)) } else { None };
+                if since.is_some_and(|s| t - s >= 1.0) {
+                    self.enter(Phase::PassBack, t);
+                    return self.tick(t);
+                }
+                if t - self.phase_start > 4.0 * p.wait_timeout {
+                    return Err(CalibrationError::NoData(format!(
+                        "the tractor did not come back onto the line within {:.0} s",
+                        4.0 * p.wait_timeout
+                    )));
+                }
+                self.phase = Phase::TurnBack { since };
+                Tick {
+                    command: None,
+                    instruction: Instruction::TurnBack(p.drive_speed),
+                    phase: "two-way pass: turn round onto the same line",
+                }
+            }
+            Phase::PassBack => {
+                if let Some(v) = speed.filter(|v| *v > p.drive_speed_max) {
+                    return Err(self.too_fast("the two-way pass", v, p.drive_speed_max));
+                }
+                // Done once past the start of the out pass, or after three times its time.
+                let past = match (self.out_line, self.position) {
+                    (Some(l), Some(pos)) => (pos - l.origin).dot(&l.u) < l.start - 2.0,
+                    _ => false,
+                };
+                let long = t - self.phase_start > 3.0 * self.pass_times().1 + MIN_OVERLAP_M;
+                if past || long {
+                    self.enter(Phase::Done, t);
+                    return self.tick(t);
+                }
+                Tick {
+                    command: None,
+                    instruction: Instruction::Line(p.drive_speed),
+                    phase: "two-way pass: back along the line",
                 }
             }
             Phase::Done => Tick {

@@ -65,7 +65,7 @@ fn mean(xs: impl Iterator<Item = f64>) -> Option<f64> {
 }
 
 /// Least-squares line y = a + b·x: (a, b, σ_a, σ_b, residual RMS).
-fn line(xy: &[(f64, f64)]) -> Option<(f64, f64, f64, f64, f64)> {
+pub(super) fn line(xy: &[(f64, f64)]) -> Option<(f64, f64, f64, f64, f64)> {
     let n = xy.len();
     if n < 3 {
         return None;

@@ -16,11 +16,18 @@ pub struct CalibrationConfig {
     /// Every hold of the steering tests and of the drive lasts this × its nominal time
     /// (0.1..=3, default 1: about 85 s of tests at a standstill and 80 s of drive).
     pub time_scale: f64,
+    /// Finish with the two-way pass for the antenna's lateral offset (the operator steers
+    /// along a marked line and back; README, Calibration). Off: `vehicle.antenna_left_m`
+    /// stays as configured.
+    pub antenna_pass: bool,
 }
 
 impl Default for CalibrationConfig {
     fn default() -> Self {
-        CalibrationConfig { time_scale: 1.0 }
+        CalibrationConfig {
+            time_scale: 1.0,
+            antenna_pass: true,
+        }
     }
 }
 
@@ -44,6 +51,7 @@ impl Config {
         p.step = p.step.min(p.max_angle);
         p.hold_angle = p.hold_angle.min(p.max_angle);
         p.time_scale = self.calibration.time_scale;
+        p.antenna_pass = self.calibration.antenna_pass;
         p
     }
 }

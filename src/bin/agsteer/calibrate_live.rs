@@ -142,6 +142,13 @@ pub fn calibrate_live(live: &Live, out: Option<&Path>) -> Result<u8> {
                         c["drive_speed_kmh"].as_f64().unwrap_or(f64::NAN)
                     ),
                     Some("stop") => "stop the tractor, hands off the wheel".to_string(),
+                    Some("line") => format!(
+                        "steer by hand along the marked line at about {:.0} km/h",
+                        c["drive_speed_kmh"].as_f64().unwrap_or(f64::NAN)
+                    ),
+                    Some("turn") => "turn round and come back over the same line, the \
+                                     wheels in the same tracks"
+                        .to_string(),
                     _ => "take over".to_string(),
                 }
             );

@@ -38,7 +38,8 @@ pub struct CalibrationProgress {
     /// The procedure's phase ("stop the tractor", "steering tests", "drive ahead", "drive:
     /// wheel-angle sensor", "done").
     pub phase: &'static str,
-    /// What the operator is asked to do: "stop", "drive" or "done".
+    /// What the operator is asked to do: "stop", "drive" (hands off), "line" (steer along the
+    /// marked line by hand), "turn" (turn round onto the same line by hand) or "done".
     pub instruction: &'static str,
     /// The speed asked for on the drive, km/h.
     pub drive_speed_kmh: f64,
@@ -95,6 +96,8 @@ fn instruction_name(i: Instruction) -> &'static str {
     match i {
         Instruction::Stop => "stop",
         Instruction::Drive(_) => "drive",
+        Instruction::Line(_) => "line",
+        Instruction::TurnBack(_) => "turn",
         Instruction::Finished => "done",
     }
 }
@@ -240,7 +243,7 @@ impl ControllerNode {
     pub(super) fn calibration_direction(&self) -> Option<DirectionRequestDirection> {
         let r = self.calibration.running.as_ref()?;
         Some(match r.progress.instruction {
-            "drive" => DirectionRequestDirection::Forward,
+            "drive" | "line" | "turn" => DirectionRequestDirection::Forward,
             _ => DirectionRequestDirection::Stop,
         })
     }
