@@ -23,7 +23,13 @@ const WAS_OFFSET_DEG: f64 = 1.0;
 fn calibration_by_the_daemon_on_vcan() {
     let Some(iface) = vcan() else { return };
     let t0 = Instant::now();
-    let _daemon = start_daemon(&["--set", "calibration.time_scale=0.2"]);
+    // No two-way pass: `agsteer sim` has no driver to steer it by hand.
+    let _daemon = start_daemon(&[
+        "--set",
+        "calibration.time_scale=0.2",
+        "--set",
+        "calibration.antenna_pass=false",
+    ]);
     let sets = [
         format!("sim.actuator_dead_time_s={DEAD_TIME_S}"),
         format!("sim.actuator_tau_s={LAG_S}"),
