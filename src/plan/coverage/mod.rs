@@ -424,20 +424,16 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
                 break;
             }
         }
-        let (pts, cut_prev, cut_next) = match found {
-            Some(x) => x,
-            // No way inside the field: the shortest direct curve, reported (the plan then
-            // breaks a guarantee there, and `agsteer plan` exits 4 naming the place).
-            None => {
-                warnings.borrow_mut().push(format!(
-                    "no transit inside the field from ({:.1}, {:.1}) to ({:.1}, {:.1}): the shortest curve is planned and leaves it",
-                    from.x, from.y, to.x, to.y
-                ));
-                match transit::transit(from, h0, to, h, p.r_min, p.point_spacing, &clear) {
-                    Some((pts, _)) => (pts, 0, 0),
-                    None => return 0,
-                }
-            }
+        // No way inside the field (parts joined only by a neck narrower than the turns need):
+        // the plan goes on from the target without a transit, so each part is worked on its
+        // own and the warning names the gap. (A curve out of the field would break a
+        // guarantee; dropping the target would leave the rest of the field unworked.)
+        let Some((pts, cut_prev, cut_next)) = found else {
+            warnings.borrow_mut().push(format!(
+                "no transit inside the field from ({:.1}, {:.1}) to ({:.1}, {:.1}): the plan goes on there without one (parts joined only by a neck too narrow to turn through; drive round outside the field)",
+                from.x, from.y, to.x, to.y
+            ));
+            return 0;
         };
         if cut_prev > 0 {
             if let Some(last) = segments.last_mut() {
