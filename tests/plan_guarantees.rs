@@ -25,7 +25,7 @@
 //! without a transit and names the gap. Measured 2026-12-02 with `many` on fresh fields: 4 000
 //! (10 runs) without a failure; 10 000 more with an earlier variant that dropped the unreached
 //! work instead: no transit out of the field or through a hole, one plan breaking a guarantee
-//! (a headland pass with a kink, three-point curvature 1.47 /m at r_min ≈ 9.8 m, a field with
+//! (a headland pass with a kink, three-point curvature 1.47 /m at r_min ≈ 9.2 m, a field with
 //! holes at w ≈ 30 m; the pass layout's, not a transit).
 
 use agsteer::config::Config;
