@@ -12,3 +12,4 @@ pub mod pty;
 #[cfg(test)]
 mod tests;
 pub mod transport;
+pub mod tty;

@@ -12,8 +12,9 @@
 //! before the (re)open are old. Counters and the connection state are published in a
 //! [`StreamStatus`] for `agsteer status`.
 //!
-//! Serial ports use `tokio-serial` (`serialport` under it) with default features off: no
-//! libudev, nothing but Rust and libc to build.
+//! Serial ports are opened and configured with `tokio-serial` (`serialport` under it) with
+//! default features off: no libudev, nothing but Rust and libc to build; they are read by
+//! [`super::tty`], which never reads an empty tty (that read waits for a kernel worker).
 
 use super::decoder::{DecoderParams, GnssDecoder, StreamCounters};
 use super::ntrip::GgaSource;
@@ -148,19 +149,8 @@ enum Conn {
 async fn open(t: &Transport) -> std::io::Result<Conn> {
     match t {
         Transport::Serial { device, baud } => {
-            use tokio_serial::SerialPort;
-            let path = device.to_string_lossy().to_string();
-            use tokio_serial::SerialPortBuilderExt;
-            let port = tokio_serial::new(&path, *baud)
-                .data_bits(tokio_serial::DataBits::Eight)
-                .parity(tokio_serial::Parity::None)
-                .stop_bits(tokio_serial::StopBits::One)
-                .flow_control(tokio_serial::FlowControl::None)
-                .open_native_async()
-                .map_err(std::io::Error::other)?;
-            port.clear(tokio_serial::ClearBuffer::Input)
-                .map_err(std::io::Error::other)?;
-            let (r, w) = tokio::io::split(port);
+            // Never a read of an empty tty on the control loop's thread (super::tty).
+            let (r, w) = super::tty::open(device, *baud)?;
             Ok(Conn::Stream(Box::new(r), Box::new(w)))
         }
         Transport::Tcp { host, port } => {
