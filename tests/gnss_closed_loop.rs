@@ -27,6 +27,12 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 
+#[path = "common/gnss_input.rs"]
+mod gnss_input;
+use gnss_input::{bad_input, free_tcp_port, free_udp_port};
+#[path = "common/host_stalls.rs"]
+mod host_stalls;
+use host_stalls::{Backlog, HostStall, TtyWatch};
 #[path = "common/caster.rs"]
 mod caster;
 use caster::{Caster, MOUNT, PASSWORD, USER};
@@ -73,11 +79,17 @@ struct Outcome {
     /// True |XTE| on the work lines: (rms, p95, max, samples), m.
     xte: (f64, f64, f64, usize),
     reengaged: u32,
-    /// Disengages outside the cut on a GNSS timeout that a stall of the loaded host explains:
-    /// no position input reached the loop for longer than `safety.gnss_timeout_s` although
-    /// the simulator kept writing. Tripping then is the right reaction, and the operator's
-    /// re-engage after it is one more in `reengaged`.
+    /// Disengages outside the cut on a GNSS timeout that a stall of the loaded host explains
+    /// ([`host_stalls::explain`]). Tripping then is the right reaction, and the operator's
+    /// re-engage after it is one more in `reengaged`; `xte` leaves out the time from such a
+    /// trip to 5 s after the re-engage (`xte_all` keeps it).
     stall_timeouts: u32,
+    stall_causes: Vec<HostStall>,
+    xte_all: (f64, f64, f64, usize),
+    /// The longest time delivered bytes waited unread in the tty (pty), s.
+    max_unread_s: f64,
+    /// The last epoch written before the cut → the first position input after it, s.
+    cut_epoch_late: f64,
     /// GNSS sent (position frame or epoch written) → the next command frame, s.
     fix_to_command: Vec<f64>,
     /// Epoch written → its position input reaching the control loop, s (streams only).
@@ -124,22 +136,23 @@ fn link_path(dir: &Path) -> PathBuf {
 /// The simulated receiver's device or socket.
 enum Sink {
     None,
-    Pty(Option<Pty>, PathBuf),
+    Pty(Option<(Pty, TtyWatch)>, PathBuf),
     Udp(std::net::UdpSocket, u16),
 }
 
 impl Sink {
-    fn plug(link: &Path) -> Pty {
+    fn plug(link: &Path) -> (Pty, TtyWatch) {
         let pty = Pty::open().unwrap();
         pty.set_nonblocking().unwrap();
         let _ = std::fs::remove_file(link);
         std::os::unix::fs::symlink(pty.path(), link).unwrap();
-        pty
+        let watch = TtyWatch::open(pty.path()).unwrap();
+        (pty, watch)
     }
     fn write(&mut self, bytes: &[u8]) {
         match self {
             Sink::None | Sink::Pty(None, _) => {}
-            Sink::Pty(Some(p), _) => {
+            Sink::Pty(Some((p, _)), _) => {
                 let _ = p.master().write_all(bytes);
             }
             Sink::Udp(s, port) => {
@@ -157,6 +170,10 @@ struct SimRecord {
     /// Monotonic time of each GNSS send.
     gnss_sent: Vec<f64>,
     rtcm_in: u64,
+    /// Monotonic time of the simulator's time 0.
+    t0: f64,
+    /// When delivered bytes waited unread in the tty (pty).
+    unread: Backlog,
 }
 
 /// The simulator in real time, as `agsteer sim` runs it: sensors every 2 ms.
@@ -207,7 +224,10 @@ fn simulate(
     };
     let mut encoder =
         GnssStreamEncoder::new(GnssStreamParams::new(DEFAULT_NMEA.to_vec(), utc_now()), enu);
-    let mut rec = SimRecord::default();
+    let mut rec = SimRecord {
+        t0,
+        ..Default::default()
+    };
     let (mut frames, mut epochs, mut bytes) =
         (Vec::new(), Vec::<GnssMeasurement>::new(), Vec::new());
     let mut next_sample = 0.0;
@@ -260,7 +280,8 @@ fn simulate(
         while let Ok(tf) = from_ctrl.try_recv() {
             node.on_frame(&tf);
         }
-        if let Sink::Pty(Some(p), _) = &sink {
+        if let Sink::Pty(Some((p, watch)), _) = &sink {
+            rec.unread.sample(monotonic_s(), watch.unread());
             // The receiver takes the corrections the daemon writes back.
             use std::io::Read;
             let mut m = p.master();
@@ -294,29 +315,6 @@ fn simulate(
         std::thread::sleep(Duration::from_millis(2));
     }
     rec
-}
-
-/// `len` bytes of bad input into `out`: random bytes, then the last good epoch with one
-/// checksum digit wrong, a replay of it whole (a valid checksum, an old time), and its first
-/// half (a truncated line).
-fn bad_input(seed: &mut u64, last_epoch: &[u8], len: usize, out: &mut Vec<u8>) {
-    out.clear();
-    while out.len() < len / 2 {
-        *seed ^= *seed << 13;
-        *seed ^= *seed >> 7;
-        *seed ^= *seed << 17;
-        out.extend_from_slice(&seed.to_le_bytes());
-    }
-    if let Some(star) = last_epoch.iter().position(|&b| b == b'*') {
-        let mut wrong = last_epoch.to_vec();
-        if let Some(d) = wrong.get_mut(star + 1) {
-            *d = if *d == b'0' { b'1' } else { b'0' };
-        }
-        out.extend_from_slice(&wrong);
-    }
-    out.extend_from_slice(last_epoch);
-    out.extend_from_slice(&last_epoch[..last_epoch.len() / 2]);
-    out.truncate(len);
 }
 
 /// One job, closed-loop in real time, for at most `max_s`.
@@ -393,6 +391,9 @@ fn run_job(path: GnssPath, extra: &[&str], cut: Option<Cut>, max_s: f64) -> Outc
                 _ = interval.tick() => {
                     let t = monotonic_s();
                     while let Ok(tf) = from_sim.try_recv() {
+                        if tf.frame.id & 0x03FF_FF00 == POSITION_RAPID {
+                            arrivals.push((monotonic_s(), true));
+                        }
                         node.on_frame(&tf);
                     }
                     let st = node.status();
@@ -465,36 +466,64 @@ fn run_job(path: GnssPath, extra: &[&str], cut: Option<Cut>, max_s: f64) -> Outc
             }
         }
     }
-    let timeout = cfg.safety.gnss_timeout_s;
     let in_cut =
         |t: f64| cut_at.is_some_and(|u| t >= u && t <= restored_at.unwrap_or(f64::MAX) + 2.0);
-    for w in ticks.windows(2) {
+    // A GNSS timeout is the cut's expected reaction, except to a caster gone.
+    let expected_timeout = |t: f64| in_cut(t) && cut.is_some_and(|c| c.what != CutKind::Caster);
+    let periods: Vec<f64> = ticks.iter().map(|k| k.0).collect();
+    let unread = (path == GnssPath::Pty).then_some(&rec.unread);
+    let gnss_period = 1.0 / cfg.sim.gnss_rate_hz;
+    // The trips a host stall explains: (trip, re-engage) (monotonic).
+    let mut excused: Vec<(f64, f64)> = Vec::new();
+    for (k, w) in ticks.windows(2).enumerate() {
         let (t, engaged, fault) = w[1];
-        if w[0].1 && !engaged && fault == FaultCode::GnssTimeout && !in_cut(t) {
+        if w[0].1 && !engaged && fault == FaultCode::GnssTimeout && !expected_timeout(t) {
             let last_input = arrivals
                 .iter()
                 .rev()
                 .find(|a| a.0 <= t)
                 .map_or(f64::MIN, |a| a.0);
-            let sent = rec
-                .gnss_sent
-                .iter()
-                .any(|&g| g > last_input && g < t - timeout);
-            if t - last_input > timeout && sent {
+            let sends = &rec.gnss_sent;
+            let run = (periods.as_slice(), dt);
+            if let Some(c) = host_stalls::explain(t, last_input, run, sends, unread, gnss_period) {
                 out.stall_timeouts += 1;
+                out.stall_causes.push(c);
+                let back = ticks[k + 1..]
+                    .iter()
+                    .find(|k| k.1)
+                    .map_or(f64::MAX, |k| k.0);
+                excused.push((t, back));
             }
         }
     }
+    out.max_unread_s = rec.unread.longest_within(f64::MIN, f64::MAX);
     if let Some(u) = cut_at {
+        let last_sent = rec.gnss_sent.iter().rev().find(|s| **s < u);
+        let first_in = |s: f64| arrivals.iter().find(|a| a.0 >= s).map_or(0.0, |a| a.0 - s);
+        out.cut_epoch_late = last_sent.map_or(0.0, |s| first_in(*s));
+    }
+    if let Some(u) = cut_at {
+        let off_by_host = |t: f64| excused.iter().any(|(a, b)| (*a..*b).contains(&t));
         out.cut = ticks
             .iter()
-            .find(|k| k.0 >= u && !k.1)
+            .find(|k| k.0 >= u && !k.1 && !off_by_host(k.0))
             .map(|k| (k.0 - u, k.2));
     }
     if let Some(r) = restored_at {
         out.restored_to_fix = arrivals.iter().find(|a| a.0 >= r && a.1).map(|a| a.0 - r);
     }
-    out.xte = xte(&cfg, &rec.trajectory);
+    out.xte_all = xte(&cfg, &rec.trajectory);
+    let kept: Vec<_> = rec
+        .trajectory
+        .iter()
+        .filter(|s| {
+            !excused
+                .iter()
+                .any(|(a, b)| (*a..*b + 5.0).contains(&(s.0 + rec.t0)))
+        })
+        .copied()
+        .collect();
+    out.xte = xte(&cfg, &kept);
     out
 }
 
@@ -538,21 +567,26 @@ fn print(name: &str, o: &mut Outcome) {
     o.transport.sort_by(|a, b| a.total_cmp(b));
     o.fix_latency.sort_by(|a, b| a.total_cmp(b));
     println!(
-        "GNSS-LOOP {name}: finished={} reengaged={} stall_timeouts={} XTE rms_m={:.4} p95_m={:.4} max_m={:.4} \
-         samples={}; fix→command median_ms={:.2} p99_ms={:.2} over {}; \
-         write→input median_ms={:.2} p99_ms={:.2}; measured fix latency median_ms={:.1}",
+        "GNSS-LOOP {name}: finished={} reengaged={} stall_timeouts={} {:?} XTE rms_m={:.4} p95_m={:.4} \
+         max_m={:.4} samples={} (with the stalls' aftermath rms_m={:.4}); fix→command \
+         median_ms={:.2} p99_ms={:.2} over {}; write→input median_ms={:.2} p99_ms={:.2} \
+         max_ms={:.1}; longest unread in the tty ms={:.1}; measured fix latency median_ms={:.1}",
         o.finished,
         o.reengaged,
         o.stall_timeouts,
+        o.stall_causes,
         o.xte.0,
         o.xte.1,
         o.xte.2,
         o.xte.3,
+        o.xte_all.0,
         pct(&o.fix_to_command, 0.5) * 1e3,
         pct(&o.fix_to_command, 0.99) * 1e3,
         o.fix_to_command.len(),
         pct(&o.transport, 0.5) * 1e3,
         pct(&o.transport, 0.99) * 1e3,
+        pct(&o.transport, 1.0) * 1e3,
+        o.max_unread_s * 1e3,
         pct(&o.fix_latency, 0.5) * 1e3,
     );
     if let Some(s) = &o.stream {
@@ -563,22 +597,9 @@ fn print(name: &str, o: &mut Outcome) {
     }
 }
 
-/// A free TCP port on loopback (for the caster).
-fn free_tcp_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port()
-}
-
-/// A free UDP port on loopback (bound, then released for the stream to take).
-fn free_udp_port() -> u16 {
-    std::net::UdpSocket::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port()
+/// Enough XTE samples on the lines: 500 (25 s), or 100 when host stalls' aftermath was left out.
+fn scored(o: &Outcome) -> bool {
+    o.xte.3 > 500 || (o.stall_timeouts > 0 && o.xte.3 > 100)
 }
 
 /// Two 60 m lines: 40 m of each scored.
@@ -591,7 +612,7 @@ fn ab_job_with_gnss_on_a_pty_tracks_within_twice_the_all_can_xte() {
     let mut pty = run_job(GnssPath::Pty, &JOB, None, 120.0);
     print("pty", &mut pty);
     assert!(can.finished && pty.finished, "both jobs finish");
-    assert!(can.xte.3 > 500 && pty.xte.3 > 500, "samples on the lines");
+    assert!(scored(&can) && scored(&pty), "samples on the lines");
     // The all-CAN run is itself a few millimetres; a millimetre of floor keeps the ratio from
     // judging sub-millimetre noise.
     assert!(
@@ -606,7 +627,15 @@ fn ab_job_with_gnss_on_a_pty_tracks_within_twice_the_all_can_xte() {
     );
     let s = pty.stream.as_ref().unwrap();
     assert_eq!(s.checksum_errors, 0, "{s:?}");
-    assert_eq!(s.reconnects, 0, "{s:?}");
+    // A reopen only after the kernel held the bytes for `gnss.silence_timeout_s`.
+    let silent = s
+        .last_error
+        .as_deref()
+        .is_some_and(|e| e.starts_with("no data"));
+    assert!(
+        s.reconnects == 0 || (silent && pty.max_unread_s <= host_stalls::READER_SLACK_S),
+        "{s:?}"
+    );
     // The fixes' latency measured from the sentences' UTC: the simulator's 50 ms plus the
     // path (host clock and the simulator's are the same clock here), to the sentences'
     // centisecond.
@@ -622,7 +651,7 @@ fn ab_job_with_gnss_over_udp() {
     let mut udp = run_job(GnssPath::Udp(free_udp_port()), &JOB, None, 120.0);
     print("udp", &mut udp);
     assert!(udp.finished);
-    assert!(udp.xte.3 > 500);
+    assert!(scored(&udp));
     // Within 2× of the all-CAN figure measured in the pty test (a few mm; the bound is 2 cm).
     assert!(udp.xte.0 < 0.02, "{}", udp.xte.0);
     assert_eq!(udp.reengaged, udp.stall_timeouts);
@@ -651,7 +680,8 @@ fn receiver_unplugged_mid_line_disengages_within_the_gnss_timeout() {
     assert_eq!(fault, FaultCode::GnssTimeout);
     // gnss_timeout_s (0.3 s) after the last fix, which came up to a GNSS period before the
     // unplug, plus a control period; 50 ms more for a loaded host's scheduling.
-    assert!(to_safe <= 0.3 + 0.01 + 0.05, "{to_safe}");
+    // (The last fix may itself reach the loop late on a loaded host: `cut_epoch_late`.)
+    assert!(to_safe <= 0.3 + 0.01 + 0.05 + o.cut_epoch_late, "{to_safe}");
     assert!(o.finished, "the job finishes after the operator re-engages");
     assert_eq!(o.reengaged, 1 + o.stall_timeouts);
     assert!(o.stream.as_ref().unwrap().reconnects >= 1);
@@ -676,7 +706,8 @@ fn udp_receiver_silent_mid_line_disengages_within_the_gnss_timeout() {
         back * 1e3
     );
     assert_eq!(fault, FaultCode::GnssTimeout);
-    assert!(to_safe <= 0.3 + 0.01 + 0.05, "{to_safe}");
+    // (The last fix may itself reach the loop late on a loaded host: `cut_epoch_late`.)
+    assert!(to_safe <= 0.3 + 0.01 + 0.05 + o.cut_epoch_late, "{to_safe}");
     assert!(o.finished);
     assert_eq!(o.reengaged, 1 + o.stall_timeouts);
 }
@@ -718,7 +749,7 @@ fn caster_gone_mid_line_degrades_the_fix_and_disengages() {
     // The corrections' age passes the limit 2 s after the last RTCM frame (which came within
     // 100 ms before the kill), then the next fix (0.1 s) is degraded, then a control period.
     assert!(
-        to_safe >= max_age - 0.15 && to_safe <= max_age + 0.1 + 0.01 + 0.05,
+        to_safe >= max_age - 0.15 && to_safe <= max_age + 0.1 + 0.01 + 0.05 + o.cut_epoch_late,
         "{to_safe}"
     );
     assert!(o.rtcm_in > 1000, "corrections reached the receiver");
@@ -755,7 +786,8 @@ fn garbage_and_a_udp_flood_in_place_of_fixes_disengage_within_the_gnss_timeout()
             s.dropped_bytes
         );
         assert_eq!(fault, FaultCode::GnssTimeout, "{name}");
-        assert!(to_safe <= 0.3 + 0.01 + 0.05, "{name}: {to_safe}");
+        let bound = 0.3 + 0.01 + 0.05 + o.cut_epoch_late;
+        assert!(to_safe <= bound, "{name}: {to_safe}");
         assert!(o.finished, "{name}");
         assert_eq!(o.reengaged, 1 + o.stall_timeouts, "{name}");
         match path {
