@@ -83,23 +83,14 @@ fn print(label: &str, r: &JobRun) {
 /// Each epoch's send time (UTC s) from `agsteer sim --gnss-log` → the next steering command
 /// frame in the candump capture (same guest clock): (median, p99, count), s.
 fn epoch_to_command(log: &str, capture: &[String]) -> (f64, f64, usize) {
-    let sent: Vec<f64> = std::fs::read_to_string(log)
-        .unwrap_or_default()
-        .lines()
-        .skip(1)
-        .filter_map(|l| l.split(',').next()?.parse().ok())
+    let cmds: Vec<f64> = steering_frames(&parse_candump(capture))
+        .iter()
+        .map(|c| c.0)
         .collect();
-    let cmds = steering_frames(&parse_candump(capture));
-    let mut lat = Vec::new();
-    let mut ci = 0;
-    for s in sent {
-        while ci < cmds.len() && cmds[ci].0 < s {
-            ci += 1;
-        }
-        if let Some(c) = cmds.get(ci) {
-            lat.push(c.0 - s);
-        }
-    }
+    let mut lat: Vec<f64> = next_after(&gnss_log_times(log), &cmds)
+        .iter()
+        .map(|(s, c)| c - s)
+        .collect();
     lat.sort_by(|a, b| a.total_cmp(b));
     (pct(&lat, 0.5), pct(&lat, 0.99), lat.len())
 }
@@ -118,14 +109,7 @@ fn k_gnss_on_a_pty_and_udp_closed_loop() {
     let pty = run_job(
         &iface,
         "pty",
-        &[
-            "--set",
-            "gnss.source=\"nmea0183\"",
-            "--set",
-            "gnss.transport=\"serial\"",
-            "--set",
-            &device,
-        ],
+        &serial_gnss_args(&device),
         &["--gnss-pty", GNSS_LINK, "--gnss-log", serial_log],
     );
     print("pty", &pty);

@@ -1,5 +1,5 @@
 //! Helpers for the vcan tests: the interface, spawning programs, candump captures, link
-//! up/down, and an echo latency baseline.
+//! up/down, and the latency baselines (an echo on the bus, bytes through a pseudo-terminal).
 
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
@@ -132,9 +132,26 @@ impl Candump {
     }
 }
 
-/// Round-trip latency (s) of a trivial echo on the bus: a thread blocked in read(2) re-sends
-/// every frame with id + 1; the measuring side blocks in read(2) too. Returns (median, p99).
-pub fn echo_latency(iface: &str, n: usize) -> (f64, f64) {
+/// This thread at SCHED_FIFO `priority` (no change when refused).
+pub fn set_fifo(priority: i32) {
+    let param = libc::sched_param {
+        sched_priority: priority,
+    };
+    // SAFETY: sets this thread's own scheduling policy; param outlives the call.
+    unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) };
+}
+
+/// Round trips of a trivial echo on the bus: a thread blocked in read(2) re-sends every frame
+/// with id + 1; the asking thread blocks in read(2) too and asks `n` times, `every` apart.
+/// Both threads run at SCHED_FIFO `priority` when one is given (the daemon's: the figure is
+/// then what a process doing nothing but read → write gets beside it, under the same load).
+/// (ask, answer) wall-clock times, s; a question unanswered within 1 s is left out.
+pub fn echo_round_trips(
+    iface: &str,
+    n: usize,
+    every: Duration,
+    priority: Option<i32>,
+) -> Vec<(f64, f64)> {
     use socketcan::{EmbeddedFrame, ExtendedId, Socket, SocketOptions};
     let filter = |id: u32| [socketcan::CanFilter::new(id | 0x8000_0000, 0x9FFF_FFFF)];
     let echo = socketcan::CanSocket::open(iface).unwrap();
@@ -143,6 +160,9 @@ pub fn echo_latency(iface: &str, n: usize) -> (f64, f64) {
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
     let s2 = stop.clone();
     let h = std::thread::spawn(move || {
+        if let Some(p) = priority {
+            set_fifo(p);
+        }
         let reply = ExtendedId::new(0x0CFF5001).unwrap();
         while !s2.load(std::sync::atomic::Ordering::Relaxed) {
             if let Ok(f) = echo.read_frame() {
@@ -152,22 +172,134 @@ pub fn echo_latency(iface: &str, n: usize) -> (f64, f64) {
             }
         }
     });
-    let sock = socketcan::CanSocket::open(iface).unwrap();
-    sock.set_filters(&filter(0x0CFF5001)).unwrap();
-    sock.set_read_timeout(Duration::from_secs(1)).unwrap();
-    let ask = ExtendedId::new(0x0CFF5000).unwrap();
-    let mut lat = Vec::with_capacity(n);
-    for k in 0..n {
-        let f = socketcan::CanFrame::new(ask, &(k as u64).to_le_bytes()).unwrap();
-        let t0 = Instant::now();
-        sock.write_frame(&f).unwrap();
-        let _ = sock.read_frame();
-        lat.push(t0.elapsed().as_secs_f64());
-    }
+    let iface = iface.to_string();
+    let asker = std::thread::spawn(move || {
+        if let Some(p) = priority {
+            set_fifo(p);
+        }
+        let sock = socketcan::CanSocket::open(&iface).unwrap();
+        sock.set_filters(&filter(0x0CFF5001)).unwrap();
+        sock.set_read_timeout(Duration::from_secs(1)).unwrap();
+        let ask = ExtendedId::new(0x0CFF5000).unwrap();
+        let mut trips = Vec::with_capacity(n);
+        for k in 0..n {
+            let f = socketcan::CanFrame::new(ask, &(k as u64).to_le_bytes()).unwrap();
+            let t0 = wall_s();
+            sock.write_frame(&f).unwrap();
+            if sock.read_frame().is_ok() {
+                trips.push((t0, wall_s()));
+            }
+            std::thread::sleep(every);
+        }
+        trips
+    });
+    let trips = asker.join().unwrap_or_default();
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
     let _ = h.join();
+    trips
+}
+
+/// Round-trip latency (s) of the echo ([`echo_round_trips`]) asked back to back at normal
+/// priority: (median, p99).
+pub fn echo_latency(iface: &str, n: usize) -> (f64, f64) {
+    let mut lat: Vec<f64> = echo_round_trips(iface, n, Duration::ZERO, None)
+        .iter()
+        .map(|(a, b)| b - a)
+        .collect();
     lat.sort_by(|a, b| a.total_cmp(b));
-    (lat[n / 2], lat[(n * 99) / 100])
+    (pct(&lat, 0.5), pct(&lat, 0.99))
+}
+
+/// A serial receiver's bytes through the kernel alone: `n` writes of an 80-byte line to a
+/// pseudo-terminal's master, `every` apart, each to the return of a blocking read(2) on its
+/// slave. Both threads run at SCHED_FIFO `priority` (the daemon's). The kernel hands a tty's
+/// received bytes to its reader from a worker thread (the tty flip buffer's work item, at
+/// normal priority), the same way for a USB CDC-ACM or UART receiver, so this is the floor of
+/// the serial fix → command path beside the daemon. (written, read) wall-clock times, s.
+pub fn pty_one_way(n: usize, every: Duration, priority: i32) -> Vec<(f64, f64)> {
+    use std::io::{Read, Write};
+    let pty = agsteer::io::pty::Pty::open().unwrap();
+    let mut slave = {
+        use std::os::unix::fs::OpenOptionsExt;
+        std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(libc::O_NOCTTY)
+            .open(pty.path())
+            .unwrap()
+    };
+    let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let s2 = stop.clone();
+    let reader = std::thread::spawn(move || {
+        set_fifo(priority);
+        let mut buf = [0u8; 4096];
+        let mut reads = Vec::with_capacity(n);
+        while !s2.load(std::sync::atomic::Ordering::Relaxed) {
+            match slave.read(&mut buf) {
+                Ok(0) | Err(_) => break,
+                Ok(_) => reads.push(wall_s()),
+            }
+        }
+        reads
+    });
+    let writer = std::thread::spawn(move || {
+        set_fifo(priority);
+        let line = [b'x'; 80];
+        let mut m = pty.master();
+        let mut writes = Vec::with_capacity(n);
+        for _ in 0..n {
+            writes.push(wall_s());
+            m.write_all(&line).unwrap();
+            std::thread::sleep(every);
+        }
+        stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        // Wakes the reader for its last look at the flag; the pty closes with this thread.
+        let _ = m.write_all(b"\n");
+        std::thread::sleep(Duration::from_millis(50));
+        writes
+    });
+    let writes = writer.join().unwrap_or_default();
+    let reads = reader.join().unwrap_or_default();
+    next_after(&writes, &reads)
+}
+
+/// Each time of `from` paired with the first time of `to` at or after it (both sorted; times
+/// of `from` after the last of `to` are left out), s.
+pub fn next_after(from: &[f64], to: &[f64]) -> Vec<(f64, f64)> {
+    let mut pairs = Vec::with_capacity(from.len());
+    let mut k = 0;
+    for &f in from {
+        while k < to.len() && to[k] < f {
+            k += 1;
+        }
+        match to.get(k) {
+            Some(&t) => pairs.push((f, t)),
+            None => break,
+        }
+    }
+    pairs
+}
+
+/// agsteerd's arguments for NMEA 0183 from a serial device; `device`: the `gnss.device=…`
+/// setting.
+pub fn serial_gnss_args(device: &str) -> [&str; 6] {
+    [
+        "--set",
+        "gnss.source=\"nmea0183\"",
+        "--set",
+        "gnss.transport=\"serial\"",
+        "--set",
+        device,
+    ]
+}
+
+/// The epoch send times (UTC s) of `agsteer sim --gnss-log FILE`.
+pub fn gnss_log_times(log: &str) -> Vec<f64> {
+    std::fs::read_to_string(log)
+        .unwrap_or_default()
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').next()?.parse().ok())
+        .collect()
 }
 
 /// A spawned program, killed when dropped.

@@ -115,7 +115,8 @@ pub struct GnssOut {
     encoder: GnssStreamEncoder,
     measurements: Vec<GnssMeasurement>,
     bytes: Vec<u8>,
-    /// `--gnss-log`: each epoch's write time (UTC s, the clock of candump's timestamps).
+    /// `--gnss-log`: each epoch's write time (UTC s, the clock of candump's timestamps), taken
+    /// just before the write.
     log: Option<std::io::BufWriter<std::fs::File>>,
     pub epochs: u64,
     pub unsent: u64,
@@ -170,11 +171,14 @@ impl GnssOut {
             self.bytes.clear();
             self.encoder.encode(m, &mut self.bytes);
             self.epochs += 1;
+            // Stamped before the write: the reader may have the epoch before this thread goes
+            // on (as a position frame's candump time is its send's).
+            let sent = utc_now();
             if !self.sink.send(&self.bytes) {
                 self.unsent += 1;
             }
             if let Some(f) = self.log.as_mut() {
-                writeln!(f, "{:.6},{:.3}", utc_now(), m.t_measured)?;
+                writeln!(f, "{sent:.6},{:.3}", m.t_measured)?;
             }
         }
         if !self.measurements.is_empty() {
