@@ -36,6 +36,8 @@ impl GnssPath {
 
 /// The fix-to-command figures of a capture.
 pub struct FixLatency {
+    /// The baseline's median less stalls (bus echo, or pty write → read), s.
+    pub baseline_median: f64,
     /// Fix → next command frame, sorted, s.
     pub raw: Vec<f64>,
     /// The same less the time the guest was frozen in between, sorted, s.
@@ -148,7 +150,11 @@ pub fn fix_latency(
             around.join(" ")
         );
     }
-    FixLatency { raw, net }
+    FixLatency {
+        baseline_median: f64::NAN,
+        raw,
+        net,
+    }
 }
 
 /// The daemon at dt = 10 ms and SCHED_FIFO `priority`, engaged on the AB job with the
@@ -223,7 +229,8 @@ fn fix_to_command_run(iface: &str, priority: i32, path: GnssPath) -> FixLatency 
             .filter(|t| *t >= t_start)
             .collect(),
     };
-    let l = fix_latency(name, &fixes, &cap, &stalls, 0.01);
+    let mut l = fix_latency(name, &fixes, &cap, &stalls, 0.01);
+    l.baseline_median = pct(&b_net, 0.5);
     println!(
         "GNSS-TO-COMMAND path={name} dt_ms=10 {}",
         figures(&l.raw, &l.net)
@@ -244,10 +251,17 @@ fn fix_to_command_both(priority: i32) {
         let l = fix_to_command_run(&iface, priority, path);
         let name = path.name();
         assert!(l.net.len() > 100, "{name}: {} fixes", l.net.len());
+        // A serial fix arrives when the kernel hands its bytes to the reader: the daemon's
+        // share is what lies beyond the pty's own median (its worker waits for the CPU).
+        let bound = match path {
+            GnssPath::Can => 0.002,
+            GnssPath::Serial => 0.002_f64.max(l.baseline_median + 0.001),
+        };
         assert!(
-            pct(&l.net, 0.5) <= 0.002,
-            "{name}: GNSS → command median {} ms less stalls",
-            pct(&l.net, 0.5) * 1e3
+            pct(&l.net, 0.5) <= bound,
+            "{name}: GNSS → command median {} ms less stalls (bound {} ms)",
+            pct(&l.net, 0.5) * 1e3,
+            bound * 1e3
         );
     }
 }
