@@ -624,7 +624,11 @@ impl ControllerNode {
             None => self.direction_request(&c),
         };
         if let Some(r) = request {
-            self.supervisor.set_direction_change(t, self.cusp);
+            // `safety.max_stop_time_s` bounds the time *below* the minimum speed: the stop
+            // starts counting once the vehicle is that slow, not when braking begins (from
+            // 25 km/h at 0.5 m/s² braking alone takes 14 s).
+            let slow = self.speed.abs() < self.supervisor.params().min_speed;
+            self.supervisor.set_direction_change(t, self.cusp && slow);
             let due = self.last_request != Some(r) || self.ticks % self.status_every == 0;
             if due {
                 if let Ok(f) = self.packer.pack(&DirectionRequest { direction: Some(r) }) {
