@@ -139,7 +139,7 @@ pub(crate) fn validate(cfg: &Config, c: &mut Checker) {
                     "job.line_width_m",
                     fmt_num(width),
                     &format!(
-                        "lines per block 2·ceil(2·r/w) + a = {} with the turn radius r = {} m (vehicle.r_min_m, or v²/safety.a_lat_max_m_s2) must be at most {} (input envelope)",
+                        "lines per block 2·ceil(2·r/w) + a = {} with the turn radius r = {} m (vehicle.r_min_m, or v²/(0.8·safety.a_lat_max_m_s2)) must be at most {} (input envelope)",
                         fmt_num(lines),
                         fmt_num((r * 100.0).round() / 100.0),
                         env::MAX_BLOCK_LINES

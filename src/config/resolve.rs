@@ -336,6 +336,10 @@ impl Config {
     }
 }
 
+/// The share of the supervisor's lateral-acceleration limit a planned turn may use
+/// ([`Config::turn_radius`]); the rest is the tracker's, for corrections and slip.
+pub const TURN_LATERAL_SHARE: f64 = 0.8;
+
 impl Config {
     /// Control period, s.
     pub fn dt(&self) -> f64 {
@@ -346,11 +350,14 @@ impl Config {
         self.control.speed_kmh / 3.6
     }
     /// Radius of the planned turns, m: `vehicle.r_min_m`, or more when the job speed would
-    /// need a lateral acceleration above `safety.a_lat_max_m_s2` on it (v² / a_lat_max). The
-    /// supervisor would not allow the tighter turn at that speed, so it is not planned.
+    /// need a lateral acceleration above [`TURN_LATERAL_SHARE`] of `safety.a_lat_max_m_s2` on
+    /// it (v² / (share · a_lat_max)). The supervisor would not allow a turn at its limit to be
+    /// corrected (it clamps the command's curvature to a_lat_max / v²), so a turn planned there
+    /// leaves the tracker no authority against tyre slip: the envelope's soft-tyred tractor_b
+    /// at 15 km/h drifted out of an 8.7 m bulb turn and started the next line 14 m off.
     pub fn turn_radius(&self) -> f64 {
         let v = self.speed();
-        let a = self.safety.a_lat_max_m_s2;
+        let a = self.safety.a_lat_max_m_s2 * TURN_LATERAL_SHARE;
         if a > 0.0 && a.is_finite() {
             self.vehicle.r_min_m.max(v * v / a)
         } else {

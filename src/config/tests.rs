@@ -3,11 +3,11 @@ use super::*;
 #[test]
 fn turns_are_planned_no_tighter_than_the_speed_allows() {
     let mut cfg = Config::default();
-    // 10 km/h, 2 m/s²: v²/a = 3.9 m < r_min 5 m.
+    // 10 km/h, 0.8 × 2 m/s²: v²/a = 4.8 m < r_min 5 m.
     assert_eq!(cfg.turn_radius(), cfg.vehicle.r_min_m);
     cfg.control.speed_kmh = 15.0;
     let v: f64 = 15.0 / 3.6;
-    assert!((cfg.turn_radius() - v * v / 2.0).abs() < 1e-12);
+    assert!((cfg.turn_radius() - v * v / (resolve::TURN_LATERAL_SHARE * 2.0)).abs() < 1e-12);
     assert!(cfg.coverage_params().r_min > 8.0);
     assert!(cfg.ab_params().turn.r_min > 8.0);
 }
