@@ -244,6 +244,11 @@ impl Config {
             law: LawParams {
                 stanley_gain: t.stanley_gain_per_s,
                 stanley_soft_speed: t.stanley_soft_speed_mps,
+                lqr: crate::track::lqr::LqrWeights {
+                    xte: t.lqr_xte_m,
+                    heading: t.lqr_heading_deg.to_radians(),
+                    rate_fraction: t.lqr_rate_fraction,
+                },
             },
             integral: IntegralParams {
                 gain: t.integral_gain_rad_per_m_s,

@@ -35,6 +35,14 @@ pub struct TrackConfig {
     pub stanley_gain_per_s: f64,
     /// Stanley softening speed, m/s.
     pub stanley_soft_speed_mps: f64,
+    /// LQR tracker (`kind = "lqr"`, see [`crate::track::lqr`]): the cross-track error its
+    /// cost counts as much as the other terms' scales (Bryson's rule), m.
+    pub lqr_xte_m: f64,
+    /// The LQR's heading-error scale, degrees.
+    pub lqr_heading_deg: f64,
+    /// The LQR's wheel-angle rate scale, as a fraction of the calibrated rate limit
+    /// (`safety.actuator_rate_deg_s`).
+    pub lqr_rate_fraction: f64,
     /// Integral action on the XTE, rad of wheel angle per (m · s); 0 = off.
     pub integral_gain_rad_per_m_s: f64,
     /// Largest wheel-angle offset the integral action may learn, degrees.
@@ -101,6 +109,9 @@ impl Default for TrackConfig {
             lead_time_s: 0.05,
             stanley_gain_per_s: 2.5,
             stanley_soft_speed_mps: 1.0,
+            lqr_xte_m: 0.1,
+            lqr_heading_deg: 6.0,
+            lqr_rate_fraction: 0.5,
             integral_gain_rad_per_m_s: 0.0,
             integral_limit_deg: 3.0,
             integral_capture_m: 0.3,
@@ -161,6 +172,9 @@ impl TrackConfig {
             0.01,
             10.0,
         );
+        c.range("track.lqr_xte_m", t.lqr_xte_m, 0.005, 2.0);
+        c.range("track.lqr_heading_deg", t.lqr_heading_deg, 0.1, 45.0);
+        c.range("track.lqr_rate_fraction", t.lqr_rate_fraction, 0.05, 2.0);
         c.range(
             "track.integral_gain_rad_per_m_s",
             t.integral_gain_rad_per_m_s,

@@ -107,7 +107,7 @@ impl Controller {
             Some(p) => Guidance::resume(plan, definition, params.guidance.clone(), p)?,
             None => Guidance::new(plan, definition, params.guidance.clone())?,
         };
-        let law = registry::law(params.tracker_kind, &params.law);
+        let law = registry::law(params.tracker_kind, &params.law, &params.tracker, params.dt);
         let needs = law.needs();
         Ok(Controller {
             estimator: Estimator::new(params.estimator_for(needs)),
@@ -259,9 +259,22 @@ impl Controller {
             pose = course_pose(&pose, drift, est.speed.abs(), min);
         }
         let local = self.guidance.local_path();
+        // The wheels as they are, in the driving direction, less the sensor's estimated offset.
+        let sensor_offset = if needs.observer {
+            self.estimator.wheel_offset()
+        } else {
+            0.0
+        };
+        let wheel = self.estimator.latest_wheel_angle().map(|a| {
+            let a = a - sensor_offset;
+            match direction {
+                Direction::Forward => a,
+                Direction::Reverse => -a,
+            }
+        });
         let law = self
             .law
-            .steer(local, &pose, est.speed.abs(), &self.params.tracker);
+            .steer(local, &pose, est.speed.abs(), wheel, &self.params.tracker);
         let mut tr = steering_from_travel(law, direction);
         // Integral action: learnt on work paths driven forward, applied on every path (the
         // disturbances it cancels do not stop at a line's end).
@@ -306,8 +319,12 @@ impl Controller {
     /// keeping the learnt offsets. The job, the guidance, approach and cusp parameters stay as
     /// they were.
     pub fn set_tuning(&mut self, params: &ControlParams) {
-        if params.tracker_kind != self.params.tracker_kind || params.law != self.params.law {
-            self.law = registry::law(params.tracker_kind, &params.law);
+        if params.tracker_kind != self.params.tracker_kind
+            || params.law != self.params.law
+            || params.tracker != self.params.tracker
+            || params.dt != self.params.dt
+        {
+            self.law = registry::law(params.tracker_kind, &params.law, &params.tracker, params.dt);
         }
         let needs = self.law.needs();
         self.integral = params.integral_for(needs, self.integral.offset);

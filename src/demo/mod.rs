@@ -538,6 +538,7 @@ pub fn run(
                 .and_then(|v| v.as_str().map(str::to_string))
                 .unwrap_or_else(|| format!("{:?}", cmd.fault));
             *disengagements.entry(name.clone()).or_insert(0) += 1;
+            tracing::info!(t_s = format_args!("{t:.2}"), fault = %name, "disengaged");
             disengage_events.push((t, name));
         }
         was_engaged = cmd.engaged;

@@ -34,6 +34,8 @@ pub struct LawParams {
     pub stanley_gain: f64,
     /// Stanley softening speed, m/s.
     pub stanley_soft_speed: f64,
+    /// The LQR's cost.
+    pub lqr: super::lqr::LqrWeights,
 }
 
 /// A steering law.
@@ -41,12 +43,15 @@ pub trait SteeringLaw: Send + Sync + std::fmt::Debug {
     /// What the controller must feed and add.
     fn needs(&self) -> LawNeeds;
 
-    /// The command for one period: `pose` in the driving direction, `speed` ≥ 0 m/s.
+    /// The command for one period: `pose` in the driving direction, `speed` ≥ 0 m/s,
+    /// `wheel_angle` the measured front-wheel angle in the driving direction less the
+    /// observer's sensor offset (rad; `None` before the first reading).
     fn steer(
         &self,
         local: &LocalPath,
         pose: &Pose,
         speed: f64,
+        wheel_angle: Option<f64>,
         params: &TrackerParams,
     ) -> TrackOutput;
 }

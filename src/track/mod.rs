@@ -6,7 +6,8 @@
 //! dead-reckoned pose, the disturbance observer, integral action, lost-motion compensation);
 //! the controller asks, it never checks which law it runs. [`pure_pursuit`] is the seed-000
 //! law: fed the latest fix it is the plain reference, fed the predicted pose and the observer's
-//! course it is the default predictive tracker; [`stanley`] is the Stanley reference.
+//! course it is the predictive tracker; [`stanley`] is the Stanley reference; [`lqr`] is a
+//! speed-scheduled LQR with the steering's lag in its model.
 //!
 //! To add a tracker: a module with a type implementing [`law::SteeringLaw`], and one entry in
 //! [`registry`] (its kind, name and constructor).
@@ -17,6 +18,7 @@
 pub mod law;
 pub mod local_path;
 pub mod lost_motion;
+pub mod lqr;
 pub mod pure_pursuit;
 pub mod registry;
 pub mod stanley;

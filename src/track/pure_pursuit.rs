@@ -56,6 +56,7 @@ impl SteeringLaw for PurePursuit {
         local: &LocalPath,
         pose: &Pose,
         speed: f64,
+        _wheel_angle: Option<f64>,
         params: &TrackerParams,
     ) -> TrackOutput {
         let ld = if self.scheduled {

@@ -6,8 +6,10 @@
 //! [`law`].
 
 use super::law::{LawParams, SteeringLaw};
+use super::lqr::Lqr;
 use super::pure_pursuit::PurePursuit;
 use super::stanley::Stanley;
+use super::TrackerParams;
 use serde::{Deserialize, Serialize};
 
 /// Which tracker steers.
@@ -21,6 +23,9 @@ pub enum TrackerKind {
     PurePursuit,
     /// Stanley steering on the same latency-compensated, dead-reckoned pose.
     Stanley,
+    /// A speed-scheduled LQR on the path-frame error model with the steering's lag in the
+    /// state, and curvature feed-forward, on the predicted pose with every compensation.
+    Lqr,
 }
 
 impl TrackerKind {
@@ -29,6 +34,7 @@ impl TrackerKind {
         TrackerKind::Predictive,
         TrackerKind::PurePursuit,
         TrackerKind::Stanley,
+        TrackerKind::Lqr,
     ];
 
     /// The configuration name (`track.kind`).
@@ -37,17 +43,24 @@ impl TrackerKind {
             TrackerKind::Predictive => "predictive",
             TrackerKind::PurePursuit => "pure_pursuit",
             TrackerKind::Stanley => "stanley",
+            TrackerKind::Lqr => "lqr",
         }
     }
 }
 
-/// The law of `kind` with its gains. Called when a job starts and when it is re-tuned, never
-/// per control period.
-pub fn law(kind: TrackerKind, params: &LawParams) -> Box<dyn SteeringLaw> {
+/// The law of `kind` with its gains, for the vehicle and steering of `tracker` at the control
+/// period `dt` (s). Called when a job starts and when it is re-tuned, never per control period.
+pub fn law(
+    kind: TrackerKind,
+    params: &LawParams,
+    tracker: &TrackerParams,
+    dt: f64,
+) -> Box<dyn SteeringLaw> {
     match kind {
         TrackerKind::Predictive => Box::new(PurePursuit::predictive()),
         TrackerKind::PurePursuit => Box::new(PurePursuit::plain()),
         TrackerKind::Stanley => Box::new(Stanley::new(params)),
+        TrackerKind::Lqr => Box::new(Lqr::new(params, tracker, dt)),
     }
 }
 
@@ -69,17 +82,27 @@ mod tests {
     }
 
     #[test]
-    fn only_the_default_tracker_uses_every_compensation() {
+    fn only_the_model_based_trackers_use_every_compensation() {
         let p = LawParams {
             stanley_gain: 2.5,
             stanley_soft_speed: 1.0,
+            lqr: Default::default(),
         };
-        let needs = |k| law(k, &p).needs();
+        let tracker = TrackerParams {
+            wheelbase: 3.0,
+            ld_min: 3.0,
+            ld_gain: 1.2,
+            max_wheel_angle: 0.6,
+            steering: Default::default(),
+        };
+        let needs = |k| law(k, &p, &tracker, 0.02).needs();
         let d = needs(TrackerKind::Predictive);
         assert!(d.prediction && d.observer && d.integral && d.lost_motion);
         let r = needs(TrackerKind::PurePursuit);
         assert!(!r.prediction && !r.observer && !r.integral && !r.lost_motion);
         let s = needs(TrackerKind::Stanley);
         assert!(s.prediction && s.integral && !s.observer && !s.lost_motion);
+        let q = needs(TrackerKind::Lqr);
+        assert!(q.prediction && q.observer && q.integral && q.lost_motion);
     }
 }

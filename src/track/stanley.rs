@@ -40,6 +40,7 @@ impl SteeringLaw for Stanley {
         local: &LocalPath,
         pose: &Pose,
         speed: f64,
+        _wheel_angle: Option<f64>,
         params: &TrackerParams,
     ) -> TrackOutput {
         stanley(local, pose, speed, params, self.gain, self.soft_speed)

@@ -30,14 +30,23 @@ pub(crate) fn trackers(name: &str) -> Result<Vec<TrackerChoice>> {
     if name == "all" {
         return Ok(TRACKERS.to_vec());
     }
-    TRACKERS
-        .iter()
-        .copied()
-        .find(|k| agsteer::demo::accuracy::tracker_name(*k) == name)
-        .map(|k| vec![k])
-        .with_context(|| {
-            format!("unknown tracker {name:?} (predictive, pure_pursuit, stanley or all)")
+    // A comma-separated list of registered trackers, the first judged (the envelope's default
+    // column), e.g. `lqr,pure_pursuit,stanley`.
+    name.split(',')
+        .map(|n| {
+            TrackerChoice::ALL
+                .iter()
+                .copied()
+                .find(|k| agsteer::demo::accuracy::tracker_name(*k) == n.trim())
+                .with_context(|| {
+                    let names: Vec<&str> = TrackerChoice::ALL.iter().map(|k| k.name()).collect();
+                    format!(
+                        "unknown tracker {n:?} ({}, a comma-separated list, or all)",
+                        names.join(", ")
+                    )
+                })
         })
+        .collect()
 }
 
 type Outcome = (usize, usize, Result<(ScenarioResult, XteSeries)>);
@@ -158,7 +167,8 @@ fn verdict(cfgs: &[(String, Config)], results: &[ScenarioResult], tracker: &str)
         let held_name = if tracker == "all" {
             agsteer::demo::accuracy::tracker_name(cfg.track.kind)
         } else {
-            tracker
+            // The first of a list is held.
+            tracker.split(',').next().unwrap_or(tracker).trim()
         };
         if r.tracker != held_name {
             continue;

@@ -72,7 +72,9 @@ enum Command {
     /// when its true XTE on work lines is beyond an [acceptance] limit of its scenario.
     #[command(after_help = agsteer::exit::help_table())]
     Accuracy {
-        /// Tracker: predictive, pure_pursuit, stanley or all.
+        /// Tracker: predictive, pure_pursuit, stanley, lqr, a comma-separated list of them
+        /// (the first held to the limits; in the envelope, the one judged) or all (the
+        /// default tracker, pure pursuit and Stanley).
         #[arg(long, default_value = "all")]
         tracker: String,
         /// Print the results as JSON instead of the Markdown table.
