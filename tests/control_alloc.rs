@@ -1,8 +1,8 @@
 //! The control path allocates nothing per period (docs/CONVENTIONS.md, The control path): a
-//! counting global allocator (this test binary's only) counts what `ControllerNode::on_frame`
-//! and `ControllerNode::tick` allocate while the node drives an AB job closed loop against the
-//! simulator on an in-memory bus, from the first frame to the end of the job (three lines and
-//! their turns). The simulator, the bus and the test's own bookkeeping are not counted; the one
+//! counting global allocator (tests/common/counting_alloc.rs: this thread's allocations only)
+//! counts what `ControllerNode::on_frame` and `ControllerNode::tick` allocate while the node
+//! drives an AB job closed loop against the simulator on an in-memory bus, from the first frame
+//! to the end of the job (three lines and their turns). The simulator, the bus and the test's own bookkeeping are not counted; the one
 //! allocation allowed is the source selector listing a source the first time it is seen.
 
 use agsteer::can::bus::{CanBus, MemBus};
@@ -14,42 +14,9 @@ use agsteer::safety::SafetyState;
 use agsteer::sim::can_node::{Scenario, SimAddresses, SimNode};
 use agsteer::sim::Simulator;
 use agsteer::track::registry::TrackerKind;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-
-struct Counting;
-static COUNTING: AtomicBool = AtomicBool::new(false);
-static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
-            ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        }
-        System.alloc(layout)
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
-            ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        }
-        System.realloc(ptr, layout, new_size)
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
-
-/// Allocations made by `f`.
-fn counted<R>(f: impl FnOnce() -> R) -> (R, u64) {
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
-    COUNTING.store(true, Ordering::Relaxed);
-    let r = f();
-    COUNTING.store(false, Ordering::Relaxed);
-    (r, ALLOCATIONS.load(Ordering::Relaxed) - before)
-}
+#[path = "common/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::counted;
 
 #[test]
 fn the_controller_node_allocates_nothing_per_period() {

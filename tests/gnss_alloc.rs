@@ -1,34 +1,13 @@
 //! The GNSS stream decoder allocates nothing per chunk, frame or sentence: a counting global
-//! allocator (this test binary's only) sees no allocation while a long mixed stream is
+//! allocator (tests/common/counting_alloc.rs) sees no allocation while a long mixed stream is
 //! decoded, once the decoder exists.
 
 use agsteer::input::nmea0183::{clock::Receipt, convert::StreamParams};
 use agsteer::input::SourceId;
 use agsteer::io::decoder::{DecoderParams, GnssDecoder, Protocol};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-
-struct Counting;
-static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
-static COUNTING: AtomicBool = AtomicBool::new(false);
-
-// SAFETY: forwards to the system allocator, only counting calls.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
-            ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        }
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+#[path = "common/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::counted;
 
 fn log(name: &str) -> Vec<u8> {
     std::fs::read(
@@ -59,17 +38,17 @@ fn decoding_allocates_nothing() {
             max_correction_age_s: 10.0,
         });
         let mut inputs = 0u64;
-        COUNTING.store(true, Ordering::SeqCst);
-        for (k, chunk) in data.chunks(61).enumerate() {
-            d.push(
-                chunk,
-                &Receipt::at(k as f64 * 0.001),
-                &mut |_| inputs += 1,
-                &mut |_| {},
-            );
-        }
-        COUNTING.store(false, Ordering::SeqCst);
+        let ((), allocations) = counted(|| {
+            for (k, chunk) in data.chunks(61).enumerate() {
+                d.push(
+                    chunk,
+                    &Receipt::at(k as f64 * 0.001),
+                    &mut |_| inputs += 1,
+                    &mut |_| {},
+                );
+            }
+        });
         assert!(inputs > 5, "{protocol:?}: {:?}", d.counters());
+        assert_eq!(allocations, 0, "{protocol:?}");
     }
-    assert_eq!(ALLOCATIONS.load(Ordering::SeqCst), 0);
 }
