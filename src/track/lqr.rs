@@ -125,18 +125,37 @@ impl Lqr {
 /// The discrete LQR gain [k_e, k_ψ, k_δ] at speed `v` for wheelbase `l`, lag `tau`, period
 /// `dt` and Bryson weights [1/e², 1/ψ², 1/δ̇²].
 fn gains_at(v: f64, l: f64, tau: f64, dt: f64, w: [f64; 3]) -> [f64; 3] {
-    let a = Matrix3::new(0.0, v, 0.0, 0.0, 0.0, v / l, 0.0, 0.0, -1.0 / tau);
-    let b = Vector3::new(0.0, 0.0, 1.0 / tau);
-    let (phi, gamma) = zoh(&a, &b, dt);
-    // Cost per second: w_e·e² + w_ψ·ψ² + w_r·((u − δ̃)/τ)², i.e. Q, R and the cross term N.
-    let rr = w[2] / (tau * tau);
-    let q = Matrix3::from_diagonal(&Vector3::new(w[0], w[1], rr)) * dt;
-    let r = rr * dt;
-    let n = Vector3::new(0.0, 0.0, -rr) * dt;
-    let x = dare(&phi, &gamma, &q, r, &n);
-    let k =
-        (gamma.transpose() * x * phi + n.transpose()) / (r + (gamma.transpose() * x * gamma)[0]);
+    let p = Problem::at(v, l, tau, dt, w);
+    let x = dare(&p.phi, &p.gamma, &p.q, p.r, &p.n);
+    let k = (p.gamma.transpose() * x * p.phi + p.n.transpose())
+        / (p.r + (p.gamma.transpose() * x * p.gamma)[0]);
     [k[0], k[1], k[2]]
+}
+
+/// The discrete LQR problem at speed `v`: the model (Φ, Γ) and the costs Q, R, N.
+struct Problem {
+    phi: Matrix3<f64>,
+    gamma: Vector3<f64>,
+    q: Matrix3<f64>,
+    r: f64,
+    n: Vector3<f64>,
+}
+
+impl Problem {
+    fn at(v: f64, l: f64, tau: f64, dt: f64, w: [f64; 3]) -> Problem {
+        let a = Matrix3::new(0.0, v, 0.0, 0.0, 0.0, v / l, 0.0, 0.0, -1.0 / tau);
+        let b = Vector3::new(0.0, 0.0, 1.0 / tau);
+        let (phi, gamma) = zoh(&a, &b, dt);
+        // Cost per second: w_e·e² + w_ψ·ψ² + w_r·((u − δ̃)/τ)², i.e. Q, R and the cross term N.
+        let rr = w[2] / (tau * tau);
+        Problem {
+            phi,
+            gamma,
+            q: Matrix3::from_diagonal(&Vector3::new(w[0], w[1], rr)) * dt,
+            r: rr * dt,
+            n: Vector3::new(0.0, 0.0, -rr) * dt,
+        }
+    }
 }
 
 /// Zero-order-hold discretisation (Φ, Γ) of ẋ = A·x + B·u over `dt`: the series of e^{A·dt}
@@ -324,13 +343,13 @@ mod tests {
         let (l, tau, dt) = (3.0, 0.15, 0.02);
         let w = [400.0, 400.0, 1.0 / (0.5 * 30f64.to_radians()).powi(2)];
         for v in [0.25, 1.0, 2.78, 5.56, 6.94, 12.0] {
-            let a = Matrix3::new(0.0, v, 0.0, 0.0, 0.0, v / l, 0.0, 0.0, -1.0 / tau);
-            let b = Vector3::new(0.0, 0.0, 1.0 / tau);
-            let (phi, gamma) = zoh(&a, &b, dt);
-            let rr = w[2] / (tau * tau);
-            let q = Matrix3::from_diagonal(&Vector3::new(w[0], w[1], rr)) * dt;
-            let r = rr * dt;
-            let n = Vector3::new(0.0, 0.0, -rr) * dt;
+            let Problem {
+                phi,
+                gamma,
+                q,
+                r,
+                n,
+            } = Problem::at(v, l, tau, dt, w);
             let x = dare(&phi, &gamma, &q, r, &n);
             let g = gamma.transpose() * x * phi + n.transpose();
             let s = r + (gamma.transpose() * x * gamma)[0];
