@@ -223,14 +223,7 @@ impl SteeringLaw for Lqr {
         params: &TrackerParams,
     ) -> TrackOutput {
         let points = local.points();
-        let invalid = TrackOutput {
-            wheel_angle: 0.0,
-            curvature: 0.0,
-            lookahead: 0.0,
-            target: pose.pos,
-            alpha: 0.0,
-            valid: false,
-        };
+        let invalid = TrackOutput::invalid(pose.pos, 0.0);
         if points.len() < 2
             || !pose.pos.x.is_finite()
             || !pose.pos.y.is_finite()

@@ -112,6 +112,21 @@ pub struct TrackOutput {
     pub valid: bool,
 }
 
+impl TrackOutput {
+    /// The zero command of a law whose inputs were not usable (`valid` false), with the
+    /// preview point `target` and look-ahead `lookahead` (m) it would have used.
+    pub fn invalid(target: Vec2, lookahead: f64) -> TrackOutput {
+        TrackOutput {
+            wheel_angle: 0.0,
+            curvature: 0.0,
+            lookahead,
+            target,
+            alpha: 0.0,
+            valid: false,
+        }
+    }
+}
+
 /// Driving in reverse about the rear axle is, kinematically, driving forward with the heading
 /// turned by π and the steering curvature negated: the bicycle model ẋ = v·cos θ,
 /// θ̇ = v·κ with v < 0 becomes, for θ' = θ + π and v' = −v > 0, ẋ = v'·cos θ', θ̇' = v'·(−κ).

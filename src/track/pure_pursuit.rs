@@ -88,14 +88,7 @@ pub fn pure_pursuit_at(
     params: &TrackerParams,
 ) -> TrackOutput {
     let points = local.points();
-    let invalid = TrackOutput {
-        wheel_angle: 0.0,
-        curvature: 0.0,
-        lookahead: ld,
-        target: pose.pos,
-        alpha: 0.0,
-        valid: false,
-    };
+    let invalid = TrackOutput::invalid(pose.pos, ld);
     if points.is_empty()
         || !pose.pos.x.is_finite()
         || !pose.pos.y.is_finite()

@@ -62,14 +62,7 @@ pub fn stanley(
 ) -> TrackOutput {
     let points = local.points();
     let front = pose.pos + heading_vec(pose.heading) * params.wheelbase;
-    let invalid = TrackOutput {
-        wheel_angle: 0.0,
-        curvature: 0.0,
-        lookahead: 0.0,
-        target: front,
-        alpha: 0.0,
-        valid: false,
-    };
+    let invalid = TrackOutput::invalid(front, 0.0);
     if points.len() < 2 || !front.x.is_finite() || !front.y.is_finite() || !speed.is_finite() {
         return invalid;
     }
