@@ -4,7 +4,7 @@
 //! technician) can tell "the job did not finish" from "the job finished but not within the
 //! documented accuracy" from "progress was not saved" without reading the messages, which name
 //! the cause on stderr. `agsteer --help`, `agsteerd --help` and README.md ("Exit statuses")
-//! show [`TABLE`]; `tests/exit_codes.rs` checks each status from the real binaries and that
+//! show [`TABLE`]; `tests/binaries/exit_codes.rs` checks each status from the real binaries and that
 //! README.md shows this table.
 //!
 //! When a run has more than one of these outcomes, the status is the first in this order:

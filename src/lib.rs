@@ -12,7 +12,7 @@
 //! configuration is read once and resolved into each consumer's parameters ([`config`]); the
 //! [`job`] layer sets the job up (and resumes it) the same way for the daemon, the demo and the
 //! tools. I/O lives only in the adapters (`can`, `io`), [`store`], [`daemon`] and the
-//! binaries. `docs/layers.txt` declares the layer order, which `tests/layering.rs` enforces.
+//! binaries. `docs/layers.txt` declares the layer order, which `tests/binaries/layering.rs` enforces.
 
 pub mod calibrate;
 pub mod can;

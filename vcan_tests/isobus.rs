@@ -2,7 +2,7 @@
 //! `agsteerd`, `agsteer sim`, `cansend` and `candump`: ISO 11783-5 address contention with a
 //! lower NAME and a Request for Address Claimed; two GNSS receivers 5 m apart; not-available
 //! codes in 129025 / 129026 / 127250; a magnetic 127250 heading; the ISO 11783-7 steer-ready
-//! loop. Each is host-tested in process too (tests/isobus.rs, tests/n2k_logs.rs,
+//! loop. Each is host-tested in process too (tests/closed_loop/isobus.rs, tests/io/n2k_logs.rs,
 //! src/input/source/tests.rs). The other devices are this test: one-off frames go out with
 //! cansend, and a [`Relay`] plays a device that copies the simulator's GNSS frames with a
 //! change (a second receiver, a sender of not-available codes, a magnetic compass).

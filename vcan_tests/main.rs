@@ -192,7 +192,7 @@ fn capture_checks(lines: &[String], dropped: u64, stalls: &[Stall], dt: f64, sha
         .filter_map(|l| serde_json::from_str(l).ok())
         .collect();
     // ISO 11783-5 network management (Request PGN 0xEA00, Address Claimed 0xEE00) is not in
-    // the DBC: the claim is built and checked by can::isobus (tests/isobus.rs).
+    // the DBC: the claim is built and checked by can::isobus (tests/closed_loop/isobus.rs).
     let network_management = |o: &serde_json::Value| {
         o.get("id")
             .and_then(|i| i.as_str())
@@ -591,7 +591,7 @@ fn f_fault_scenarios_on_vcan() {
     let Some(iface) = vcan() else { return };
     let cases: [(&str, f64); 6] = [
         // gnss_timeout + dt, plus 20 ms for the emulated VM's scheduling jitter (the exact
-        // bound is held in process: tests/faults.rs).
+        // bound is held in process: tests/closed_loop/faults.rs).
         ("gnss_dropout", 0.33),
         ("rtk_float", 0.3),
         ("corrupt_wheel_angle_crc", 0.1),

@@ -1,6 +1,6 @@
 //! One entry point per decoder or parser that bytes from outside reach. Each takes arbitrary
 //! bytes and must return without panicking, whatever they are; errors are fine. The cargo-fuzz
-//! targets (`fuzz/fuzz_targets/`) call these, and `tests/bad_input.rs` replays the corpora
+//! targets (`fuzz/fuzz_targets/`) call these, and `tests/binaries/bad_input.rs` replays the corpora
 //! (`fuzz/corpus/<target>/`) and random bytes through them on stable Rust.
 //!
 //! `agsteer dbc decode` and `agsteer maneuver` parse in the binary; their modules are compiled

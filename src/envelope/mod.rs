@@ -2,7 +2,7 @@
 //!
 //! Every limit that protects the machine from an input (a field, a configuration, a log, a
 //! request) is a documented constant here, so the README's envelope table, the checks where
-//! input enters and the bad-input suite (`tests/bad_input.rs`) all name the same figure.
+//! input enters and the bad-input suite (`tests/binaries/bad_input.rs`) all name the same figure.
 //! Inside the envelope agsteer works (large work shows progress and stays under the memory
 //! bound quoted in the README); beyond it the input is refused with an error naming the key or
 //! file, the value and the limit. Never an out-of-memory, a hang or a panic.

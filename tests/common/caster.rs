@@ -1,6 +1,6 @@
 //! RTKLIB's `str2str` as an NTRIP caster on a local port, serving a recorded RTCM 3 stream
 //! (tools/gnss/logs/rtcm3.2.log, IGS MGEX station STFU7, via gpsd) written to its standard
-//! input at a steady pace (tests/ntrip.rs, tests/gnss_closed_loop.rs).
+//! input at a steady pace (tests/io/ntrip.rs, tests/io/gnss_closed_loop.rs).
 
 use agsteer::io::framer::{Frame, Framer};
 use std::io::Write;

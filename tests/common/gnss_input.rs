@@ -1,4 +1,4 @@
-//! Inputs of the real-time GNSS tests (`tests/gnss_closed_loop.rs`): the bad bytes written in
+//! Inputs of the real-time GNSS tests (`tests/io/gnss_closed_loop.rs`): the bad bytes written in
 //! place of fixes, and free loopback ports for the caster and UDP receivers.
 
 /// `len` bytes of bad input into `out`: random bytes, then the last good epoch with one

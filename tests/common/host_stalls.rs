@@ -1,5 +1,5 @@
 //! Telling a loaded host's stalls from the controller's own faults in the real-time GNSS tests
-//! (`tests/gnss_closed_loop.rs`).
+//! (`tests/io/gnss_closed_loop.rs`).
 //!
 //! A serial receiver's bytes reach their reader through the kernel: a write to a tty (a pty's
 //! master here, a USB CDC-ACM or UART driver on a tractor) only queues them in the tty's flip

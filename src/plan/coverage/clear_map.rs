@@ -258,7 +258,7 @@ mod tests {
         }
     }
 
-    /// The field of a failing case of tests/plan_guarantees.rs (a star with a square hole).
+    /// The field of a failing case of tests/plan/plan_guarantees.rs (a star with a square hole).
     #[test]
     fn the_map_agrees_on_a_star_with_a_hole() {
         let size = 155.29840172620393;

@@ -203,8 +203,8 @@ fn misses(p: &Plant, f: &Figures) -> Vec<String> {
 }
 
 /// 20 plants: about 2 minutes of CPU in release (each a 3-minute procedure simulated at 1 ms
-/// and three fits), so not in the default run; `cargo test --release --test calibrate --
-/// --ignored` (figures in README.md, "Calibration").
+/// and three fits), so not in the default run; `cargo test --release --test closed_loop
+/// calibrate:: -- --ignored` (figures in README.md, "Calibration").
 #[test]
 #[ignore]
 fn twenty_random_plants_are_identified_within_the_tolerances() {

@@ -720,7 +720,7 @@ fn node_properties_with_random_frames() {
     let mut cfg = Config::default();
     cfg.job.point_b_m = [0.0, 500.0];
     // The properties are of a node that holds its address: with the ISO 11783-5 claim on, the
-    // first half second has no steering frame by design (tests/isobus.rs covers the claim).
+    // first half second has no steering frame by design (tests/closed_loop/isobus.rs covers the claim).
     cfg.isobus.address_claim = false;
     let cases = (total_cases() / 2).max(1);
     let mut r = runner(cases, 0xF8A3E);

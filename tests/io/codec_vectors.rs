@@ -9,7 +9,7 @@ use agsteer::can::codec::{
 use serde_json::Value;
 
 fn vectors() -> Vec<Value> {
-    let text = include_str!("../tools/cantools/vectors.json");
+    let text = include_str!("../../tools/cantools/vectors.json");
     let v: Value = serde_json::from_str(text).expect("vectors.json parses");
     v["vectors"].as_array().expect("vectors").clone()
 }

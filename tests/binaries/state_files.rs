@@ -45,9 +45,14 @@ fn kill_during_write_leaves_old_or_new_file() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(20);
     let mut last = 0;
     let mut temps_left = 0;
+    // The writer's test name in this binary: its module path less the crate's name.
+    let writer = match module_path!().split_once("::") {
+        Some((_, module)) => format!("{module}::child_writer"),
+        None => "child_writer".to_string(),
+    };
     for kill in 0..20 {
         let mut child = Command::new(std::env::current_exe().unwrap())
-            .args(["--ignored", "--exact", "child_writer", "--nocapture"])
+            .args(["--ignored", "--exact", &writer, "--nocapture"])
             .env(CHILD_ENV, dir.path())
             .stdout(Stdio::null())
             .stderr(Stdio::null())

@@ -27,15 +27,13 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 
-#[path = "common/gnss_input.rs"]
+#[path = "../common/gnss_input.rs"]
 mod gnss_input;
 use gnss_input::{bad_input, free_tcp_port, free_udp_port};
-#[path = "common/host_stalls.rs"]
+#[path = "../common/host_stalls.rs"]
 mod host_stalls;
+use crate::caster::{self, Caster, MOUNT, PASSWORD, USER};
 use host_stalls::{Backlog, HostStall, TtyWatch};
-#[path = "common/caster.rs"]
-mod caster;
-use caster::{Caster, MOUNT, PASSWORD, USER};
 use std::time::Duration;
 
 const CONFIG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/config/vcan.toml");

@@ -2,12 +2,13 @@
 //! every path sampled at 1 cm reaches the goal, respects κ_max and σ_max, and has continuous
 //! curvature, zero at the start, the goal and every cusp. Also reports the CC / RS length ratio.
 //!
-//! Run: cargo test --release --test cc_paths -- --nocapture
+//! Run: cargo test --release --test plan cc_paths:: -- --nocapture
 
 use agsteer::geo::wrap_angle;
 use agsteer::plan::maneuver::cc_reeds_shepp::{cc_reeds_shepp_length, cc_reeds_shepp_shortest};
 use agsteer::plan::maneuver::path::{CurveParams, PathSample};
 use agsteer::plan::maneuver::reeds_shepp::reeds_shepp_length;
+#[path = "../common/mod.rs"]
 mod common;
 
 use common::random_pose_pairs as pairs;

@@ -1,7 +1,7 @@
 //! The exit statuses of the real binaries (`src/exit.rs`): each one `agsteer` can give from a
 //! situation made here, agsteerd's configuration status, the `--help` tables and README.md's.
 //! (4, a plan breaking its guarantees, needs a faulty planner: `agsteer plan` maps it in
-//! `src/bin/agsteer/plan_cmd.rs`; 9 is checked in `tests/replay.rs`; agsteerd's 1 and 8 need a
+//! `src/bin/agsteer/plan_cmd.rs`; 9 is checked in `tests/binaries/replay.rs`; agsteerd's 1 and 8 need a
 //! CAN interface: the VM suite.)
 
 use agsteer::exit::Exit;

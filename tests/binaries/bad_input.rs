@@ -9,7 +9,7 @@
 //! The corpora of the fuzz targets (`fuzz/corpus/<target>/`) are replayed through the same
 //! entry points on stable Rust, and each target also gets arbitrary bytes from proptest.
 //!
-//! Run with `cargo test --release --test bad_input` (the time bounds assume a release build).
+//! Run with `cargo test --release --test binaries bad_input::` (the time bounds assume a release build).
 
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
@@ -17,7 +17,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 #[allow(dead_code)]
-#[path = "../fuzz/src/entries.rs"]
+#[path = "../../fuzz/src/entries.rs"]
 mod entries;
 
 /// Address-space cap of every run, bytes (the 2 GB).
@@ -487,7 +487,7 @@ fn a_large_legitimate_field_is_planned_within_the_memory_bound() {
 
 /// The README's figure: 1 000 ha at w 3 m shows progress on stderr and stays under 2 GB
 /// (measured 1.34 GB peak RSS, about 70 s on the shared 2-core host). Takes minutes: run with
-/// `cargo test --release --test bad_input -- --ignored`.
+/// `cargo test --release --test binaries bad_input:: -- --ignored`.
 #[test]
 #[ignore]
 fn the_1000_ha_field_at_3_m_shows_progress_under_the_memory_bound() {

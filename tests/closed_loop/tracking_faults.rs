@@ -3,7 +3,7 @@
 //! that the supervisor disengages with a tracking fault, the time from the onset (the first
 //! period the true |XTE| leaves the straight-line target of 15 cm) to the safe state, and that
 //! with the checks switched off the same run weaves on engaged — so the test fails without the
-//! detector. `tests/accuracy.rs` checks that the nominal suite never trips it.
+//! detector. `tests/closed_loop/accuracy.rs` checks that the nominal suite never trips it.
 
 use agsteer::config::Config;
 use agsteer::demo::{run, DemoOptions, DemoRun};
@@ -80,7 +80,7 @@ fn check(name: &str, set: &[&str], bound_s: f64) {
 fn an_uncalibrated_slow_steering_weaves_and_the_supervisor_disengages() {
     // A 0.6 s steering lag the controller was not told of (it assumes 0.15 s): the default
     // tracker's look-ahead is scheduled on the lag it knows, too short for this one. (Told,
-    // `safety.actuator_tau_s=0.6`, it holds the line: tests/envelope_subset.rs, lag_0.6.)
+    // `safety.actuator_tau_s=0.6`, it holds the line: tests/closed_loop/envelope_subset.rs, lag_0.6.)
     check(
         "steering lag 0.6 s, uncalibrated",
         &["sim.actuator_tau_s=0.6"],

@@ -16,7 +16,7 @@
 //!
 //! Both run 48 fields each (a few seconds in release on the loaded shared host; 400 random more
 //! with `--ignored many`); failing cases are kept in
-//! `tests/plan_guarantees.proptest-regressions` and run first.
+//! `tests/plan/plan_guarantees.proptest-regressions` and run first.
 //! [`a_violation_is_never_exit_0`] draws new fields every run. [`every_plan_keeps_the_guarantees`]
 //! draws from a fixed seed, so CI is reproducible; `many` keeps drawing fresh fields. Until
 //! session 5 the planner broke a guarantee on about 1 random field in 2 000 (2 of 10 runs of
@@ -388,8 +388,9 @@ fn the_checks_catch_what_they_check() {
 
 /// The planner over 400 random fields (the same generator, a fixed seed), by shape: cases,
 /// "no plan" answers, plans breaking a guarantee, and of those any `check_plan` misses. A
-/// measurement, not a check: `cargo test --release --test plan_guarantees -- --ignored tally
-/// --nocapture` (about 10 s of CPU). Session 4 before the passes bent round the holes: concave
+/// measurement, not a check: `cargo test --release --test plan -- --ignored
+/// plan_guarantees::tally --nocapture` (about 10 s of CPU). Session 4 before the passes bent
+/// round the holes: concave
 /// 85/0/0/0, convex 85/2/0/0, holes 124/0/28/0 (16 headland passes and 12 swaths through or
 /// over a hole), thin 106/0/0/0; after: holes 124/0/0/0, the others unchanged.
 #[test]
