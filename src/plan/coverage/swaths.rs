@@ -63,8 +63,9 @@ pub fn swath_lines(cell: &Area, safe: &[Area], angle: f64, line_width: f64) -> S
                     let (x0, x1) = (x0.max(s.0), x1.min(s.1));
                     (x1 - x0 > 1e-3).then_some((x0, x1))
                 })
-                .collect()
+                .collect::<Vec<_>>()
         })
+        .map(merge_overlapping)
         .collect();
     SwathLines {
         angle,
@@ -75,6 +76,22 @@ pub fn swath_lines(cell: &Area, safe: &[Area], angle: f64, line_width: f64) -> S
     }
 }
 
+/// Intervals sorted and merged where they overlap or touch. Pieces of one line that the band's
+/// extent widened over the same ground (a line crossing a notched edge in several pieces, each
+/// widened to the whole band) are one swath: kept apart, each was driven over the same ground
+/// (bg_arable_60ha at w 6 m drove its outermost swath four times).
+fn merge_overlapping(mut ivs: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    ivs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut merged: Vec<(f64, f64)> = Vec::with_capacity(ivs.len());
+    for iv in ivs {
+        match merged.last_mut() {
+            Some(m) if iv.0 <= m.1 + 1e-6 => m.1 = m.1.max(iv.1),
+            _ => merged.push(iv),
+        }
+    }
+    merged
+}
+
 /// The x-extent of `rot` within the band [y − half, y + half]: intervals at both band edges and
 /// at every vertex inside the band, merged where they overlap.
 fn band_extent(rot: &Area, y: f64, half: f64) -> Vec<(f64, f64)> {
@@ -82,16 +99,7 @@ fn band_extent(rot: &Area, y: f64, half: f64) -> Vec<(f64, f64)> {
     for ring in std::iter::once(&rot.0).chain(rot.1.iter()) {
         ys.extend(ring.iter().map(|p| p.y).filter(|v| (v - y).abs() < half));
     }
-    let mut all: Vec<(f64, f64)> = ys.iter().flat_map(|&v| scan_intervals(rot, v)).collect();
-    all.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut merged: Vec<(f64, f64)> = Vec::new();
-    for iv in all {
-        match merged.last_mut() {
-            Some(m) if iv.0 <= m.1 => m.1 = m.1.max(iv.1),
-            _ => merged.push(iv),
-        }
-    }
-    merged
+    merge_overlapping(ys.iter().flat_map(|&v| scan_intervals(rot, v)).collect())
 }
 
 /// One swath of a run: line index and x-interval, rotated frame.
@@ -177,5 +185,38 @@ mod tests {
         assert_eq!(r.len(), 4, "{r:?}");
         let swaths: usize = r.iter().map(|x| x.len()).sum();
         assert_eq!(swaths, l.intervals.iter().map(|v| v.len()).sum::<usize>());
+    }
+
+    #[test]
+    fn a_line_crossing_a_notched_edge_is_one_swath_not_one_per_piece() {
+        // Two notches 4 m deep in the bottom edge: the first line (y 2.8) crosses the cell in
+        // three pieces, and its band reaches above the notches, so each piece widens to the
+        // whole width. They are one swath, driven once.
+        let cell: Area = (
+            vec![
+                v2(0.0, 0.0),
+                v2(20.0, 0.0),
+                v2(25.0, 4.0),
+                v2(30.0, 0.0),
+                v2(60.0, 0.0),
+                v2(65.0, 4.0),
+                v2(70.0, 0.0),
+                v2(100.0, 0.0),
+                v2(100.0, 50.0),
+                v2(0.0, 50.0),
+            ],
+            vec![],
+        );
+        let l = swath_lines(&cell, std::slice::from_ref(&cell), 0.0, 6.0);
+        assert_eq!(
+            crate::plan::coverage::geometry::scan_intervals(&cell, l.ys[0]).len(),
+            3
+        );
+        assert_eq!(l.intervals[0].len(), 1, "{:?}", l.intervals[0]);
+        let (a, b) = l.intervals[0][0];
+        assert!(a.abs() < 1e-6 && (b - 100.0).abs() < 1e-6, "{a} {b}");
+        for ivs in &l.intervals {
+            assert!(ivs.windows(2).all(|p| p[0].1 < p[1].0), "{ivs:?}");
+        }
     }
 }
