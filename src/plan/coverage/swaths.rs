@@ -207,7 +207,8 @@ mod tests {
             ],
             vec![],
         );
-        let l = swath_lines(&cell, std::slice::from_ref(&cell), 0.0, 6.0);
+        // Where the implement is clear: here the rectangle without the notches.
+        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0);
         assert_eq!(
             crate::plan::coverage::geometry::scan_intervals(&cell, l.ys[0]).len(),
             3
