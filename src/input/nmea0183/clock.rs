@@ -18,9 +18,10 @@
 //! allowed to creep up by [`CLOCK_DRIFT`] per second, for the two clocks' rate difference).
 //! An epoch arriving more than `max_delay_s` later than the best the link has shown was held
 //! up somewhere (a buffer flushed after a stall, a replay) and is stale: its inputs are
-//! dropped, never passed on as fresh. A time of validity older than the current epoch is a
-//! replay or out of order, also dropped. A jump of more than [`CLOCK_JUMP_S`] either way is a
-//! receiver clock reset: the reference starts again from it.
+//! dropped, never passed on as fresh. So is a sentence of the current epoch arriving that late (a
+//! replay of the last epoch), with the epoch's sentences without a time after it. A time of
+//! validity older than the current epoch is a replay or out of order, also dropped. A jump of more
+//! than [`CLOCK_JUMP_S`] either way is a receiver clock reset: the reference starts again from it.
 
 /// When bytes arrived.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -168,6 +169,16 @@ impl EpochClock {
         if let Some(c) = self.current {
             let d = wrap_half(fix_time - c, self.period);
             if d.abs() < SAME_EPOCH_S {
+                // A sentence of the current epoch held up beyond `max_delay_s` (a replay of the
+                // last epoch): stale, and so is the rest of the epoch (its sentences without a
+                // time of their own).
+                let late = self.best_offset.is_some_and(|best| {
+                    let best = best + CLOCK_DRIFT * (t - self.last_t).max(0.0);
+                    wrap_half(t - fix_time - best, self.period) > self.max_delay_s
+                });
+                if late {
+                    self.current_fresh = false;
+                }
                 return Epoch::Same {
                     fresh: self.current_fresh,
                 };
@@ -269,6 +280,12 @@ mod tests {
         assert!(!c.current_fresh());
         // Then on time again.
         assert_eq!(c.observe(5.25, 1005.2), Epoch::New);
+        // The same epoch's sentence again, held up 0.4 s beyond the best: a replay, stale, and
+        // the epoch's sentences without a time after it too.
+        assert_eq!(c.observe(5.28, 1005.2), Epoch::Same { fresh: true });
+        assert_eq!(c.observe(5.25 + 0.41, 1005.2), Epoch::Same { fresh: false });
+        assert!(!c.current_fresh());
+        assert_eq!(c.observe(5.35, 1005.3), Epoch::New);
         // A replayed older epoch.
         assert_eq!(c.observe(5.3, 1004.0), Epoch::Old);
         // The receiver's clock resets.
