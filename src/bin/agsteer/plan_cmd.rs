@@ -372,6 +372,9 @@ struct SweepRow {
     unworked_m2: f64,
     unreachable_m2: f64,
     unreachable_pieces: usize,
+    /// The field worked over its reachable ground (the field less the metrics' unreachable
+    /// ground): (field − unworked) / (field − unreachable), at most 1.
+    reachable_worked_fraction: f64,
     outside_area_m2: f64,
     outside_length_m: f64,
     obstacle_length_m: f64,
@@ -478,6 +481,7 @@ where
                     unworked_m2: loaded.cleanup.area_after_m2,
                     unreachable_m2: 0.0,
                     unreachable_pieces: 0,
+                    reachable_worked_fraction: 0.0,
                     outside_area_m2: 0.0,
                     outside_length_m: 0.0,
                     obstacle_length_m: 0.0,
@@ -506,6 +510,12 @@ where
                         row.working_area_covered_fraction = m.working_area_covered_fraction;
                         row.overlap_fraction = m.overlap_fraction;
                         row.unworked_m2 = m.unworked_area_m2;
+                        let reachable = m.field_area_m2 - row.unreachable_m2;
+                        row.reachable_worked_fraction = if reachable > 0.0 {
+                            ((m.field_area_m2 - m.unworked_area_m2) / reachable).min(1.0)
+                        } else {
+                            1.0
+                        };
                         row.outside_area_m2 = m.outside_area_m2;
                         row.outside_length_m = m.outside_length_m;
                         row.obstacle_length_m = m.obstacle_length_m;
@@ -571,12 +581,19 @@ where
                 > 0
         })
         .count();
+    // Issue 17's per-plan targets: the field worked ≥ 97 % (and of its reachable ground, where
+    // the rest is ground no vehicle of that width and r_min reaches), overlap ≤ 3 %.
+    let count =
+        |f: &dyn Fn(&SweepRow) -> bool| rows.iter().filter(planned).filter(|r| f(r)).count();
+    let worked_97 = count(&|r| r.covered_fraction >= 0.97);
+    let reachable_97 = count(&|r| r.reachable_worked_fraction >= 0.97);
+    let overlap_3 = count(&|r| r.overlap_fraction <= 0.03);
     let worst = rows
         .iter()
         .filter(|r| r.field_ha <= 100.0)
         .max_by(|a, b| a.plan_time_ms.total_cmp(&b.plan_time_ms));
     println!(
-        "{} plans: {} refused (no swath fits, headland passes alone < {:.0} %), {} errors; of the {} planned: field worked median {:.2} %, min {:.2} %; overlap max {:.2} %; {} plans with violations",
+        "{} plans: {} refused (no swath fits, headland passes alone < {:.0} %), {} errors; of the {} planned: field worked median {:.2} %, min {:.2} %; overlap max {:.2} %; {} plans with violations; {} worked ≥ 97 % of the field, {} ≥ 97 % of its reachable ground, {} with overlap ≤ 3 %",
         rows.len(),
         refused,
         100.0 * HEADLAND_ONLY_MIN_WORKED,
@@ -585,7 +602,10 @@ where
         100.0 * med,
         100.0 * min,
         100.0 * max_overlap,
-        violating
+        violating,
+        worked_97,
+        reachable_97,
+        overlap_3
     );
     if let Some(w) = worst {
         println!(
