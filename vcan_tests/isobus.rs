@@ -626,12 +626,13 @@ fn magnetic_heading_refused_by_default() {
     assert!(during.max_xte_m < 0.05, "XTE {}", during.max_xte_m);
 }
 
-/// Where `a_closed_loop_job_on_vcan` records its true XTE (RMS, p95) for the steer-ready loop.
+/// Where `a_closed_loop_job_on_vcan` records its true XTE (RMS, p95): the reference of the
+/// steer-ready loop and of the GNSS paths (gnss.rs).
 pub const ANGLE_XTE_FILE: &str = "/tmp/agsteer-angle-job-xte";
 
 /// The wheel-angle mode's XTE (RMS, p95) on the same job in this boot: recorded by
 /// `a_closed_loop_job_on_vcan` when it ran, else measured here.
-fn angle_mode_xte(iface: &str) -> (f64, f64, &'static str) {
+pub(super) fn angle_mode_xte(iface: &str) -> (f64, f64, &'static str) {
     let recorded = std::fs::read_to_string(ANGLE_XTE_FILE).ok().and_then(|t| {
         let v: Vec<f64> = t
             .split_whitespace()
