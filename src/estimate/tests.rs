@@ -542,3 +542,23 @@ fn the_robust_observer_coasts_through_a_step_but_not_a_ramp() {
         }
     }
 }
+
+#[test]
+fn small_angle_sin_cos_and_rotations_match_the_library() {
+    for k in -1000..=1000 {
+        let a = k as f64 * 1e-4;
+        let (s, c) = crate::geo::small_sin_cos(a);
+        assert!(
+            (s - a.sin()).abs() <= 2e-17 && (c - a.cos()).abs() <= 2e-16,
+            "{a}"
+        );
+    }
+    // 400 rotations (a 2 s prediction at 5 ms steps) stay on the library's angle.
+    let (mut sc, mut th) = (0.3f64.sin_cos(), 0.3);
+    for i in 0..400 {
+        let a = 0.01 * ((i as f64) * 0.1).sin();
+        sc = crate::geo::rotate(sc, crate::geo::small_sin_cos(a));
+        th += a;
+    }
+    assert!((sc.0 - th.sin()).abs() < 1e-13 && (sc.1 - th.cos()).abs() < 1e-13);
+}

@@ -59,6 +59,23 @@ pub fn cross(a: &Vec2, b: &Vec2) -> f64 {
     a.x * b.y - a.y * b.x
 }
 
+/// Sine and cosine of `a` (rad): a Taylor series while |a| ≤ 0.05 (a prediction step's heading
+/// change; the error is below 1e-19 there), else `sin_cos`.
+pub fn small_sin_cos(a: f64) -> (f64, f64) {
+    if a.abs() > 0.05 {
+        return a.sin_cos();
+    }
+    let a2 = a * a;
+    let sin = a * (1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0))));
+    let cos = 1.0 - a2 / 2.0 * (1.0 - a2 / 12.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0)));
+    (sin, cos)
+}
+
+/// `(sin θ, cos θ)` turned by the angle whose sine and cosine are `by`: (sin, cos) of θ + α.
+pub fn rotate((sin, cos): (f64, f64), by: (f64, f64)) -> (f64, f64) {
+    (sin * by.1 + cos * by.0, cos * by.1 - sin * by.0)
+}
+
 /// Left-hand normal (rotate +90°).
 #[inline]
 pub fn left_normal(v: &Vec2) -> Vec2 {
