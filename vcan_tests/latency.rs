@@ -241,6 +241,7 @@ fn fix_to_command_run(iface: &str, priority: i32, path: GnssPath) -> FixLatency 
 /// Both paths at the daemon's configured priority (50, below the simulator's 60).
 fn fix_to_command_both(priority: i32) {
     let Some(iface) = vcan() else { return };
+    println!("VM-ENV {}", guest_environment());
     let (idle_median, idle_p99) = echo_latency(&iface, 1000);
     println!(
         "ECHO-LATENCY idle: median_us={:.1} p99_us={:.1}",
@@ -280,4 +281,47 @@ fn l_fix_to_command_latency_dt_10ms() {
 #[ignore = "an experiment: run with --ignored"]
 fn l_fix_to_command_latency_dt_10ms_daemon_above_sim() {
     fix_to_command_both(70);
+}
+
+/// The guest's kernel, clock source and speculation mitigations, and what a clock read and a
+/// trivial system call cost in it: under TCG these set the floor of every figure here, and
+/// they change with the kernel the VM boots (tools/vm/cache/kernel-version).
+fn guest_environment() -> String {
+    let read = |p: &str| {
+        std::fs::read_to_string(p)
+            .map(|s| s.trim().to_string())
+            .unwrap_or_else(|_| "?".into())
+    };
+    let mitigated = std::fs::read_dir("/sys/devices/system/cpu/vulnerabilities")
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .filter_map(|e| {
+                    let v = std::fs::read_to_string(e.path()).ok()?;
+                    let v = v.trim();
+                    (v != "Not affected")
+                        .then(|| format!("{}={v}", e.file_name().to_string_lossy()))
+                })
+                .collect::<Vec<_>>()
+                .join("; ")
+        })
+        .unwrap_or_default();
+    let n = 20_000;
+    let start = std::time::Instant::now();
+    for _ in 0..n {
+        std::hint::black_box(std::time::Instant::now());
+    }
+    let clock_ns = start.elapsed().as_nanos() as f64 / n as f64;
+    let start = std::time::Instant::now();
+    for _ in 0..n {
+        // SAFETY: getppid has no arguments and cannot fail.
+        std::hint::black_box(unsafe { libc::getppid() });
+    }
+    let syscall_ns = start.elapsed().as_nanos() as f64 / n as f64;
+    format!(
+        "kernel={} clocksource={} clock_read_ns={clock_ns:.0} getppid_ns={syscall_ns:.0} \
+         cmdline=[{}] vulnerabilities=[{mitigated}]",
+        read("/proc/sys/kernel/osrelease"),
+        read("/sys/devices/system/clocksource/clocksource0/current_clocksource"),
+        read("/proc/cmdline"),
+    )
 }

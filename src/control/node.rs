@@ -619,6 +619,9 @@ impl ControllerNode {
         };
         // While calibrating, the procedure's demand replaces the tracker's.
         let calibration = self.calibration_demand(t);
+        // The frames before the command (direction request, operator replies) are moved after
+        // it below: the command leaves first (a fix's latency counts to the command).
+        let first = out.len();
         let request = match self.calibration_direction() {
             Some(r) => Some(r),
             None => self.direction_request(&c),
@@ -663,6 +666,7 @@ impl ControllerNode {
             .to_degrees()
             .clamp(-90.0, 90.0);
 
+        let commands_at = out.len() - first;
         if matches!(self.output, OutputKind::Angle | OutputKind::Both) {
             if let Ok(f) = self.packer.pack(&SteeringCommand {
                 angle: Some(sensed_deg),
@@ -697,6 +701,9 @@ impl ControllerNode {
                 out.push(f);
                 self.last_intended = Some(cmd.engaged);
             }
+        }
+        if let Some(rest) = out.get_mut(first..) {
+            rest.rotate_right(rest.len() - commands_at.min(rest.len()));
         }
         let g = self.ctrl.guidance();
         self.status = NodeStatus {

@@ -9,6 +9,8 @@
 pub mod bus_log;
 pub mod calibration;
 pub mod gnss;
+pub mod loop_stats;
 pub mod notify;
 pub mod run;
+pub mod sources;
 pub mod tick;

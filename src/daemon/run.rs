@@ -18,6 +18,7 @@
 //! saw and `agsteer replay` reproduces its decisions.
 
 use super::bus_log::{BusLog, BusLogError, BusLogParams, BusLogStats};
+use super::loop_stats::{count_by, LoopStats, FIX_PHASE_EDGES_US, FIX_TO_COMMAND_EDGES_US};
 use super::tick::TickSchedule;
 use crate::can::bus::{monotonic_s, AsyncSocketCan, BusError, Filter};
 use crate::can::candump::log_time;
@@ -64,39 +65,6 @@ pub enum DaemonError {
     ProgressNotSaved(#[source] progress_file::ProgressFileError),
 }
 
-/// Upper edges of [`LoopStats::fix_to_command_counts`], µs.
-pub const FIX_TO_COMMAND_EDGES_US: [f64; 7] =
-    [100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0, 10000.0];
-
-/// Control-loop timing, for the status socket.
-#[derive(Debug, Clone, Copy, Default, Serialize)]
-pub struct LoopStats {
-    pub ticks: u64,
-    /// Ticks that started more than one period late.
-    pub deadline_misses: u64,
-    pub max_late_ms: f64,
-    pub mean_late_ms: f64,
-    /// Duration of the last control step, µs.
-    pub last_step_us: f64,
-    pub max_step_us: f64,
-    pub frames_in: u64,
-    pub send_errors: u64,
-    pub bus_up: bool,
-    /// Control periods run at once on a GNSS fix (the rest ran on the timer).
-    pub fix_ticks: u64,
-    /// A fix's receive time to its command handed to the socket: last and largest, µs.
-    pub fix_to_command_us: f64,
-    pub max_fix_to_command_us: f64,
-    /// Fixes by receive-to-command time, µs: counts up to each of
-    /// [`FIX_TO_COMMAND_EDGES_US`] and beyond the last (the daemon's own share of the
-    /// latency, without the wait before the frame is read).
-    pub fix_to_command_counts: [u64; FIX_TO_COMMAND_EDGES_US.len() + 1],
-    /// Timer periods held back for an expected fix ([`super::tick`]).
-    pub held_ticks: u64,
-    /// The fixes' period as learnt, ms (0: not learnt).
-    pub fix_period_ms: f64,
-}
-
 #[derive(Serialize)]
 struct StatusReply<'a> {
     #[serde(flatten)]
@@ -109,77 +77,13 @@ struct StatusReply<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     gnss: Option<super::gnss::GnssStatusReply>,
     /// Every GNSS source seen and the one each input is locked on.
-    sources: SourcesReply,
+    sources: super::sources::SourcesReply,
     /// `--bus-log`, when on.
     #[serde(skip_serializing_if = "Option::is_none")]
     bus_log: Option<BusLogStats>,
     /// The steering calibration under way or the last one's result.
     #[serde(skip_serializing_if = "Option::is_none")]
     calibration: Option<super::calibration::CalibrationReply<'a>>,
-}
-
-/// One source seen, for the status reply.
-#[derive(Serialize)]
-struct SourceReply {
-    source: crate::input::SourceId,
-    /// Its ISO 11783-5 NAME (hex), once it claimed an address.
-    name: Option<String>,
-    /// The inputs it sends, and those it is selected for.
-    sends: Vec<crate::input::source::Kind>,
-    selected_for: Vec<crate::input::source::Kind>,
-    quality: Option<crate::input::FixQuality>,
-    inputs: u64,
-    last_s_ago: f64,
-}
-
-#[derive(Serialize)]
-struct SourcesReply {
-    /// The source each input is locked on (null: none yet).
-    position: Option<crate::input::SourceId>,
-    course_speed: Option<crate::input::SourceId>,
-    heading: Option<crate::input::SourceId>,
-    quality: Option<crate::input::SourceId>,
-    seen: Vec<SourceReply>,
-    /// Sources past the listed ones.
-    unlisted: u64,
-}
-
-fn sources_reply(sel: &crate::input::source::SourceSelector, now: f64) -> SourcesReply {
-    use crate::input::source::Kind;
-    const KINDS: [Kind; 4] = [
-        Kind::Position,
-        Kind::CourseSpeed,
-        Kind::Heading,
-        Kind::Quality,
-    ];
-    let pick = |flags: &[bool; 4]| {
-        KINDS
-            .iter()
-            .zip(flags)
-            .filter(|(_, on)| **on)
-            .map(|(k, _)| *k)
-            .collect()
-    };
-    SourcesReply {
-        position: sel.selected(Kind::Position),
-        course_speed: sel.selected(Kind::CourseSpeed),
-        heading: sel.selected(Kind::Heading),
-        quality: sel.selected(Kind::Quality),
-        seen: sel
-            .seen()
-            .iter()
-            .map(|s| SourceReply {
-                source: s.source,
-                name: s.name.map(|n| format!("{n:016X}")),
-                sends: pick(&s.kinds),
-                selected_for: pick(&s.selected),
-                quality: s.quality,
-                inputs: s.inputs,
-                last_s_ago: (now - s.last_t).max(0.0),
-            })
-            .collect(),
-        unlisted: sel.unlisted(),
-    }
 }
 
 enum BusEvent {
@@ -300,10 +204,11 @@ fn send_all(
 ) -> bool {
     let mut ok = true;
     for f in frames {
+        let sent = bus.try_send(f);
         if let Some(l) = log {
             l.record(t, f);
         }
-        if let Err(e) = bus.try_send(f) {
+        if let Err(e) = sent {
             stats.send_errors += 1;
             if stats.send_errors.is_power_of_two() {
                 tracing::warn!("sending {:08X}: {e}", f.id);
@@ -380,13 +285,30 @@ struct Outputs {
 }
 
 impl Outputs {
-    /// One control period at `t`; true when it had guidance events (a line change).
+    /// One control period at `t`: its frames computed and handed to the socket, then the
+    /// bookkeeping. True when it had guidance events (a line change).
     fn step(&mut self, node: &mut ControllerNode, t: f64, stats: &mut LoopStats) -> bool {
+        let sent = self.compute_and_send(node, t, stats);
+        self.after_send(node, sent, stats)
+    }
+
+    /// The node's period at `t` and its frames to the socket; whether they were sent.
+    fn compute_and_send(
+        &mut self,
+        node: &mut ControllerNode,
+        t: f64,
+        stats: &mut LoopStats,
+    ) -> bool {
         self.frames.clear();
         node.tick(t, &mut self.frames);
+        send_all(&self.bus, t, &self.frames, stats, self.log.as_ref())
+    }
+
+    /// What a period does once its frames have left: the link's state, the calibration's
+    /// thread, progress saved and guidance events logged at a line change (true then).
+    fn after_send(&mut self, node: &mut ControllerNode, sent: bool, stats: &mut LoopStats) -> bool {
         self.calibration.poll(node);
         // A period without frames (claiming) says nothing of the link.
-        let sent = send_all(&self.bus, t, &self.frames, stats, self.log.as_ref());
         if sent && !self.bus_up && !self.frames.is_empty() {
             tracing::info!(
                 "CAN interface {} is back; claiming the address again",
@@ -415,33 +337,49 @@ impl Outputs {
         had_events
     }
 
-    /// A GNSS fix received at `t_fix` entered the node: its command now, the timer restarted.
+    /// A GNSS fix read at `fix.read` entered the node (the loop took it at `fix.taken`): its
+    /// command now, then the bookkeeping, the timer restarted.
     fn on_fix(
         &mut self,
         node: &mut ControllerNode,
-        t_fix: f64,
+        fix: FixArrival,
         stats: &mut LoopStats,
         schedule: &mut TickSchedule,
     ) {
         let start = std::time::Instant::now();
         let t = log_time(monotonic_s());
-        self.step(node, t, stats);
-        schedule.on_fix(t_fix, t);
+        self.frames.clear();
+        node.tick(t, &mut self.frames);
+        let ready = monotonic_s();
+        let sent = send_all(&self.bus, t, &self.frames, stats, self.log.as_ref());
+        let left = monotonic_s();
+        self.after_send(node, sent, stats);
+        schedule.on_fix(fix.read, t);
         stats.held_ticks = schedule.held;
         stats.fix_period_ms = schedule.fix_period().unwrap_or(0.0) * 1e3;
         stats.fix_ticks += 1;
-        stats.fix_to_command_us = (monotonic_s() - t_fix).max(0.0) * 1e6;
+        stats.fix_to_command_us = (left - fix.read).max(0.0) * 1e6;
         stats.max_fix_to_command_us = stats.max_fix_to_command_us.max(stats.fix_to_command_us);
-        let bucket = FIX_TO_COMMAND_EDGES_US
-            .iter()
-            .position(|e| stats.fix_to_command_us <= *e)
-            .unwrap_or(FIX_TO_COMMAND_EDGES_US.len());
-        if let Some(c) = stats.fix_to_command_counts.get_mut(bucket) {
-            *c += 1;
-        }
+        count_by(
+            &mut stats.fix_to_command_counts,
+            &FIX_TO_COMMAND_EDGES_US,
+            stats.fix_to_command_us,
+        );
+        let us = |a: f64, b: f64| (b - a).max(0.0) * 1e6;
+        let p = &mut stats.fix_phases;
+        count_by(&mut p.queue, &FIX_PHASE_EDGES_US, us(fix.read, fix.taken));
+        count_by(&mut p.compute, &FIX_PHASE_EDGES_US, us(fix.taken, ready));
+        count_by(&mut p.send, &FIX_PHASE_EDGES_US, us(ready, left));
         stats.last_step_us = start.elapsed().as_secs_f64() * 1e6;
         stats.max_step_us = stats.max_step_us.max(stats.last_step_us);
     }
+}
+
+/// When a GNSS fix was read (its receive time) and when the loop took it (monotonic s).
+#[derive(Debug, Clone, Copy)]
+struct FixArrival {
+    read: f64,
+    taken: f64,
 }
 
 /// Frames taken from the reader's queue when the timer is due, at most (a flood never delays
@@ -449,22 +387,26 @@ impl Outputs {
 const DRAIN_AT_TICK: usize = 64;
 
 /// One event from the bus reader: a frame into the node (and the bus log), or the link down.
-/// The receive time when a GNSS fix entered the controller.
+/// Its arrival when a GNSS fix entered the controller.
 fn on_bus_event(
     ev: BusEvent,
     node: &mut ControllerNode,
     out: &mut Outputs,
     stats: &mut LoopStats,
     iface: &str,
-) -> Option<f64> {
+) -> Option<FixArrival> {
     match ev {
         BusEvent::Frame(mut tf) => {
+            let taken = monotonic_s();
             stats.frames_in += 1;
             tf.t = log_time(tf.t);
+            let fix = node
+                .on_frame(&tf)
+                .then_some(FixArrival { read: tf.t, taken });
             if let Some(l) = &out.log {
                 l.record(tf.t, &tf.frame);
             }
-            node.on_frame(&tf).then_some(tf.t)
+            fix
         }
         BusEvent::Down(e) => {
             if out.bus_up {
@@ -673,15 +615,16 @@ async fn run_async(
                         if let Some(g) = gnss.as_mut().filter(|_| fix.is_none()) {
                             for _ in 0..DRAIN_AT_TICK {
                                 let Ok(i) = g.inputs.try_recv() else { break };
+                                let taken = monotonic_s();
                                 if node.on_input(&i) {
-                                    fix = Some(i.t());
+                                    fix = Some(FixArrival { read: i.t(), taken });
                                     break;
                                 }
                             }
                         }
                         apply_operator_request(&mut node, &resolved, &configured, &mut book, &jobs_tx);
-                        if let Some(t_fix) = fix {
-                            out.on_fix(&mut node, t_fix, &mut stats, &mut schedule);
+                        if let Some(f) = fix {
+                            out.on_fix(&mut node, f, &mut stats, &mut schedule);
                             timer.as_mut().reset(deadline(schedule.next()));
                             continue;
                         }
@@ -711,10 +654,17 @@ async fn run_async(
                         watchdog.period(late <= dt);
                     }
                     ev = rx.recv() => {
-                        let Some(ev) = ev else { break };
-                        if let Some(t_fix) = on_bus_event(ev, &mut node, &mut out, &mut stats, &iface) {
-                            out.on_fix(&mut node, t_fix, &mut stats, &mut schedule);
-                            timer.as_mut().reset(deadline(schedule.next()));
+                        let Some(mut ev) = ev else { break };
+                        // This frame and those read with it, up to a fix (its period runs at
+                        // once) or DRAIN_AT_TICK: one pass of the loop, not one per frame.
+                        for _ in 0..DRAIN_AT_TICK {
+                            if let Some(f) = on_bus_event(ev, &mut node, &mut out, &mut stats, &iface) {
+                                out.on_fix(&mut node, f, &mut stats, &mut schedule);
+                                timer.as_mut().reset(deadline(schedule.next()));
+                                break;
+                            }
+                            let Ok(next) = rx.try_recv() else { break };
+                            ev = next;
                         }
                         apply_operator_request(&mut node, &resolved, &configured, &mut book, &jobs_tx);
                     }
@@ -724,11 +674,18 @@ async fn run_async(
                             None => std::future::pending().await,
                         }
                     } => {
-                        if let Some(i) = input {
+                        // This input and those decoded with it, up to a fix (as frames above).
+                        let mut input = input;
+                        for _ in 0..DRAIN_AT_TICK {
+                            let Some(i) = input.take() else { break };
+                            let taken = monotonic_s();
                             if node.on_input(&i) {
-                                out.on_fix(&mut node, i.t(), &mut stats, &mut schedule);
+                                let f = FixArrival { read: i.t(), taken };
+                                out.on_fix(&mut node, f, &mut stats, &mut schedule);
                                 timer.as_mut().reset(deadline(schedule.next()));
+                                break;
                             }
+                            input = gnss.as_mut().and_then(|g| g.inputs.try_recv().ok());
                         }
                     }
                     conn = async {
@@ -744,7 +701,7 @@ async fn run_async(
                                 interface: &iface,
                                 dt_s: dt,
                                 gnss: gnss.as_ref().map(|g| g.status(monotonic_s())),
-                                sources: sources_reply(node.sources(), monotonic_s()),
+                                sources: super::sources::sources_reply(node.sources(), monotonic_s()),
                                 bus_log: out.log.as_ref().map(BusLog::stats),
                                 calibration: out.calibration.reply(&node),
                             };
