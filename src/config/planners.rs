@@ -8,7 +8,8 @@ use crate::plan::arcs::ArcsParams;
 use crate::plan::turns::TurnParams;
 
 impl Config {
-    /// The AB planner's parameters (turns planned at [`Config::turn_radius`]).
+    /// The AB planner's parameters (turns planned at [`Config::turn_radius`] and
+    /// [`Config::turn_curvature_rate`]).
     pub fn ab_params(&self) -> AbParams {
         let (j, g) = (&self.job, &self.guidance);
         AbParams {
@@ -29,7 +30,7 @@ impl Config {
                 merge_distance: g.turn_merge_distance_m,
                 point_spacing: g.point_spacing_m,
                 max_points: g.turn_max_points,
-                max_curvature_rate: self.vehicle.max_curvature_rate_per_m2,
+                max_curvature_rate: self.turn_curvature_rate(),
             },
         }
     }

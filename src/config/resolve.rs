@@ -242,6 +242,7 @@ impl Config {
             },
             tracker_kind: t.kind,
             law: LawParams {
+                predictive_ld_max: t.predictive_ld_max_m,
                 stanley_gain: t.stanley_gain_per_s,
                 stanley_soft_speed: t.stanley_soft_speed_mps,
                 lqr: crate::track::lqr::LqrWeights {
@@ -345,6 +346,10 @@ impl Config {
 /// ([`Config::turn_radius`]); the rest is the tracker's, for corrections and slip.
 pub const TURN_LATERAL_SHARE: f64 = 0.8;
 
+/// The share of the steering's wheel rate a planned turn's curvature rate may use
+/// ([`Config::turn_curvature_rate`]); the rest is the tracker's.
+pub const TURN_STEERING_SHARE: f64 = 0.8;
+
 impl Config {
     /// Control period, s.
     pub fn dt(&self) -> f64 {
@@ -369,10 +374,32 @@ impl Config {
             self.vehicle.r_min_m
         }
     }
+    /// Curvature rate of the planned turns, 1/m²: `vehicle.max_curvature_rate_per_m2`, or
+    /// less when the steering could not sweep the wheels that fast at the job speed: a wheel
+    /// rate ω (the slower of `safety.actuator_rate_deg_s`, which calibration measures, and
+    /// `safety.max_wheel_rate_deg_s`) turns the path at dκ/ds = ω / (L·v·cos²δ) ≥ ω / (L·v),
+    /// of which a turn may use [`TURN_STEERING_SHARE`]. A turn planned faster than the
+    /// steering leaves every line start off the line (the envelope's 10°/s motor at 10 km/h
+    /// follows 0.021 /m², not 0.1: 11 cm RMS on the straights). 0 stays 0 (turns of arcs).
+    pub fn turn_curvature_rate(&self) -> f64 {
+        let sigma = self.vehicle.max_curvature_rate_per_m2;
+        let rate = self
+            .safety
+            .actuator_rate_deg_s
+            .min(self.safety.max_wheel_rate_deg_s)
+            .to_radians();
+        let v = self.speed().abs();
+        let steering = TURN_STEERING_SHARE * rate / (self.vehicle.wheelbase_m * v);
+        if sigma > 0.0 && steering.is_finite() && steering > 0.0 {
+            sigma.min(steering)
+        } else {
+            sigma
+        }
+    }
     /// The steering's response as calibration measured it (`safety.actuator_*`), for the
     /// default law's look-ahead schedule.
     pub fn steering_response(&self) -> SteeringResponse {
-        let (f, v) = (&self.safety, &self.vehicle);
+        let f = &self.safety;
         SteeringResponse {
             lag: f.actuator_tau_s,
             dead_time: (f.actuator_dead_time_s - self.track.lead_time_s).max(0.0),
@@ -380,9 +407,37 @@ impl Config {
                 .actuator_rate_deg_s
                 .min(f.max_wheel_rate_deg_s)
                 .to_radians(),
-            sweep: (v.wheelbase_m / self.turn_radius())
-                .atan()
-                .min(self.max_wheel_angle()),
+            sweep: self.turn_exit_slew(),
+        }
+    }
+    /// The wheel angle the steering still has to sweep when the planned turn's exit has been
+    /// driven, rad: the turn's wheel angle atan(L / [`Config::turn_radius`]) less what the
+    /// wheels sweep at the steering's rate while the exit clothoid (κ from 1/R to 0 at the
+    /// planned curvature rate σ) is driven, (1/R)/(σ·v) s. 0 for turns planned within the
+    /// steering's rate ([`Config::turn_curvature_rate`]); the whole angle for turns of arcs.
+    /// Field jobs plan their turns at `vehicle.max_curvature_rate_per_m2`; an arcs job's are
+    /// counted as arcs.
+    pub fn turn_exit_slew(&self) -> f64 {
+        let (f, v) = (&self.safety, &self.vehicle);
+        let radius = self.turn_radius();
+        let sweep = (v.wheelbase_m / radius).atan().min(self.max_wheel_angle());
+        let sigma = match self.job.kind {
+            JobKind::Field => v.max_curvature_rate_per_m2,
+            // Concentric lines a few metres apart take tall bulbs that cross themselves, made
+            // of arcs (`plan::turns`), and the lines start with a curvature step.
+            JobKind::Arcs => 0.0,
+            _ => self.turn_curvature_rate(),
+        };
+        let rate = f
+            .actuator_rate_deg_s
+            .min(f.max_wheel_rate_deg_s)
+            .to_radians();
+        let exit_s = 1.0 / (radius * sigma * self.speed().abs());
+        let residual = sweep - rate * exit_s;
+        if residual.is_finite() {
+            residual.clamp(0.0, sweep)
+        } else {
+            sweep
         }
     }
     /// Largest wheel angle, rad.

@@ -30,6 +30,9 @@ pub struct LawNeeds {
 /// The laws' own gains (`[track]`), SI.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LawParams {
+    /// The default law's longest look-ahead from the growth with speed, m
+    /// (`track.predictive_ld_max_m`).
+    pub predictive_ld_max: f64,
     /// Stanley cross-track gain k, 1/s.
     pub stanley_gain: f64,
     /// Stanley softening speed, m/s.

@@ -323,6 +323,7 @@ mod tests {
 
     fn law_params() -> LawParams {
         LawParams {
+            predictive_ld_max: 4.5,
             stanley_gain: 2.5,
             stanley_soft_speed: 1.0,
             lqr: LqrWeights::default(),

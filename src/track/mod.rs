@@ -56,7 +56,9 @@ pub struct SteeringResponse {
     /// Rate limit of the wheel angle (the slower of the actuator and the command limit),
     /// rad/s; 0 = none.
     pub rate: f64,
-    /// The wheel angle swept out of the planned turns (atan(L / turn radius)), rad.
+    /// The wheel angle the steering still has to sweep when the exit of a planned turn has
+    /// been driven (atan(L / turn radius) for turns of arcs, 0 for continuous-curvature turns
+    /// planned within the steering's rate; `Config::turn_exit_slew`), rad.
     pub sweep: f64,
 }
 

@@ -12,15 +12,18 @@ use crate::geo::{cross, heading_vec, Pose};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PurePursuit {
     pub needs: LawNeeds,
-    /// The look-ahead is scheduled on the steering's response
-    /// ([`scheduled_lookahead`]); `false`: the seed's `ld_min`/`ld_gain` alone.
-    pub scheduled: bool,
+    /// The look-ahead is scheduled on the steering's response ([`scheduled_lookahead`]), its
+    /// growth with speed (`ld_gain`) stopping at this distance, m; `None`: the seed's
+    /// `ld_min`/`ld_gain` alone.
+    pub scheduled: Option<f64>,
 }
 
 impl PurePursuit {
     /// The default tracker: pure pursuit on a latency-compensated, dead-reckoned pose, steering
-    /// the course over ground with every compensation on.
-    pub fn predictive() -> Self {
+    /// the course over ground with every compensation on; its look-ahead grows with speed up
+    /// to `ld_max` m (`track.predictive_ld_max_m`), or further where the steering's response
+    /// needs it.
+    pub fn predictive(ld_max: f64) -> Self {
         PurePursuit {
             needs: LawNeeds {
                 prediction: true,
@@ -28,7 +31,7 @@ impl PurePursuit {
                 integral: true,
                 lost_motion: true,
             },
-            scheduled: true,
+            scheduled: Some(ld_max),
         }
     }
 
@@ -41,7 +44,7 @@ impl PurePursuit {
                 integral: false,
                 lost_motion: false,
             },
-            scheduled: false,
+            scheduled: None,
         }
     }
 }
@@ -59,10 +62,20 @@ impl SteeringLaw for PurePursuit {
         _wheel_angle: Option<f64>,
         params: &TrackerParams,
     ) -> TrackOutput {
-        let ld = if self.scheduled {
-            scheduled_lookahead(params, params.response_time(), speed)
-        } else {
-            lookahead(params, speed)
+        let ld = match self.scheduled {
+            Some(ld_max) => {
+                let growth = (params.ld_gain * speed.abs()).min(ld_max);
+                scheduled_lookahead(
+                    &TrackerParams {
+                        ld_gain: 0.0,
+                        ..*params
+                    },
+                    params.response_time(),
+                    speed,
+                )
+                .max(growth)
+            }
+            None => lookahead(params, speed),
         };
         pure_pursuit_at(local, pose, ld, params)
     }

@@ -25,8 +25,11 @@
 //! [`crate::geo`] only.
 
 pub mod cache;
+mod cc;
 
 pub use cache::{canonical_turn, TurnCache, TurnPart};
+pub(crate) use cc::cc_quarter_turn;
+use cc::{cc_bulb_turn, cc_pi_turn};
 
 use super::types::PlanError;
 use crate::geo::{cross, left_normal, v2, PathPoint, Vec2};
@@ -232,7 +235,10 @@ pub fn pi_turn(
             distance: d,
         });
     }
-    if params.max_curvature_rate > 0.0 && cc_pi_turn(p1, dir1, p2, n, d, params, out) {
+    if params.max_curvature_rate > 0.0
+        && (cc_pi_turn(p1, dir1, p2, n, d, params, out)
+            || cc_bulb_turn(p1, dir1, p2, n, d, params, out))
+    {
         return Ok(());
     }
     let c1 = p1 + n * r;
@@ -260,79 +266,6 @@ pub fn pi_turn(
     Ok(())
 }
 
-/// A forward continuous-curvature quarter turn (clothoid + arc + clothoid at κ_max = 1/r_min
-/// and σ_max = `max_curvature_rate`), to the left or right, and its reach: being symmetric, it
-/// ends as far along its start heading as across it, m (a little more than r_min).
-pub(crate) fn cc_quarter_turn(
-    params: &TurnParams,
-    left: bool,
-) -> (Vec<crate::plan::maneuver::path::CurveSegment>, f64) {
-    use crate::geo::{Direction, Pose};
-    use crate::plan::maneuver::cc_turn::cc_turn;
-    use crate::plan::maneuver::path::{CurveParams, CurvePath};
-    let curve = CurveParams {
-        kappa_max: 1.0 / params.r_min,
-        sigma_max: params.max_curvature_rate,
-    };
-    let delta = if left {
-        std::f64::consts::FRAC_PI_2
-    } else {
-        -std::f64::consts::FRAC_PI_2
-    };
-    let segments = cc_turn(delta, Direction::Forward, &curve);
-    let reach = CurvePath {
-        start: Pose::new(0.0, 0.0, 0.0),
-        segments: segments.clone(),
-    }
-    .end_pose()
-    .pos
-    .x;
-    (segments, reach)
-}
-
-/// The pi turn with continuous curvature: a CC quarter turn (clothoid + arc + clothoid at
-/// κ_max = 1/r_min and σ_max = `max_curvature_rate`), a straight across, a second CC quarter
-/// turn. A CC quarter turn reaches a distance q > r_min both along and across, so it needs the
-/// lines at least 2·q apart and level; `false` (nothing written) otherwise, and the arcs are
-/// used.
-fn cc_pi_turn(
-    p1: Vec2,
-    dir1: Vec2,
-    p2: Vec2,
-    n: Vec2,
-    d: f64,
-    params: &TurnParams,
-    out: &mut Vec<PathPoint>,
-) -> bool {
-    use crate::geo::{Direction, Pose, Tag};
-    use crate::plan::maneuver::path::{CurvePath, CurveSegment};
-    let (quarter, q) = cc_quarter_turn(params, cross(&dir1, &n) > 0.0);
-    let start = Pose::new(p1.x, p1.y, dir1.y.atan2(dir1.x));
-    let level = (p2 - p1).dot(&dir1).abs() < 1e-3;
-    if !level || d + 1e-9 < 2.0 * q || !q.is_finite() {
-        return false;
-    }
-    let mut segments = quarter.clone();
-    segments.push(CurveSegment::line(Direction::Forward, d - 2.0 * q));
-    segments.extend(quarter);
-    let mut samples = Vec::new();
-    CurvePath { start, segments }.sample(params.point_spacing.min(0.5), &mut samples);
-    let first = out.len();
-    out.extend(samples.iter().map(|s| PathPoint {
-        pos: s.pose.pos,
-        tag: Tag::Turn,
-        direction: Direction::Forward,
-    }));
-    // Exact ends, as the arc turns.
-    if let Some(q) = out.get_mut(first) {
-        q.pos = p1;
-    }
-    if let Some(q) = out.last_mut() {
-        q.pos = p2;
-    }
-    true
-}
-
 /// A forward-only bulb (omega) turn between lines closer than `2·r_min`: an arc away from the
 /// next line by β, a large arc the other way by π + 2β, and an arc away again by β, all of
 /// radius `r_min` (m) and tangent to each other, ending exactly at `p2` heading along `−dir1`.
@@ -357,6 +290,9 @@ pub fn bulb_turn(
             reason: "lines 2·r_min or more apart take a pi turn",
             distance: d,
         });
+    }
+    if params.max_curvature_rate > 0.0 && cc_bulb_turn(p1, dir1, p2, n, d, params, out) {
+        return Ok(());
     }
     // Centres: c1 beside the current line away from the next one, c3 beside the next line on
     // the far side, c2 ahead in the headland tangent to both.
@@ -492,11 +428,75 @@ mod tests {
                 }
             }
         }
-        // 12 m apart (≥ 2·r_min, below two CC reaches): the arc turn, top exactly r_min.
+        // 12 m apart (≥ 2·r_min, below two CC reaches): the CC bulb, reaching further than
+        // the arcs' r_min.
         let mut out = Vec::new();
         pi_turn(p1, dir, v2(12.0, 100.0), &p, &mut out).unwrap();
         let top = out.iter().map(|q| q.pos.y).fold(f64::MIN, f64::max);
-        assert!((top - 105.0).abs() < 1e-9, "{top}");
+        assert!(top > 105.5, "{top}");
+        assert_eq!(out.last().unwrap().pos, v2(12.0, 100.0));
+        // Not level: the arcs, top exactly r_min.
+        let mut out = Vec::new();
+        pi_turn(p1, dir, v2(12.0, 101.0), &p, &mut out).unwrap();
+        let top = out.iter().map(|q| q.pos.y).fold(f64::MIN, f64::max);
+        assert!((top - 106.0).abs() < 1e-9, "{top}");
+    }
+
+    /// Curvature from three points (1/m, positive left), or 0 on a straight.
+    fn three_point_curvature(a: Vec2, b: Vec2, c: Vec2) -> f64 {
+        let (u, w) = (b - a, c - b);
+        let chord = (c - a).norm();
+        if chord < 1e-9 {
+            return 0.0;
+        }
+        2.0 * cross(&u, &w) / (u.norm() * w.norm() * chord)
+    }
+
+    /// A slow curvature rate (a 10°/s motor at 10 km/h on a 3 m wheelbase: 0.021 /m²) makes
+    /// the CC quarter turn reach far more than r_min: the AB demo's gaps (12, 15 m) and any
+    /// gap up to wider than the CC pi turn's still get a continuous-curvature turn, forward
+    /// only, ending exactly on the next line heading back, within κ_max and σ_max. Closer
+    /// lines, whose CC bulb would cross itself, keep the arcs (ends exact all the same).
+    #[test]
+    fn close_lines_get_a_continuous_curvature_bulb_at_a_slow_curvature_rate() {
+        let sigma = 0.021;
+        let mut p = params(5.0);
+        p.max_curvature_rate = sigma;
+        p.point_spacing = 0.25;
+        for &d in &[0.0, 3.0, 6.0, 10.0, 12.0, 15.0, 24.0] {
+            for side in [1.0, -1.0] {
+                let (p1, dir) = (v2(2.0, 50.0), heading_vec(0.4));
+                let p2 = p1 + left_normal(&dir) * (d * side);
+                let mut out = Vec::new();
+                forward_turn(p1, dir, p2, d, &p, &mut out).unwrap();
+                let pts: Vec<Vec2> = out.iter().map(|q| q.pos).collect();
+                assert_eq!(pts[0], p1);
+                assert_eq!(*pts.last().unwrap(), p2);
+                assert_no_duplicates(&pts);
+                let n = pts.len();
+                assert!((pts[1] - pts[0]).normalize().dot(&dir) > 0.999, "d {d}");
+                assert!(
+                    (pts[n - 1] - pts[n - 2]).normalize().dot(&-dir) > 0.999,
+                    "d {d}"
+                );
+                if d < 10.0 {
+                    continue;
+                }
+                let kappa: Vec<f64> = pts
+                    .windows(3)
+                    .map(|w| three_point_curvature(w[0], w[1], w[2]))
+                    .collect();
+                assert!(kappa[0].abs() < 0.02 && kappa[kappa.len() - 1].abs() < 0.02);
+                for k in &kappa {
+                    assert!(k.abs() <= 0.2 * 1.02, "d {d}: κ {k}");
+                }
+                // Continuous: κ changes by no more than σ_max over the sample spacing (with
+                // slack for the sampling), never by a step.
+                for w in kappa.windows(2) {
+                    assert!((w[1] - w[0]).abs() < 3.0 * sigma * 0.5, "d {d}: {w:?}");
+                }
+            }
+        }
     }
 
     #[test]
