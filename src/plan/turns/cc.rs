@@ -1,5 +1,5 @@
-//! The continuous-curvature turns between parallel lines (`TurnParams::max_curvature_rate`
-//! > 0): the CC quarter turn, the CC pi turn (two quarter turns and a straight) and, for lines
+//! The continuous-curvature turns between parallel lines (a positive
+//! `TurnParams::max_curvature_rate`): the CC quarter turn, the CC pi turn (two quarter turns and a straight) and, for lines
 //! too close for it, the CC bulb (three CC turns). Each returns `false` (nothing written) where
 //! it does not fit, and [`super`] falls back to its turns of arcs.
 
