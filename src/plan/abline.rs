@@ -22,7 +22,7 @@ use super::skip_order::{
 use super::turns::{forward_turn, TurnCache, TurnParams};
 pub use super::types::Side;
 use super::types::{PlanError, PlanSegment, SegmentKind};
-use crate::geo::{left_normal, Direction, PathPoint, Vec2};
+use crate::geo::{cross, left_normal, v2, Direction, PathPoint, Vec2};
 
 /// The seed's five parameters and the shape of the generated paths.
 #[derive(Debug, Clone, PartialEq)]
@@ -61,6 +61,10 @@ pub struct AbPlan {
     blocks: Option<u64>,
     first_order: BlockOrder,
     last_order: Option<BlockOrder>,
+    /// The plan's turns solved once at construction in the canonical frame (start at the origin
+    /// heading +x, end at (0, lateral)), by lateral offset (mm): [`AbPlan::turn_points`], called
+    /// by guidance inside a control period, then only moves points (no solving, no allocation).
+    turns: Vec<(i64, Vec<PathPoint>)>,
 }
 
 impl AbPlan {
@@ -120,7 +124,7 @@ impl AbPlan {
                 }
             }
         };
-        Ok(AbPlan {
+        let mut plan = AbPlan {
             params,
             dir,
             shift,
@@ -130,7 +134,55 @@ impl AbPlan {
             blocks,
             first_order,
             last_order,
-        })
+            turns: Vec::new(),
+        };
+        plan.turns = plan.canonical_turns();
+        Ok(plan)
+    }
+
+    /// The turns between consecutive lines: the first two blocks (the line order repeats with
+    /// them, both parities of the driving direction) and the last two of a finite job. A turn
+    /// that cannot be solved is left out: [`AbPlan::turn_points`] solves it again and reports.
+    fn canonical_turns(&self) -> Vec<(i64, Vec<PathPoint>)> {
+        let mut firsts = vec![0u64, 1];
+        if let Some(n) = self.blocks {
+            firsts.extend([n.saturating_sub(2), n.saturating_sub(1)]);
+        }
+        let mut turns: Vec<(i64, Vec<PathPoint>)> = Vec::new();
+        for block in firsts {
+            for rank in 0..self.block_len(block) {
+                let Some(next) = self.next_position(block, rank) else {
+                    continue;
+                };
+                let (e1, dir1, s2) = self.turn_ends((block, rank), next);
+                let lateral = cross(&dir1, &(s2 - e1));
+                let key = turn_key(lateral);
+                if turns.iter().any(|(k, _)| *k == key) {
+                    continue;
+                }
+                let mut points = Vec::new();
+                let solved = forward_turn(
+                    v2(0.0, 0.0),
+                    v2(1.0, 0.0),
+                    v2(0.0, lateral),
+                    lateral.abs(),
+                    &self.params.turn,
+                    &mut points,
+                );
+                if solved.is_ok() {
+                    turns.push((key, points));
+                }
+            }
+        }
+        turns
+    }
+
+    /// The end of line `from` (with its travel direction) and the start of line `to`.
+    fn turn_ends(&self, from: (u64, usize), to: (u64, usize)) -> (Vec2, Vec2, Vec2) {
+        let (fl, tl) = (self.line_of(from.0, from.1), self.line_of(to.0, to.1));
+        let (s1, e1) = self.line_endpoints(fl, self.line_reversed(from.0, from.1));
+        let (s2, _) = self.line_endpoints(tl, self.line_reversed(to.0, to.1));
+        (e1, (e1 - s1) / self.length, s2)
     }
 
     pub fn params(&self) -> &AbParams {
@@ -238,13 +290,34 @@ impl AbPlan {
         to: (u64, usize),
         out: &mut Vec<PathPoint>,
     ) -> Result<(), PlanError> {
+        let (e1, dir1, s2) = self.turn_ends(from, to);
+        let offset = s2 - e1;
+        let lateral = cross(&dir1, &offset);
+        let level = dir1.dot(&offset).abs() <= 1e-6 * self.length.max(1.0);
+        let cached = self.turns.iter().find(|(k, _)| *k == turn_key(lateral));
+        if let (true, Some((_, shape))) = (level, cached) {
+            let nrm = left_normal(&dir1);
+            let last = shape.len().saturating_sub(1);
+            for (i, q) in shape.iter().enumerate() {
+                // The ends exactly on the lines, as a solved turn has them.
+                let pos = match i {
+                    0 => e1,
+                    i if i == last => s2,
+                    _ => e1 + dir1 * q.pos.x + nrm * q.pos.y,
+                };
+                out.push(PathPoint { pos, ..*q });
+            }
+            return Ok(());
+        }
         let (fl, tl) = (self.line_of(from.0, from.1), self.line_of(to.0, to.1));
-        let (s1, e1) = self.line_endpoints(fl, self.line_reversed(from.0, from.1));
-        let (s2, _) = self.line_endpoints(tl, self.line_reversed(to.0, to.1));
-        let dir1 = (e1 - s1) / self.length;
-        let lateral = fl.abs_diff(tl) as f64 * self.params.line_width;
-        forward_turn(e1, dir1, s2, lateral, &self.params.turn, out)
+        let gap = fl.abs_diff(tl) as f64 * self.params.line_width;
+        forward_turn(e1, dir1, s2, gap, &self.params.turn, out)
     }
+}
+
+/// The key of a turn in [`AbPlan`]'s cache: its lateral offset, mm (the sign is the side).
+fn turn_key(lateral: f64) -> i64 {
+    (lateral * 1000.0).round() as i64
 }
 
 /// The lines of a finite AB job driven in turn (line 0, 1, 2, … alternating direction), as
@@ -318,6 +391,77 @@ mod tests {
                 max_points: 500,
                 max_curvature_rate: 0.0,
             },
+        }
+    }
+
+    /// Largest distance from a point of `a` to the polyline `b`, m.
+    fn hausdorff(a: &[PathPoint], b: &[PathPoint]) -> f64 {
+        a.iter()
+            .map(|q| {
+                b.windows(2)
+                    .map(|s| {
+                        let (p0, d) = (s[0].pos, s[1].pos - s[0].pos);
+                        let t =
+                            ((q.pos - p0).dot(&d) / d.norm_squared().max(1e-18)).clamp(0.0, 1.0);
+                        (q.pos - (p0 + d * t)).norm()
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max)
+    }
+
+    fn polyline_length(a: &[PathPoint]) -> f64 {
+        a.windows(2).map(|s| (s[1].pos - s[0].pos).norm()).sum()
+    }
+
+    #[test]
+    fn turns_from_the_cache_are_the_turns_solved_in_place() {
+        // Finite and endless jobs, odd and even blocks, pi and bulb turns, arcs and
+        // continuous-curvature turns: every turn the job drives, moved from the cache, is the
+        // turn solved at its own ends.
+        for (w, r, a, n, rate) in [
+            (3.0, 5.0, 1, 12, 0.0),
+            (3.0, 5.0, 1, 12, 0.05),
+            (2.0, 5.0, 3, 31, 0.021),
+            (6.0, 4.0, 2, 0, 0.1),
+            (12.0, 5.0, 1, 7, 0.05),
+        ] {
+            let mut p = params(w, r, a, n);
+            p.point_a = v2(3.0, -7.0);
+            p.point_b = v2(40.0, 80.0);
+            p.turn.max_curvature_rate = rate;
+            let plan = AbPlan::new(p.clone()).unwrap();
+            assert!(!plan.turns.is_empty());
+            let mut pos = Some((0u64, 0usize));
+            let (mut cached, mut solved) = (Vec::new(), Vec::new());
+            for _ in 0..(if n == 0 {
+                3 * plan.block_size()
+            } else {
+                n as usize
+            }) {
+                let Some(from) = pos else { break };
+                let Some(to) = plan.next_position(from.0, from.1) else {
+                    break;
+                };
+                cached.clear();
+                solved.clear();
+                plan.turn_points(from, to, &mut cached).unwrap();
+                let (e1, dir1, s2) = plan.turn_ends(from, to);
+                let gap = cross(&dir1, &(s2 - e1)).abs();
+                forward_turn(e1, dir1, s2, gap, &p.turn, &mut solved).unwrap();
+                // The same curve: an arc's step count can differ by one between frames (its
+                // sweep at a multiple of the step), so the points are compared with the other's
+                // polyline, within the chords' sag (5° steps at r_min 4–5 m: under 5 mm).
+                let what = format!("{w} {r} {a} {n} {rate} {from:?}");
+                assert!(hausdorff(&cached, &solved) < 0.01, "{what}");
+                assert!(hausdorff(&solved, &cached) < 0.01, "{what}");
+                let (lc, ls) = (polyline_length(&cached), polyline_length(&solved));
+                assert!((lc - ls).abs() < 0.005 * ls, "{what}: {lc} vs {ls} m");
+                assert!(cached.iter().all(|q| q.tag == solved[0].tag), "{what}");
+                assert_eq!(cached.first().map(|q| q.pos), Some(e1));
+                assert_eq!(cached.last().map(|q| q.pos), Some(s2));
+                pos = Some(to);
+            }
         }
     }
 
