@@ -50,7 +50,7 @@ pub(super) fn cc_pi_turn(
     params: &TurnParams,
     out: &mut Vec<PathPoint>,
 ) -> bool {
-    use crate::geo::{Direction, Pose, Tag};
+    use crate::geo::{Direction, Pose};
     use crate::plan::maneuver::path::{CurvePath, CurveSegment};
     let (quarter, q) = cc_quarter_turn(params, cross(&dir1, &n) > 0.0);
     let start = Pose::new(p1.x, p1.y, dir1.y.atan2(dir1.x));
@@ -63,19 +63,7 @@ pub(super) fn cc_pi_turn(
     segments.extend(quarter);
     let mut samples = Vec::new();
     CurvePath { start, segments }.sample(params.point_spacing.min(0.5), &mut samples);
-    let first = out.len();
-    out.extend(samples.iter().map(|s| PathPoint {
-        pos: s.pose.pos,
-        tag: Tag::Turn,
-        direction: Direction::Forward,
-    }));
-    // Exact ends, as the arc turns.
-    if let Some(q) = out.get_mut(first) {
-        q.pos = p1;
-    }
-    if let Some(q) = out.last_mut() {
-        q.pos = p2;
-    }
+    append_turn(out, &samples, p1, p2, |pos| pos);
     true
 }
 
@@ -97,7 +85,7 @@ pub(super) fn cc_bulb_turn(
     params: &TurnParams,
     out: &mut Vec<PathPoint>,
 ) -> bool {
-    use crate::geo::{Direction, Pose, Tag};
+    use crate::geo::{Direction, Pose};
     use crate::plan::maneuver::cc_turn::cc_turn;
     use crate::plan::maneuver::path::{CurveParams, CurvePath};
     use std::f64::consts::{FRAC_PI_2, PI};
@@ -147,11 +135,24 @@ pub(super) fn cc_bulb_turn(
         return false;
     }
     // Canonical (x along dir1, y toward the next line) into the world.
+    append_turn(out, &samples, p1, p2, |pos| p1 + dir1 * pos.x + n * pos.y);
+    true
+}
+
+/// Append the sampled turn to `out`, each position moved by `place`, its ends exactly `p1` and
+/// `p2` (as the arc turns have them).
+fn append_turn(
+    out: &mut Vec<PathPoint>,
+    samples: &[crate::plan::maneuver::path::PathSample],
+    p1: Vec2,
+    p2: Vec2,
+    place: impl Fn(Vec2) -> Vec2,
+) {
     let first = out.len();
     out.extend(samples.iter().map(|s| PathPoint {
-        pos: p1 + dir1 * s.pose.pos.x + n * s.pose.pos.y,
-        tag: Tag::Turn,
-        direction: Direction::Forward,
+        pos: place(s.pose.pos),
+        tag: crate::geo::Tag::Turn,
+        direction: crate::geo::Direction::Forward,
     }));
     if let Some(q) = out.get_mut(first) {
         q.pos = p1;
@@ -159,7 +160,6 @@ pub(super) fn cc_bulb_turn(
     if let Some(q) = out.last_mut() {
         q.pos = p2;
     }
-    true
 }
 
 /// Whether the sampled path crosses itself (two segments that are not neighbours intersect).
