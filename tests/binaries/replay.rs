@@ -32,6 +32,10 @@ fn us(t: f64) -> f64 {
 /// Run `seconds` of a job closed-loop, logging to `log`; returns (control periods, fix
 /// periods, engaged periods).
 fn closed_loop(cfg: &Config, seconds: f64, log: &BusLog) -> (u64, u64, u64) {
+    let log = &Paced {
+        log,
+        sent: std::cell::Cell::new(0),
+    };
     let mut node = agsteer::job::node_for_config(cfg, None).unwrap();
     let a = v2(cfg.job.point_a_m[0], cfg.job.point_a_m[1]);
     let b = v2(cfg.job.point_b_m[0], cfg.job.point_b_m[1]);
@@ -120,6 +124,31 @@ fn closed_loop(cfg: &Config, seconds: f64, log: &BusLog) -> (u64, u64, u64) {
         while let Ok(Some(_)) = terminal_bus.try_recv() {}
     }
     (ticks, fix_ticks, engaged)
+}
+
+/// The bus log fed at the pace its writer keeps: the simulated run is ~600× faster than real
+/// time, so on a loaded host the writer thread could fall a whole channel behind and drop
+/// frames, which a real bus (frames at real time) never does. `record` waits while the channel
+/// is nearly full; what is recorded is unchanged.
+struct Paced<'a> {
+    log: &'a BusLog,
+    sent: std::cell::Cell<u64>,
+}
+
+impl Paced<'_> {
+    fn record(&self, t: f64, frame: &Frame) {
+        let room = agsteer::daemon::bus_log::CHANNEL_FRAMES as u64 / 2;
+        // At most 10 s: a writer that stopped shows as drops, as before.
+        for _ in 0..10_000 {
+            let s = self.log.stats();
+            if self.sent.get() < s.lines + s.dropped + room {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        self.sent.set(self.sent.get() + 1);
+        self.log.record(t, frame);
+    }
 }
 
 fn replay(files: &[PathBuf], set: &[&str]) -> serde_json::Value {
