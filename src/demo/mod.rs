@@ -361,8 +361,8 @@ pub fn tracker_name(kind: TrackerChoice) -> &'static str {
     kind.name()
 }
 
-/// A default time budget: three times the time to drive every line and turn.
-fn default_max_time(cfg: &Config) -> f64 {
+/// A default time budget: three times the time to drive every line and turn at `speed`.
+fn default_max_time(cfg: &Config, speed: f64) -> f64 {
     let ab = v2(
         cfg.job.point_b_m[0] - cfg.job.point_a_m[0],
         cfg.job.point_b_m[1] - cfg.job.point_a_m[1],
@@ -373,8 +373,8 @@ fn default_max_time(cfg: &Config) -> f64 {
     } else {
         cfg.job.line_num
     } as f64;
-    let per_line = ab + 4.0 * cfg.vehicle.r_min_m + 20.0 * cfg.job.line_width_m;
-    60.0 + 3.0 * lines * per_line / cfg.speed().max(0.1)
+    let per_line = ab + 4.0 * cfg.turn_radius() + 20.0 * cfg.job.line_width_m;
+    60.0 + 3.0 * lines * per_line / speed
 }
 
 /// Run the job closed-loop. `on_progress` is called at every line change with the snapshot to
@@ -445,13 +445,20 @@ pub fn run(
     let mut terminal_bus = bus_ctrl.node();
     let mut terminal = Packer::new(0x26);
     let dt = resolved.control.dt;
+    // The time budget at the slowest speed the driver keeps: with a speed profile the turns
+    // are driven at its minimum (at 20 km/h the turns of 19 m radius are most of a block's
+    // length, and at 4 km/h they took more than three times the job at the job speed).
+    let budget_speed = sim_setup
+        .speed_profile
+        .map_or(speed, |p| p.min.min(speed))
+        .max(0.1);
     let max_time = if sim_setup.max_time > 0.0 {
         sim_setup.max_time
     } else if let JobPlan::Segments(job) = node.controller().guidance().job_plan() {
         let length: f64 = job.segments().iter().map(|s| s.length()).sum();
-        60.0 + 3.0 * length / speed.max(0.1)
+        60.0 + 3.0 * length / budget_speed
     } else {
-        default_max_time(cfg)
+        default_max_time(cfg, budget_speed)
     };
 
     let mut stats = XteStats::default();
