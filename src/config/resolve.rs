@@ -250,6 +250,13 @@ impl Config {
                     heading: t.lqr_heading_deg.to_radians(),
                     rate_fraction: t.lqr_rate_fraction,
                 },
+                curvature: crate::track::CurvatureScaleParams {
+                    gain: t.curvature_gain_per_m_s,
+                    limit: t.curvature_scale_limit,
+                    capture: t.integral_capture_m,
+                    min_speed: t.integral_min_speed_mps,
+                    max_heading_error: crate::track::CURVATURE_SCALE_MAX_HEADING_ERROR,
+                },
             },
             integral: IntegralParams {
                 gain: t.integral_gain_rad_per_m_s,

@@ -64,6 +64,13 @@ pub struct TrackConfig {
     pub integral_capture_m: f64,
     /// The integral action learns only above this speed, m/s.
     pub integral_min_speed_mps: f64,
+    /// Curvature scale (the default tracker; `track::CurvatureScale`): how fast the wheel
+    /// angle curves need beyond the kinematic model's (wheelbase error, understeer, antenna
+    /// along the vehicle) is learnt on curved work paths, 1/(m · s); 0 = off, else ≤ 5. It
+    /// learns within `integral_capture_m` and above `integral_min_speed_mps`.
+    pub curvature_gain_per_m_s: f64,
+    /// Largest curvature scale learnt (a fraction of the curve's wheel angle), 0..=0.5.
+    pub curvature_scale_limit: f64,
     /// Disturbance observer (predictive tracker only; see
     /// [`ObserverParams`](crate::estimate::ObserverParams)): time constant of the wheel-angle
     /// offset estimate, s (0 = off, else 1..=600).
@@ -130,6 +137,8 @@ impl Default for TrackConfig {
             integral_limit_deg: 3.0,
             integral_capture_m: 0.3,
             integral_min_speed_mps: 0.5,
+            curvature_gain_per_m_s: 0.5,
+            curvature_scale_limit: 0.3,
             observer_bias_tau_s: 20.0,
             observer_drift_tau_s: 60.0,
             observer_min_speed_mps: 1.0,
@@ -203,6 +212,13 @@ impl TrackConfig {
         );
         c.range("track.integral_limit_deg", t.integral_limit_deg, 0.0, 10.0);
         c.range("track.integral_capture_m", t.integral_capture_m, 0.01, 5.0);
+        c.range(
+            "track.curvature_gain_per_m_s",
+            t.curvature_gain_per_m_s,
+            0.0,
+            5.0,
+        );
+        c.range("track.curvature_scale_limit", t.curvature_scale_limit, 0.0, 0.5);
         c.range(
             "track.integral_min_speed_mps",
             t.integral_min_speed_mps,

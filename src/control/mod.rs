@@ -15,7 +15,9 @@ use crate::guidance::progress::{JobDefinition, Progress};
 use crate::guidance::{Guidance, GuidanceError, JobPlan};
 use crate::track::law::SteeringLaw;
 use crate::track::lost_motion::LostMotion;
-use crate::track::{registry, steering_from_travel, travel_pose, IntegralAction, TrackOutput};
+use crate::track::{
+    registry, steering_from_travel, travel_pose, CurvatureScale, IntegralAction, TrackOutput,
+};
 
 pub mod isobus;
 pub mod node;
@@ -71,6 +73,8 @@ pub struct Controller {
     guidance: Guidance,
     law: Box<dyn SteeringLaw>,
     integral: IntegralAction,
+    /// The learnt error of the wheel angle curves need (`track::CurvatureScale`).
+    curvature: CurvatureScale,
     /// Time of the previous tick, s.
     last_tick: Option<f64>,
     /// Approach paths (`guidance.approach_paths`), `None` when off.
@@ -113,6 +117,11 @@ impl Controller {
             estimator: Estimator::new(params.estimator_for(needs)),
             guidance,
             integral: params.integral_for(needs, 0.0),
+            curvature: CurvatureScale::new(
+                params.law.curvature.for_needs(needs),
+                params.tracker.wheelbase,
+                0.0,
+            ),
             last_tick: None,
             approach: params.approach.map(|params| ApproachSettings {
                 params,
@@ -285,6 +294,18 @@ impl Controller {
         let mut offset = self
             .integral
             .update(out.xte.unwrap_or(f64::NAN), est.speed, dt, learning);
+        // Curves: the wheel angle the path's curvature needs beyond the model's, learnt (only
+        // laws that report the path's curvature, in the vehicle's frame after the reversal).
+        offset += self.curvature.update(
+            (
+                out.xte.unwrap_or(f64::NAN),
+                out.heading_error.unwrap_or(f64::NAN),
+            ),
+            tr.path_curvature,
+            est.speed,
+            dt,
+            learning,
+        );
         if needs.observer {
             // The steering controller servos the sensed angle to the command, so a sensor
             // reading `wheel_offset` more than the wheels leaves them short by as much:
@@ -328,6 +349,11 @@ impl Controller {
         }
         let needs = self.law.needs();
         self.integral = params.integral_for(needs, self.integral.offset);
+        self.curvature = CurvatureScale::new(
+            params.law.curvature.for_needs(needs),
+            params.tracker.wheelbase,
+            self.curvature.scale,
+        );
         self.lost_motion.set_params(params.lost_motion_for(needs));
         self.estimator.set_params(params.estimator_for(needs));
         self.params = ControlParams {

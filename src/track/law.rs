@@ -39,6 +39,8 @@ pub struct LawParams {
     pub stanley_soft_speed: f64,
     /// The LQR's cost.
     pub lqr: super::lqr::LqrWeights,
+    /// The curvature scale's learning (laws that report the path's curvature).
+    pub curvature: super::CurvatureScaleParams,
 }
 
 /// A steering law.

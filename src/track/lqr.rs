@@ -266,6 +266,7 @@ impl SteeringLaw for Lqr {
             lookahead: preview,
             target: point_along(points, i, preview),
             alpha: -psi,
+            path_curvature: 0.0,
             valid: true,
         }
     }
@@ -327,6 +328,7 @@ mod tests {
             stanley_gain: 2.5,
             stanley_soft_speed: 1.0,
             lqr: LqrWeights::default(),
+            curvature: Default::default(),
         }
     }
 

@@ -111,6 +111,9 @@ pub struct TrackOutput {
     pub target: Vec2,
     /// Angle from the heading to the preview point, rad.
     pub alpha: f64,
+    /// The path's own curvature at the preview point, 1/m (positive left); 0 from laws that do
+    /// not report it (then [`CurvatureScale`] neither learns nor adds anything).
+    pub path_curvature: f64,
     pub valid: bool,
 }
 
@@ -124,6 +127,7 @@ impl TrackOutput {
             lookahead,
             target,
             alpha: 0.0,
+            path_curvature: 0.0,
             valid: false,
         }
     }
@@ -149,6 +153,7 @@ pub fn steering_from_travel(out: TrackOutput, direction: Direction) -> TrackOutp
             wheel_angle: -out.wheel_angle,
             curvature: -out.curvature,
             alpha: -out.alpha,
+            path_curvature: -out.path_curvature,
             ..out
         },
     }
@@ -190,6 +195,136 @@ pub fn point_along(points: &[Vec2], start: usize, distance: f64) -> Vec2 {
         }
     }
     points.last().copied().unwrap_or_else(Vec2::zeros)
+}
+
+/// The curvature of the local path at `distance` along it from sample `start`, 1/m (positive
+/// left): the circle through the points `distance` − `half`, `distance` and `distance` + `half`
+/// along it (0 where they are collinear or coincide). Allocation-free.
+pub fn curvature_along(points: &[Vec2], start: usize, distance: f64, half: f64) -> f64 {
+    let a = point_along(points, start, (distance - half).max(0.0));
+    let b = point_along(points, start, distance);
+    let c = point_along(points, start, distance + half);
+    let (ab, bc, ac) = (b - a, c - b, c - a);
+    let denom = ab.norm() * bc.norm() * ac.norm();
+    let k = 2.0 * crate::geo::cross(&ab, &bc) / denom;
+    if denom > 1e-9 && k.is_finite() {
+        k
+    } else {
+        0.0
+    }
+}
+
+/// How the curvature scale learns (`track.curvature_gain_per_m_s`,
+/// `track.curvature_scale_limit`; see [`CurvatureScale`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurvatureScaleParams {
+    /// Learning rate, 1/(m of XTE · s); 0 = off.
+    pub gain: f64,
+    /// Largest |scale| (a fraction of the wheel angle the path's curvature asks for).
+    pub limit: f64,
+    /// Learns only while |XTE| is below this, m (`track.integral_capture_m`).
+    pub capture: f64,
+    /// Learns only above this speed, m/s (`track.integral_min_speed_mps`).
+    pub min_speed: f64,
+    /// Learns only while the heading error is below this, rad: the vehicle runs parallel to
+    /// the path, so the XTE is a standing error and not a line start's transient.
+    pub max_heading_error: f64,
+}
+
+impl Default for CurvatureScaleParams {
+    fn default() -> Self {
+        CurvatureScaleParams {
+            gain: 0.0,
+            limit: 0.3,
+            capture: 0.3,
+            min_speed: 0.5,
+            max_heading_error: CURVATURE_SCALE_MAX_HEADING_ERROR,
+        }
+    }
+}
+
+impl CurvatureScaleParams {
+    /// As configured for a law with integral action; off for the others (the references).
+    pub fn for_needs(self, needs: law::LawNeeds) -> Self {
+        CurvatureScaleParams {
+            gain: if needs.integral { self.gain } else { 0.0 },
+            ..self
+        }
+    }
+}
+
+/// The heading error below which the curvature scale learns, rad (1°).
+pub const CURVATURE_SCALE_MAX_HEADING_ERROR: f64 = 0.0175;
+
+/// Paths curving less than this teach the curvature scale nothing, 1/m (R 100 m: the XTE there
+/// is the tracker's own corrections and noise, not a curvature bias).
+pub const CURVATURE_SCALE_MIN_CURVATURE: f64 = 0.01;
+
+/// A learnt error of the wheel angle a curve needs, in proportion to the path's curvature:
+/// the plant turns less (or more) for a wheel angle than the kinematic model with the
+/// configured wheelbase says — a wheelbase that differs from the configured one, tyre slip
+/// that grows with the curvature at the job speed (understeer: δ = κ·(L + K·v²)), an antenna
+/// mounted elsewhere along the vehicle than configured (the heading error on a curve is its
+/// distance over R). A geometric law settles every such error as a standing XTE on a curve,
+/// on the outside for understeer, and a constant-offset integral cannot learn it on lines that
+/// curve both ways. This learns a scale s on curved work paths: ds/dt = −gain · XTE · sign κ,
+/// and adds s · atan(L·κ) to the wheel angle on every path (the turns have the same bias).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurvatureScale {
+    pub params: CurvatureScaleParams,
+    /// The configured wheelbase, m.
+    pub wheelbase: f64,
+    /// The learnt scale (0: the model is right; 0.1: curves need 10 % more wheel angle).
+    pub scale: f64,
+}
+
+impl CurvatureScale {
+    /// A scale learnt with `params` for wheelbase `wheelbase` (m), keeping `learnt` (clamped).
+    pub fn new(params: CurvatureScaleParams, wheelbase: f64, learnt: f64) -> Self {
+        let limit = params.limit.max(0.0);
+        CurvatureScale {
+            params,
+            wheelbase,
+            scale: if learnt.is_finite() {
+                learnt.clamp(-limit, limit)
+            } else {
+                0.0
+            },
+        }
+    }
+
+    /// Learn from one period of `dt` s at cross-track error `xte` (m, positive = left of the
+    /// path) and heading error `heading_error` (rad) on a path of curvature `curvature` (1/m,
+    /// positive left, in the vehicle's frame) at `speed` (m/s) when `learning` (work paths
+    /// driven forward) and within the bounds of [`CurvatureScaleParams`]; return the wheel
+    /// angle to add, rad.
+    pub fn update(
+        &mut self,
+        (xte, heading_error): (f64, f64),
+        curvature: f64,
+        speed: f64,
+        dt: f64,
+        learning: bool,
+    ) -> f64 {
+        let p = self.params;
+        if p.gain <= 0.0 || !curvature.is_finite() {
+            return 0.0;
+        }
+        if learning
+            && xte.is_finite()
+            && xte.abs() < p.capture
+            && heading_error.abs() < p.max_heading_error
+            && curvature.abs() >= CURVATURE_SCALE_MIN_CURVATURE
+            && dt.is_finite()
+            && dt > 0.0
+            && dt < 1.0
+            && speed.abs() >= p.min_speed
+        {
+            let limit = p.limit.max(0.0);
+            self.scale = (self.scale - p.gain * xte * curvature.signum() * dt).clamp(-limit, limit);
+        }
+        self.scale * (self.wheelbase * curvature).atan()
+    }
 }
 
 /// Integral action on the cross-track error: a slowly learnt wheel-angle offset that cancels
@@ -355,6 +490,69 @@ mod tests {
             out.curvature,
             1.0 / r
         );
+        // The path's own curvature at the preview point, left positive; mirrored, right.
+        assert!(
+            (out.path_curvature - 1.0 / r).abs() < 0.03 / r,
+            "path κ {}",
+            out.path_curvature
+        );
+        let mirrored: Vec<Vec2> = lp.points().iter().map(|p| v2(p.x, -p.y)).collect();
+        let k = curvature_along(&mirrored, lp.index_local(), 2.0, 1.0);
+        assert!((k + 1.0 / r).abs() < 0.03 / r, "mirrored κ {k}");
+        let line: Vec<Vec2> = (0..20).map(|i| v2(i as f64 * 0.5, 1.0)).collect();
+        assert_eq!(curvature_along(&line, 0, 3.0, 1.0), 0.0);
+    }
+
+    /// A toy loop: a plant that turns `ratio` times less than the model for a wheel angle
+    /// settles, under a proportional law on a circle, at a standing error on the outside; the
+    /// scale learns until the curve is driven on the line, whichever way it curves.
+    #[test]
+    fn curvature_scale_learns_the_curve_bias_either_way_and_only_when_allowed() {
+        let params = CurvatureScaleParams {
+            gain: 0.5,
+            limit: 0.3,
+            capture: 0.3,
+            min_speed: 0.5,
+            max_heading_error: CURVATURE_SCALE_MAX_HEADING_ERROR,
+        };
+        let (l, r, ratio) = (3.0, 15.0, 1.1);
+        for side in [1.0, -1.0] {
+            let kappa = side / r;
+            let mut s = CurvatureScale::new(params, l, 0.0);
+            let mut xte = 0.0;
+            for _ in 0..3000 {
+                // The law's own correction (2·XTE/Ld² for a 3 m look-ahead) and the scale's
+                // share; the plant turns 1/ratio of the commanded wheel angle's curvature; the
+                // error moves by the curvature shortfall (steady state of pure pursuit).
+                let add = s.update((xte, 0.0), kappa, 3.0, 0.02, true);
+                let delta = (l * kappa).atan() + add - 2.0 * xte / 9.0 * l;
+                let driven = delta.tan() / (l * ratio);
+                xte += (driven - kappa) * 9.0 / 2.0 * side.abs() * 0.02 * 5.0;
+            }
+            assert!((s.scale - (ratio - 1.0)).abs() < 0.02, "scale {}", s.scale);
+            assert!(xte.abs() < 0.002, "xte {xte}");
+        }
+        // Nothing is learnt on a straight, off the line, turning hard, slowly, on a turn, or
+        // from NaN; it is clamped; gain 0 adds nothing.
+        let mut s = CurvatureScale::new(params, l, 0.0);
+        for (xte, he, k, v, learn) in [
+            (0.05, 0.0, 0.001, 3.0, true),
+            (0.5, 0.0, 0.1, 3.0, true),
+            (0.05, 0.05, 0.1, 3.0, true),
+            (0.05, 0.0, 0.1, 0.1, true),
+            (0.05, 0.0, 0.1, 3.0, false),
+            (f64::NAN, 0.0, 0.1, 3.0, true),
+        ] {
+            s.update((xte, he), k, v, 0.1, learn);
+            assert_eq!(s.scale, 0.0, "learnt from {xte} {he} {k} {v} {learn}");
+        }
+        for _ in 0..10_000 {
+            s.update((-0.2, 0.0), 0.1, 3.0, 0.1, true);
+        }
+        assert_eq!(s.scale, 0.3, "clamped");
+        assert_eq!(CurvatureScale::new(params, l, 0.9).scale, 0.3);
+        let off = CurvatureScaleParams { gain: 0.0, ..params };
+        assert_eq!(CurvatureScale::new(off, l, 0.2).update((0.1, 0.0), 0.1, 3.0, 0.1, true), 0.0);
     }
 
     /// Closed loop on the kinematic bicycle model: backing along a straight line from 0.5 m

@@ -5,7 +5,9 @@
 
 use super::law::{LawNeeds, SteeringLaw};
 use super::local_path::LocalPath;
-use super::{lookahead, point_along, scheduled_lookahead, TrackOutput, TrackerParams};
+use super::{
+    curvature_along, lookahead, point_along, scheduled_lookahead, TrackOutput, TrackerParams,
+};
 use crate::geo::{cross, heading_vec, Pose};
 
 /// Pure pursuit with what the controller feeds it chosen by `needs`.
@@ -81,6 +83,9 @@ impl SteeringLaw for PurePursuit {
     }
 }
 
+/// Half the chord over which the path's curvature at the preview point is measured, m.
+const PATH_CURVATURE_HALF_M: f64 = 1.0;
+
 /// Seed-000 pure pursuit: from the nearest local point integrate the look-ahead along the
 /// local path to the preview point; α is the angle from the heading to it;
 /// κ = 2·sin α / Ld and δ = atan(L·κ).
@@ -124,6 +129,7 @@ pub fn pure_pursuit_at(
         lookahead: ld,
         target,
         alpha,
+        path_curvature: curvature_along(points, local.index_local(), ld, PATH_CURVATURE_HALF_M),
         valid: true,
     }
 }

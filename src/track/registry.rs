@@ -88,6 +88,7 @@ mod tests {
             stanley_gain: 2.5,
             stanley_soft_speed: 1.0,
             lqr: Default::default(),
+            curvature: Default::default(),
         };
         let tracker = TrackerParams {
             wheelbase: 3.0,

@@ -95,6 +95,7 @@ pub fn stanley(
         lookahead: (points[i] - pose.pos).norm(),
         target: points[i],
         alpha: cross(&h, &(points[i] - pose.pos)).atan2(h.dot(&(points[i] - pose.pos))),
+        path_curvature: 0.0,
         valid: true,
     }
 }
