@@ -218,7 +218,12 @@ impl TrackConfig {
             0.0,
             5.0,
         );
-        c.range("track.curvature_scale_limit", t.curvature_scale_limit, 0.0, 0.5);
+        c.range(
+            "track.curvature_scale_limit",
+            t.curvature_scale_limit,
+            0.0,
+            0.5,
+        );
         c.range(
             "track.integral_min_speed_mps",
             t.integral_min_speed_mps,

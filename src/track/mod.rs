@@ -551,8 +551,14 @@ mod tests {
         }
         assert_eq!(s.scale, 0.3, "clamped");
         assert_eq!(CurvatureScale::new(params, l, 0.9).scale, 0.3);
-        let off = CurvatureScaleParams { gain: 0.0, ..params };
-        assert_eq!(CurvatureScale::new(off, l, 0.2).update((0.1, 0.0), 0.1, 3.0, 0.1, true), 0.0);
+        let off = CurvatureScaleParams {
+            gain: 0.0,
+            ..params
+        };
+        assert_eq!(
+            CurvatureScale::new(off, l, 0.2).update((0.1, 0.0), 0.1, 3.0, 0.1, true),
+            0.0
+        );
     }
 
     /// Closed loop on the kinematic bicycle model: backing along a straight line from 0.5 m
