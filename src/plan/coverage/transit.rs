@@ -469,8 +469,7 @@ pub fn route_graph(
     // Edges whose points were checked: (parent, state) → (word, length); `None` when no word
     // is clear. When a state's best offer turns out blocked or longer than queued, the offers
     // of its expanded neighbours that were not queued are queued then, at their known lengths.
-    let mut checked: HashMap<(u32, u32), Option<(u8, f64)>, BuildHasherDefault<EdgeHasher>> =
-        HashMap::default();
+    let mut checked: CheckedEdges = HashMap::default();
     let mut from_start = vec![false; states];
     let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::new();
     // Queue the start's neighbours with their shortest words' lengths.
@@ -652,6 +651,10 @@ pub fn route_graph(
     }
     None
 }
+
+/// Edges of the waypoint search whose points were checked: (parent, state) → the first clear
+/// word and its length, `None` when none is clear.
+type CheckedEdges = HashMap<(u32, u32), Option<(u8, f64)>, BuildHasherDefault<EdgeHasher>>;
 
 /// Hasher of the search's edge keys (two state indices): one multiply-rotate per word, where
 /// the standard SipHash cost as much as the lookups it served.
