@@ -3,6 +3,9 @@
 //! input (issue 19 point 5). Each path runs beside its baseline, measured in the same run under
 //! the same load: for fixes on the bus an echo on the bus; for fixes over a pseudo-terminal the
 //! kernel's own pty path (bytes written → a blocking read returns), at the daemon's priority.
+//! The daemon records each fix's times (`AGSTEER_FIX_TRACE`), and `FIX-SPLIT` splits the
+//! arrival → command time at them: the kernel's delivery and the daemon's wake-up, its queue,
+//! the control period, the send.
 
 use super::support::*;
 use std::time::Duration;
@@ -15,6 +18,68 @@ fn is_position(id: u32) -> bool {
 /// The simulator's pseudo-terminal link and epoch log for the serial runs.
 const SERIAL_LINK: &str = "/tmp/gnss-receiver-latency";
 const SERIAL_LOG: &str = "/tmp/agsteer-gnss-latency.csv";
+
+/// The daemon's per-fix times (`AGSTEER_FIX_TRACE`) for the runs here.
+const FIX_TRACE: &str = "/tmp/agsteer-fix-trace.csv";
+
+/// Each fix's arrival → command split at the daemon's own times (`AGSTEER_FIX_TRACE`: read,
+/// taken by the loop, frames ready, handed to the socket; realtime s): arrival → read (the
+/// kernel's delivery and the daemon's wake-up), read → taken, taken → ready (the control
+/// period), ready → left, and left → the command frame's candump time. Medians and p90, ms.
+fn print_fix_split(path: &str, fixes: &[f64], cap: &[(f64, u32, Vec<u8>)]) {
+    let rows: Vec<[f64; 4]> = std::fs::read_to_string(FIX_TRACE)
+        .unwrap_or_default()
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let v: Vec<f64> = l.split(',').filter_map(|x| x.parse().ok()).collect();
+            (v.len() == 4).then(|| [v[0], v[1], v[2], v[3]])
+        })
+        .collect();
+    let cmds: Vec<f64> = steering_frames(cap).iter().map(|c| c.0).collect();
+    // Each arrival paired with the first trace row read at or after it, within 50 ms. The
+    // fix → next command figures below count the next command frame of any period: a fix
+    // read later than the timer's next period is "answered" by that period's command, which
+    // did not use it; the split shows the fix's own command.
+    let mut parts: [Vec<f64>; 5] = Default::default();
+    let mut k = 0;
+    for &a in fixes {
+        while k < rows.len() && rows[k][0] < a {
+            k += 1;
+        }
+        let Some(r) = rows.get(k) else { break };
+        if r[0] - a > 0.05 {
+            continue;
+        }
+        let c = cmds.partition_point(|c| *c < r[3] - 0.0005);
+        let Some(cmd) = cmds.get(c) else { break };
+        // A capture gap (candump starved by the guest's real-time load drops frames) or a
+        // row the writer thread had not written when the daemon was killed: left out.
+        if cmd - r[3] > 0.05 {
+            continue;
+        }
+        let v = [r[0] - a, r[1] - r[0], r[2] - r[1], r[3] - r[2], cmd - r[3]];
+        for (p, x) in parts.iter_mut().zip(v) {
+            p.push(x);
+        }
+    }
+    for p in parts.iter_mut() {
+        p.sort_by(|a, b| a.total_cmp(b));
+    }
+    let f = |v: &[f64]| format!("{:.3}/{:.3}", pct(v, 0.5) * 1e3, pct(v, 0.9) * 1e3);
+    println!(
+        "FIX-SPLIT path={path} median/p90 ms: arrival→read {} read→taken {} taken→ready {} \
+         ready→left {} left→frame {} over {} of {} fixes ({} traced)",
+        f(&parts[0]),
+        f(&parts[1]),
+        f(&parts[2]),
+        f(&parts[3]),
+        f(&parts[4]),
+        parts[0].len(),
+        fixes.len(),
+        rows.len()
+    );
+}
 
 /// Where the fixes come from.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -167,11 +232,14 @@ fn fix_to_command_run(iface: &str, priority: i32, path: GnssPath) -> FixLatency 
     let device = format!("gnss.device=\"{SERIAL_LINK}\"");
     let mut daemon_args = vec!["--set", rt.as_str()];
     let mut sim_args = Vec::new();
+    let _ = std::fs::remove_file(FIX_TRACE);
+    std::env::set_var("AGSTEER_FIX_TRACE", FIX_TRACE);
     if path == GnssPath::Serial {
         daemon_args.extend(serial_gnss_args(&device));
         sim_args.extend(["--gnss-pty", SERIAL_LINK, "--gnss-log", SERIAL_LOG]);
     }
     let daemon = start_daemon(&daemon_args);
+    std::env::remove_var("AGSTEER_FIX_TRACE");
     let sim = start_sim(iface, &sim_args);
     let mut term = Terminal::new(iface);
     assert!(term.engage(Duration::from_secs(15)), "{name}: engaged");
@@ -229,6 +297,7 @@ fn fix_to_command_run(iface: &str, priority: i32, path: GnssPath) -> FixLatency 
             .filter(|t| *t >= t_start)
             .collect(),
     };
+    print_fix_split(name, &fixes, &cap);
     let mut l = fix_latency(name, &fixes, &cap, &stalls, 0.01);
     l.baseline_median = pct(&b_net, 0.5);
     println!(
@@ -248,23 +317,25 @@ fn fix_to_command_both(priority: i32) {
         idle_median * 1e6,
         idle_p99 * 1e6
     );
-    for path in [GnssPath::Can, GnssPath::Serial] {
-        let l = fix_to_command_run(&iface, priority, path);
-        let name = path.name();
+    let can = fix_to_command_run(&iface, priority, GnssPath::Can);
+    let serial = fix_to_command_run(&iface, priority, GnssPath::Serial);
+    let (can_median, serial_median) = (pct(&can.net, 0.5), pct(&serial.net, 0.5));
+    println!(
+        "GNSS-TO-COMMAND serial/can median ratio={:.2} (less stalls: serial {:.3} ms, can {:.3} ms)",
+        serial_median / can_median,
+        serial_median * 1e3,
+        can_median * 1e3
+    );
+    for (name, l) in [("can", &can), ("serial", &serial)] {
         assert!(l.net.len() > 100, "{name}: {} fixes", l.net.len());
-        // Bus fixes: issue 16 point 7's median. Serial fixes are printed, not asserted: issue
-        // 19 point 5 (the same latency for serial input) is not met. In the clean-clone CI run
-        // of 2026-12-02 (quiet host) the serial median was 2.19 ms less stalls beside a pty
-        // baseline of 0.31 ms, p99 5.1 ms; the daemon's own read → command share was within
-        // 1 ms for 45 % of fixes, within 2 ms for 92 % (the bus path: 40 % and 83 %).
-        if path == GnssPath::Can {
-            assert!(
-                pct(&l.net, 0.5) <= 0.002,
-                "{name}: GNSS → command median {} ms less stalls (bound 2 ms)",
-                pct(&l.net, 0.5) * 1e3
-            );
-        }
     }
+    // Bus fixes: issue 16 point 7's median (both paths run first, so a failure here still
+    // prints the serial figures). Serial fixes are printed, not asserted (see the README).
+    assert!(
+        can_median <= 0.002,
+        "can: GNSS → command median {} ms less stalls (bound 2 ms)",
+        can_median * 1e3
+    );
 }
 
 /// Fixes on the bus, then over a pseudo-terminal, at dt = 10 ms, each beside its baseline.

@@ -8,6 +8,7 @@
 
 pub mod bus_log;
 pub mod calibration;
+pub mod fix_trace;
 pub mod gnss;
 pub mod loop_stats;
 pub mod notify;

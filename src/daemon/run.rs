@@ -282,6 +282,8 @@ struct Outputs {
     progress: mpsc::SyncSender<Progress>,
     log: Option<BusLog>,
     calibration: super::calibration::CalibrationRunner,
+    /// `AGSTEER_FIX_TRACE`: each fix's times to a file.
+    trace: Option<super::fix_trace::FixTrace>,
 }
 
 impl Outputs {
@@ -372,6 +374,15 @@ impl Outputs {
         count_by(&mut p.send, &FIX_PHASE_EDGES_US, us(ready, left));
         stats.last_step_us = start.elapsed().as_secs_f64() * 1e6;
         stats.max_step_us = stats.max_step_us.max(stats.last_step_us);
+        if let Some(trace) = &self.trace {
+            trace.record(super::fix_trace::FixRecord {
+                read: fix.read,
+                taken: fix.taken,
+                ready,
+                left,
+                utc_offset: super::fix_trace::utc_offset(),
+            });
+        }
     }
 }
 
@@ -504,6 +515,7 @@ async fn run_async(
         }
         None => None,
     };
+    let fix_trace = super::fix_trace::FixTrace::from_env();
     // Helper threads exist now; only the control loop's thread gets real-time priority.
     set_realtime_priority(resolved.daemon.realtime_priority);
 
@@ -564,6 +576,7 @@ async fn run_async(
         progress: progress_tx,
         log: bus_log,
         calibration: super::calibration::CalibrationRunner::new(resolved.daemon.state_dir.clone()),
+        trace: fix_trace,
     };
     let mut stats = LoopStats {
         bus_up: true,
