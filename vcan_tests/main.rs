@@ -91,7 +91,8 @@ fn recv_within(bus: &mut SocketCanBus, d: Duration) -> Option<agsteer::can::Time
 fn a_closed_loop_job_on_vcan() {
     let Some(iface) = vcan() else { return };
     let cfg = agsteer::config::Config::load(std::path::Path::new(CONFIG), &[]).unwrap();
-    let daemon = start_daemon(&[]);
+    // The daemon above the simulator (FIFO 70 against 60): see the gap check at the end.
+    let daemon = start_daemon(&["--set", "daemon.realtime_priority=70"]);
     let probe = StallProbe::start();
     let dump = Candump::start(&iface);
     let traj = "/tmp/agsteer-trajectory.csv";
@@ -155,10 +156,11 @@ fn a_closed_loop_job_on_vcan() {
     assert!(rms < 0.05, "true XTE RMS {rms}");
     // At dt = 10 ms, 99.9 % of the gaps less the time the whole guest was frozen (see
     // `StallProbe`) within 2·dt, and every one within 3·dt (no period lost twice in a row).
-    // Not every one within 2·dt as at dt = 20 ms (test b): the guest is one emulated vCPU that
-    // the simulator (FIFO 60, standing for other ECUs) shares above the daemon, and pauses
-    // shorter than the probe's resolution are not subtracted. CI saw one such gap (2026-12-02):
-    // 23.1 ms less the recorded pauses, 1 of 4742, the others all within 22 ms.
+    // Not every one within 2·dt as at dt = 20 ms (test b): pauses shorter than the probe's
+    // resolution are not subtracted, and at dt = 10 ms they reach a period. CI saw one gap of
+    // 23.1 ms less the recorded pauses in 4742 (2026-12-02) and, with the simulator above the
+    // daemon, one of 88.7 ms: the simulator's CPU time (it stands for separate processors)
+    // charged to the daemon. So the daemon runs above it here, as in the latency test.
     capture_checks(&lines, dropped, &stalls, 0.01, 0.999);
 }
 
