@@ -350,8 +350,8 @@ fn l_fix_to_command_latency_dt_10ms() {
     fix_to_command_both(70);
 }
 
-/// The same with the simulator above the daemon (config/vcan.toml's FIFO 50 against 60), the
-/// arrangement of the other vcan tests: how much the simulator's CPU time adds.
+/// The same with the simulator above the daemon (FIFO 50 against 60, the vcan tests'
+/// arrangement before 2026-12-03): how much the simulator's CPU time adds.
 #[test]
 #[ignore = "an experiment: run with --ignored"]
 fn l_fix_to_command_latency_dt_10ms_sim_above_daemon() {

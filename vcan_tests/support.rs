@@ -364,9 +364,12 @@ impl Drop for Proc {
 pub const CONFIG: &str = "config/vcan.toml";
 
 /// SCHED_FIFO priority of the simulator: it stands for the tractor's own ECUs and GNSS
-/// receiver, separate hardware in the field, so on the guest's one vCPU it runs above the
-/// daemon (`daemon.realtime_priority` = 50 in config/vcan.toml), below the [`StallProbe`], and
-/// the daemon's CPU use cannot make its inputs stale. It sleeps 2 ms per loop.
+/// receiver, separate hardware in the field. On the guest's one vCPU it runs below the daemon
+/// (`daemon.realtime_priority` = 70 in config/vcan.toml, since 2026-12-03; 50 before) and the
+/// [`StallProbe`]: above the daemon it charged its own CPU time to the daemon's figures (fix →
+/// command medians doubled, one 88.7 ms command gap at dt 10 ms). The daemon's step (about
+/// 1 ms under emulation) delays the simulator's 2 ms loop instead, far inside every input
+/// timeout.
 pub const SIM_PRIORITY: u8 = 60;
 
 /// Start `agsteer sim` on `iface` with `extra` arguments, at [`SIM_PRIORITY`].
