@@ -339,7 +339,7 @@ fn fix_to_command_both(priority: i32) {
 }
 
 /// Fixes on the bus, then over a pseudo-terminal, at dt = 10 ms, each beside its baseline, with
-/// the daemon above the simulator (SCHED_FIFO 70 against 60). The simulator stands for the
+/// the daemon at config/vcan.toml's priority, above the simulator (SCHED_FIFO 70 against 60). The simulator stands for the
 /// GNSS receiver and the other ECUs, separate processors on a tractor; on the guest's one vCPU
 /// at 60 it would charge each fix with its own CPU time after it sends the fix (one
 /// `tools/vcan-vm` boot on a quiet host, 2026-12-03: bus median 2.54 ms with it above, 1.30 ms
@@ -347,7 +347,8 @@ fn fix_to_command_both(priority: i32) {
 /// kernel's pty worker set the tail; see the README).
 #[test]
 fn l_fix_to_command_latency_dt_10ms() {
-    fix_to_command_both(70);
+    let cfg = agsteer::config::Config::load(std::path::Path::new(CONFIG), &[]).unwrap();
+    fix_to_command_both(i32::from(cfg.daemon.realtime_priority));
 }
 
 /// The same with the simulator above the daemon (FIFO 50 against 60, the vcan tests'
