@@ -90,6 +90,8 @@ pub struct ControllerNode {
     quality: Option<(f64, FixQuality)>,
     status_every: u64,
     ticks: u64,
+    /// Time of the previous control period, s (a late one is a pause of the loop's).
+    last_tick_t: Option<f64>,
     status: NodeStatus,
     cusps: CuspParams,
     /// A stop for a change of direction is under way (from the stop request until the vehicle
@@ -125,6 +127,9 @@ struct CuspParams {
 }
 
 /// Control periods between two status frames (at least 1).
+/// A control period this many dt after the previous one follows a pause of the loop's.
+const LATE_PERIOD: f64 = 1.5;
+
 fn status_every(status_period: f64, dt: f64) -> u64 {
     ((status_period / dt).round() as u64).max(1)
 }
@@ -179,6 +184,7 @@ impl ControllerNode {
             quality: None,
             status_every: status_every(bus.status_period, dt),
             ticks: 0,
+            last_tick_t: None,
             cusps: CuspParams {
                 decel: c.decel,
                 stopped_speed: c.stopped_speed,
@@ -582,6 +588,17 @@ impl ControllerNode {
 
     /// One control period at `t`: appends the frames to send.
     pub fn tick(&mut self, t: f64, out: &mut Vec<Frame>) -> Cmd {
+        // A period more than LATE_PERIOD·dt after the previous one: the loop could not run
+        // from when it was due (the previous + dt) until now, and the inputs' timeouts do not
+        // count that (safety::pauses). Judged from the periods' times alone, so a replay of
+        // the bus log reproduces it.
+        let dt = self.ctrl.params().dt;
+        if let Some(prev) = self.last_tick_t.filter(|p| t - p > LATE_PERIOD * dt) {
+            self.supervisor.on_loop_pause(prev + dt, t);
+        }
+        if t.is_finite() {
+            self.last_tick_t = Some(t);
+        }
         // The address claim first: until it stands, nothing else goes out.
         let address = self.iso.begin_tick(t, out);
         if let Some(a) = address {

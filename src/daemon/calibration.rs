@@ -74,24 +74,10 @@ pub fn fit_and_save(session: &Session, state_dir: &std::path::Path) -> Calibrati
     }
 }
 
-/// The calling thread under the normal scheduler, niced: a thread spawned by the control loop
-/// inherits its SCHED_FIFO priority (`daemon.realtime_priority`) and would otherwise run the
-/// fit ahead of, or level with, the control loop.
+/// The fit's thread under the normal scheduler, niced (see [`super::run::normal_scheduling`]).
 fn normal_scheduling() {
-    let param = libc::sched_param { sched_priority: 0 };
-    // SAFETY: both calls act on the calling thread (Linux: pid/who 0 is the caller's thread
-    // id) with valid arguments; failure leaves the thread as it was, which is logged.
-    let (rc, nice) = unsafe {
-        (
-            libc::sched_setscheduler(0, libc::SCHED_OTHER, &param),
-            libc::setpriority(libc::PRIO_PROCESS, 0, 10),
-        )
-    };
-    if rc != 0 || nice != 0 {
-        tracing::warn!(
-            "calibration fit: cannot lower its scheduling: {}",
-            std::io::Error::last_os_error()
-        );
+    if let Err(e) = super::run::normal_scheduling(10) {
+        tracing::warn!("calibration fit: cannot lower its scheduling: {e}");
     }
 }
 

@@ -193,6 +193,25 @@ pub fn set_realtime_priority(priority: u8) {
     }
 }
 
+/// The calling thread under the normal scheduler at `nice`: a thread spawned by the control
+/// loop's inherits its SCHED_FIFO priority (`daemon.realtime_priority`) and would otherwise run
+/// its work ahead of, or level with, the control loop and every simulated or real sender below.
+pub(super) fn normal_scheduling(nice: i32) -> std::io::Result<()> {
+    let param = libc::sched_param { sched_priority: 0 };
+    // SAFETY: both calls act on the calling thread (Linux: pid/who 0 is the caller's thread
+    // id) with valid arguments; failure leaves the thread as it was.
+    let (rc, nice_rc) = unsafe {
+        (
+            libc::sched_setscheduler(0, libc::SCHED_OTHER, &param),
+            libc::setpriority(libc::PRIO_PROCESS, 0, nice),
+        )
+    };
+    if rc != 0 || nice_rc != 0 {
+        return Err(std::io::Error::last_os_error());
+    }
+    Ok(())
+}
+
 /// Send a control period's frames at `t` (each logged, sent or not: the log holds what the
 /// node decided).
 fn send_all(
@@ -268,6 +287,13 @@ pub fn run(
 ) -> Result<(), DaemonError> {
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
+        // The blocking pool's threads (a SIGHUP's configuration read) start after the control
+        // loop's thread took SCHED_FIFO and would inherit it: back to the normal scheduler.
+        .on_thread_start(|| {
+            if let Err(e) = normal_scheduling(0) {
+                tracing::warn!("a helper thread keeps the control loop's scheduling: {e}");
+            }
+        })
         .build()
         .map_err(DaemonError::Runtime)?;
     rt.block_on(run_async(cfg, source, bus_log))

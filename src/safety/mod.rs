@@ -16,6 +16,7 @@
 //! (`line_unfollowable`, held like the tracking faults).
 
 pub mod heading;
+pub mod pauses;
 pub mod tracking;
 
 pub use heading::{HeadingCheck, HeadingCheckParams};
@@ -258,6 +259,8 @@ pub struct Supervisor {
     /// A tracking fault held until the line changes or the operator disengages.
     tracking_latch: Option<FaultCode>,
     heading_check: HeadingCheck,
+    /// The control loop's own late periods: not counted against the inputs' ages.
+    pauses: pauses::LoopPauses,
 }
 
 const HISTORY: usize = 64;
@@ -294,7 +297,16 @@ impl Supervisor {
             tracking: TrackingMonitor::new(),
             tracking_latch: None,
             heading_check: HeadingCheck::new(),
+            pauses: pauses::LoopPauses::default(),
         }
+    }
+
+    /// The control loop could not run from `from` until `to` (s, the inputs' clock): a period
+    /// that woke up late. The inputs' timeouts do not count that time, up to each timeout (see
+    /// [`pauses`]): where the senders froze with the loop, the late period must not give the
+    /// steering back for it.
+    pub fn on_loop_pause(&mut self, from: f64, to: f64) {
+        self.pauses.record(from, to);
     }
 
     /// The line being driven: `Some(id)` on a work line, where the tracking is supervised;
@@ -497,7 +509,7 @@ impl Supervisor {
     fn input_fault(&self, t: f64) -> FaultCode {
         let p = &self.params;
         let fresh = |last: Option<f64>, timeout: f64| {
-            last.is_some_and(|l| t - l <= timeout && t >= l - 1.0)
+            last.is_some_and(|l| self.pauses.age(l, t, timeout) <= timeout && t >= l - 1.0)
         };
         if self.bus_down {
             return FaultCode::BusDown;

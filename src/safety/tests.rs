@@ -404,3 +404,68 @@ fn speeding_up_on_a_curve_past_the_lateral_limit_gives_the_steering_back() {
     let v = given_back_at.expect("given back") * 3.6;
     assert!((19.7..19.9).contains(&v), "at {v} km/h");
 }
+
+/// The loop frozen together with the sensors (one virtual CPU): the late period finds every
+/// input older than the freeze. Up to the timeout, the freeze is the loop's, not the inputs'.
+#[test]
+fn a_pause_of_the_loop_is_not_a_silent_wheel_angle_sensor() {
+    let (mut s, t) = engaged_supervisor();
+    // Due at t + DT, ran 80 ms late: the wheel angle is 100 ms old, the timeout 100 ms.
+    let woke = t + DT + 0.080;
+    s.on_loop_pause(t + DT, woke);
+    let c = s.step(woke, Some(0.0), Some(0.0), Some(0.0));
+    assert!(c.engaged, "{c:?}");
+    // The senders run again: fresh inputs, still engaged.
+    feed_good(&mut s, woke + 0.001);
+    assert!(s.step(woke + DT, Some(0.0), Some(0.0), Some(0.0)).engaged);
+}
+
+#[test]
+fn without_the_pause_the_same_silence_disengages() {
+    let (mut s, t) = engaged_supervisor();
+    s.on_gnss(t + 0.1, FixQuality::RtkFixed);
+    s.on_speed(t + 0.1, 10.0 / 3.6);
+    let c = s.step(t + DT + 0.090, Some(0.0), Some(0.0), Some(0.0));
+    assert!(!c.engaged);
+    assert_eq!(c.fault, FaultCode::WheelAngleTimeout);
+}
+
+#[test]
+fn a_pause_longer_than_the_timeout_still_disengages() {
+    let (mut s, t) = engaged_supervisor();
+    // 300 ms late: credited 100 ms (the wheel angle's timeout), 220 ms remain.
+    let woke = t + DT + 0.300;
+    s.on_loop_pause(t + DT, woke);
+    s.on_gnss(woke, FixQuality::RtkFixed);
+    s.on_speed(woke, 10.0 / 3.6);
+    let c = s.step(woke, Some(0.0), Some(0.0), Some(0.0));
+    assert!(!c.engaged);
+    assert_eq!(c.fault, FaultCode::WheelAngleTimeout);
+}
+
+#[test]
+fn a_sensor_silent_after_the_pause_is_still_caught() {
+    let (mut s, t) = engaged_supervisor();
+    let woke = t + DT + 0.080;
+    s.on_loop_pause(t + DT, woke);
+    assert!(s.step(woke, Some(0.0), Some(0.0), Some(0.0)).engaged);
+    // The loop runs on time again but the wheel angle never comes back: caught by the
+    // timeout plus the credited pause at most.
+    let mut now = woke;
+    let disengaged_at = loop {
+        now += DT;
+        s.on_gnss(now, FixQuality::RtkFixed);
+        s.on_speed(now, 10.0 / 3.6);
+        let c = s.step(now, Some(0.0), Some(0.0), Some(0.0));
+        if !c.engaged {
+            assert_eq!(c.fault, FaultCode::WheelAngleTimeout);
+            break now;
+        }
+        assert!(now < woke + 1.0, "never disengaged");
+    };
+    assert!(
+        disengaged_at - t <= 0.1 + 0.080 + DT + 1e-9,
+        "{}",
+        disengaged_at - t
+    );
+}

@@ -243,6 +243,17 @@ impl Bench {
         }
         cmd
     }
+    /// The whole machine frozen for `freeze` s (one virtual CPU): the node's next period runs
+    /// that late and before the simulated sensors have sent anything new.
+    fn frozen_period(&mut self, dt: f64, freeze: f64) -> agsteer::safety::SteeringCommand {
+        self.t += dt + freeze;
+        self.out.clear();
+        let cmd = self.node.tick(self.t, &mut self.out);
+        // The sensors send again only after it; their frames of the frozen time are not sent.
+        self.sim_out.clear();
+        self.sim.advance_to(self.t, &mut self.sim_out);
+        cmd
+    }
     fn engage(&mut self, dt: f64) {
         for _ in 0..100 {
             // A new frame each time: a repeated one would be a frozen counter.
@@ -314,4 +325,31 @@ fn can_flood_of_unrelated_ids_changes_nothing() {
         0,
         "unrelated ids are not our frames"
     );
+}
+
+/// After a freeze of everything (the daemon and the simulated tractor on one frozen virtual
+/// CPU, the vcan tests' situation), the late period finds the wheel angle older than its
+/// timeout. Up to the timeout the freeze is the loop's own pause, not a silent sensor: the
+/// steering stays engaged; a freeze longer than the wheel angle's timeout plus a period still
+/// gives it back, with the wheel angle's fault.
+#[test]
+fn a_freeze_of_the_whole_machine_up_to_the_timeout_keeps_the_steering() {
+    let cfg = config();
+    let dt = cfg.dt();
+    let timeout = cfg.safety.wheel_angle_timeout_s;
+    let mut b = Bench::new(&cfg);
+    b.engage(dt);
+    for _ in 0..50 {
+        assert!(b.period(dt, &[]).engaged);
+    }
+    let freeze = timeout - dt / 2.0;
+    let cmd = b.frozen_period(dt, freeze);
+    assert!(cmd.engaged, "a {freeze} s freeze: {cmd:?}");
+    for _ in 0..50 {
+        assert!(b.period(dt, &[]).engaged);
+    }
+    let freeze = 2.0 * timeout + dt;
+    let cmd = b.frozen_period(dt, freeze);
+    assert!(!cmd.engaged, "a {freeze} s freeze");
+    assert_eq!(cmd.fault, agsteer::safety::FaultCode::WheelAngleTimeout);
 }
