@@ -368,10 +368,11 @@ pub const CONFIG: &str = "config/vcan.toml";
 /// (`daemon.realtime_priority` = 70 in config/vcan.toml, since 2026-12-03; 50 before) and the
 /// [`StallProbe`]: above the daemon it charged its own CPU time to the daemon's figures (fix →
 /// command medians doubled, one 88.7 ms command gap at dt 10 ms). The daemon's step (about
-/// 1 ms under emulation) delays the simulator's 2 ms loop instead. The cost: after a freeze of
-/// the whole guest the daemon runs first and can find the wheel angle stale (a clean-clone CI
-/// run here with the guest frozen up to 77 ms at a time saw `WheelAngleTimeout` and
-/// disengagements in four tests; the quiet-host suite passed every test).
+/// 1 ms under emulation) delays the simulator's 2 ms loop instead. After a freeze of the whole
+/// guest the daemon runs first and finds the wheel angle older than the freeze; the supervisor
+/// does not count its loop's own pauses against the inputs (`safety::pauses`), which a clean-clone
+/// CI run here needed (guest frozen up to 77 ms at a time: `WheelAngleTimeout` and
+/// disengagements in four tests before).
 pub const SIM_PRIORITY: u8 = 60;
 
 /// Start `agsteer sim` on `iface` with `extra` arguments, at [`SIM_PRIORITY`].
