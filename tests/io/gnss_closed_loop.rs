@@ -38,6 +38,8 @@ use std::time::Duration;
 const CONFIG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/config/vcan.toml");
 /// The PGN 129025 (position, rapid update) part of an identifier.
 const POSITION_RAPID: u32 = 0x01F8_0100;
+/// The wheel angle's (proprietary B 0xFF10, 100 Hz) part of an identifier.
+const WHEEL_ANGLE: u32 = 0x00FF_1000;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum GnssPath {
@@ -177,6 +179,8 @@ struct SimRecord {
     trajectory: Vec<(f64, f64, f64, bool)>,
     /// Monotonic time of each GNSS send.
     gnss_sent: Vec<f64>,
+    /// Monotonic time of each wheel-angle frame sent.
+    wheel_sent: Vec<f64>,
     rtcm_in: u64,
     /// Monotonic time of the simulator's time 0.
     t0: f64,
@@ -249,6 +253,9 @@ fn simulate(
             let now = monotonic_s();
             if f.id & 0x03FF_FF00 == POSITION_RAPID {
                 rec.gnss_sent.push(now);
+            }
+            if f.id & 0x03FF_FF00 == WHEEL_ANGLE {
+                rec.wheel_sent.push(now);
             }
             let _ = to_ctrl.send(TimedFrame { t: now, frame: *f });
         }
@@ -499,6 +506,30 @@ fn run_job(path: GnssPath, extra: &[&str], cut: Option<Cut>, max_s: f64) -> Outc
             if let Some(c) = host_stalls::explain(t, last_input, run, sends, unread, gnss_period) {
                 out.stall_timeouts += 1;
                 out.stall_causes.push(c);
+                let back = ticks[k + 1..]
+                    .iter()
+                    .find(|k| k.1)
+                    .map_or(f64::MAX, |k| k.0);
+                excused.push((t, back));
+            }
+        }
+    }
+    // A wheel-angle timeout is the host's when the simulator's thread sent no wheel angle for
+    // longer than the timeout before it (descheduled: nothing in this test silences the
+    // sensor); when it sent one in time and the loop did not take it, the controller's.
+    let wheel_timeout = cfg.safety.wheel_angle_timeout_s;
+    for (k, w) in ticks.windows(2).enumerate() {
+        let (t, engaged, fault) = w[1];
+        if w[0].1 && !engaged && fault == FaultCode::WheelAngleTimeout {
+            let last_sent = rec
+                .wheel_sent
+                .iter()
+                .rev()
+                .find(|s| **s <= t)
+                .map_or(f64::MIN, |s| *s);
+            if t - last_sent > wheel_timeout {
+                out.stall_timeouts += 1;
+                out.stall_causes.push(HostStall::SimDescheduled);
                 let back = ticks[k + 1..]
                     .iter()
                     .find(|k| k.1)
