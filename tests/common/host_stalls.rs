@@ -158,6 +158,64 @@ pub fn explain(
     (backlog.is_some() && written).then_some(HostStall::KernelHeld)
 }
 
+/// A run's GNSS as the controller saw it: position inputs' arrivals (monotonic s, RTK fixed),
+/// the simulator's epoch writes, the tty's unread stretches (`None` off a tty), the receiver's
+/// period (s).
+pub struct GnssRun<'a> {
+    pub arrivals: &'a [(f64, bool)],
+    pub sends: &'a [f64],
+    pub backlog: Option<&'a Backlog>,
+    pub period_s: f64,
+}
+
+/// The disengagements of a run (`ticks`: each control period's time, engaged, fault; every
+/// `dt`) that a host stall explains, as (trip, re-engage) spans with their causes:
+/// - a GNSS timeout judged unexpected by `gnss_timeout_counts`, by [`explain`];
+/// - a wheel-angle timeout when the simulator's thread sent no wheel angle (`wheel`: its sends,
+///   and the timeout, s) for longer than the timeout before it (descheduled: nothing in these
+///   tests silences that sensor); one sent in time and not taken is the controller's doing.
+pub fn excused_trips(
+    ticks: &[(f64, bool, agsteer::safety::FaultCode)],
+    dt: f64,
+    gnss: &GnssRun,
+    (wheel_sends, wheel_timeout_s): (&[f64], f64),
+    gnss_timeout_counts: impl Fn(f64) -> bool,
+) -> (Vec<(f64, f64)>, Vec<HostStall>) {
+    use agsteer::safety::FaultCode;
+    let periods: Vec<f64> = ticks.iter().map(|k| k.0).collect();
+    let last_before = |times: &mut dyn Iterator<Item = f64>, t: f64| {
+        times.filter(|x| *x <= t).fold(f64::MIN, f64::max)
+    };
+    let (mut spans, mut causes) = (Vec::new(), Vec::new());
+    for (k, w) in ticks.windows(2).enumerate() {
+        let (t, engaged, fault) = w[1];
+        if !w[0].1 || engaged {
+            continue;
+        }
+        let cause = match fault {
+            FaultCode::GnssTimeout if gnss_timeout_counts(t) => {
+                let last_input = last_before(&mut gnss.arrivals.iter().map(|a| a.0), t);
+                let run = (periods.as_slice(), dt);
+                explain(t, last_input, run, gnss.sends, gnss.backlog, gnss.period_s)
+            }
+            FaultCode::WheelAngleTimeout => {
+                let last_sent = last_before(&mut wheel_sends.iter().copied(), t);
+                (t - last_sent > wheel_timeout_s).then_some(HostStall::SimDescheduled)
+            }
+            _ => None,
+        };
+        if let Some(c) = cause {
+            let back = ticks[k + 1..]
+                .iter()
+                .find(|k| k.1)
+                .map_or(f64::MAX, |k| k.0);
+            spans.push((t, back));
+            causes.push(c);
+        }
+    }
+    (spans, causes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -208,5 +266,38 @@ mod tests {
             explain(0.45, 0.1, (&periods, 0.01), &[0.1], None, 0.1),
             Some(HostStall::SimDescheduled)
         );
+    }
+
+    #[test]
+    fn a_wheel_angle_timeout_is_excused_only_when_the_sender_was_silent() {
+        use agsteer::safety::FaultCode;
+        // Engaged every 10 ms until 1.0 s, then a wheel-angle timeout, engaged again at 1.5 s.
+        let ticks: Vec<(f64, bool, FaultCode)> = (0..200)
+            .map(|k| {
+                let t = k as f64 * 0.01;
+                let off = (1.0..1.5).contains(&t);
+                let fault = if off {
+                    FaultCode::WheelAngleTimeout
+                } else {
+                    FaultCode::None
+                };
+                (t, !off, fault)
+            })
+            .collect();
+        let gnss = GnssRun {
+            arrivals: &[],
+            sends: &[],
+            backlog: None,
+            period_s: 0.1,
+        };
+        // The simulator sent nothing from 0.85 s: silent 150 ms at the trip, excused.
+        let silent: Vec<f64> = (0..85).map(|k| k as f64 * 0.01).collect();
+        let (spans, causes) = excused_trips(&ticks, 0.01, &gnss, (&silent, 0.1), |_| true);
+        assert_eq!(causes, vec![HostStall::SimDescheduled]);
+        assert!((spans[0].0 - 1.0).abs() < 1e-9 && (spans[0].1 - 1.5).abs() < 1e-9);
+        // It sent every 10 ms: the frames were there, the controller's doing.
+        let sent: Vec<f64> = (0..200).map(|k| k as f64 * 0.01).collect();
+        let (spans, causes) = excused_trips(&ticks, 0.01, &gnss, (&sent, 0.1), |_| true);
+        assert!(spans.is_empty() && causes.is_empty());
     }
 }

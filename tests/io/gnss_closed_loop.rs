@@ -485,59 +485,23 @@ fn run_job(path: GnssPath, extra: &[&str], cut: Option<Cut>, max_s: f64) -> Outc
         |t: f64| cut_at.is_some_and(|u| t >= u && t <= restored_at.unwrap_or(f64::MAX) + 2.0);
     // A GNSS timeout is the cut's expected reaction, except to a caster gone.
     let expected_timeout = |t: f64| in_cut(t) && cut.is_some_and(|c| c.what != CutKind::Caster);
-    let periods: Vec<f64> = ticks.iter().map(|k| k.0).collect();
     out.disengages = (ticks.windows(2).filter(|w| w[0].1 && !w[1].1))
         .map(|w| (w[1].0 - rec.t0, w[1].2))
         .collect();
     let unread = (path == GnssPath::Pty).then_some(&rec.unread);
     let gnss_period = 1.0 / cfg.sim.gnss_rate_hz;
     // The trips a host stall explains: (trip, re-engage) (monotonic).
-    let mut excused: Vec<(f64, f64)> = Vec::new();
-    for (k, w) in ticks.windows(2).enumerate() {
-        let (t, engaged, fault) = w[1];
-        if w[0].1 && !engaged && fault == FaultCode::GnssTimeout && !expected_timeout(t) {
-            let last_input = arrivals
-                .iter()
-                .rev()
-                .find(|a| a.0 <= t)
-                .map_or(f64::MIN, |a| a.0);
-            let sends = &rec.gnss_sent;
-            let run = (periods.as_slice(), dt);
-            if let Some(c) = host_stalls::explain(t, last_input, run, sends, unread, gnss_period) {
-                out.stall_timeouts += 1;
-                out.stall_causes.push(c);
-                let back = ticks[k + 1..]
-                    .iter()
-                    .find(|k| k.1)
-                    .map_or(f64::MAX, |k| k.0);
-                excused.push((t, back));
-            }
-        }
-    }
-    // A wheel-angle timeout is the host's when the simulator's thread sent no wheel angle for
-    // longer than the timeout before it (descheduled: nothing in this test silences the
-    // sensor); when it sent one in time and the loop did not take it, the controller's.
-    let wheel_timeout = cfg.safety.wheel_angle_timeout_s;
-    for (k, w) in ticks.windows(2).enumerate() {
-        let (t, engaged, fault) = w[1];
-        if w[0].1 && !engaged && fault == FaultCode::WheelAngleTimeout {
-            let last_sent = rec
-                .wheel_sent
-                .iter()
-                .rev()
-                .find(|s| **s <= t)
-                .map_or(f64::MIN, |s| *s);
-            if t - last_sent > wheel_timeout {
-                out.stall_timeouts += 1;
-                out.stall_causes.push(HostStall::SimDescheduled);
-                let back = ticks[k + 1..]
-                    .iter()
-                    .find(|k| k.1)
-                    .map_or(f64::MAX, |k| k.0);
-                excused.push((t, back));
-            }
-        }
-    }
+    let gnss = host_stalls::GnssRun {
+        arrivals: &arrivals,
+        sends: &rec.gnss_sent,
+        backlog: unread,
+        period_s: gnss_period,
+    };
+    let wheel = (rec.wheel_sent.as_slice(), cfg.safety.wheel_angle_timeout_s);
+    let (excused, causes) =
+        host_stalls::excused_trips(&ticks, dt, &gnss, wheel, |t| !expected_timeout(t));
+    out.stall_timeouts = causes.len() as u32;
+    out.stall_causes = causes;
     out.max_unread_s = rec.unread.longest_within(f64::MIN, f64::MAX);
     if let Some(u) = cut_at {
         let last_sent = rec.gnss_sent.iter().rev().find(|s| **s < u);
