@@ -125,8 +125,13 @@ fn kill_9_resume(lines: u64, kill_count: u32) {
         restart.len(),
         stalls.iter().map(|s| s.to_s - s.from_s).sum::<f64>() * 1e3
     );
-    let crossings = line_crossings(traj, &set);
+    let (crossings, events) = line_crossings(traj, &set);
     println!("VCAN-KILL9 kills={kills} finished={finished} reengaged_after={reengaged} crossings_per_line={crossings:?}");
+    if crossings.iter().any(|c| *c != 1) {
+        // What to look at when it fails: each crossing (simulator time s, line, speed m/s,
+        // engaged) and each restart (wall s, as candump stamps).
+        println!("VCAN-KILL9 crossings (t_s, line, speed_m_s, engaged): {events:?}; restarts at {execs:?}");
+    }
     assert!(
         kills >= kill_count,
         "only {kills} kills before the job ended"
@@ -139,9 +144,12 @@ fn kill_9_resume(lines: u64, kill_count: u32) {
     );
 }
 
+/// One crossing of a line's middle: simulator time s, line, speed m/s, engaged.
+type Crossing = (f64, usize, f64, bool);
+
 /// How often the vehicle crossed the middle of each work line (attributed to the nearest line
-/// within half a line width).
-fn line_crossings(path: &str, set: &str) -> Vec<u32> {
+/// within half a line width), and each crossing.
+fn line_crossings(path: &str, set: &str) -> (Vec<u32>, Vec<Crossing>) {
     use agsteer::config::Config;
     use agsteer::plan::abline::AbPlan;
     let cfg = Config::load(std::path::Path::new(CONFIG), &[set.to_string()]).unwrap();
@@ -151,6 +159,7 @@ fn line_crossings(path: &str, set: &str) -> Vec<u32> {
     let half = plan.line_length() / 2.0;
     let mut counts = vec![0u32; cfg.job.line_num as usize];
     let mut prev: Option<f64> = None;
+    let mut events = Vec::new();
     let text = std::fs::read_to_string(path).unwrap();
     for l in text.lines().skip(1) {
         let v: Vec<f64> = l.split(',').filter_map(|x| x.parse().ok()).collect();
@@ -171,11 +180,14 @@ fn line_crossings(path: &str, set: &str) -> Vec<u32> {
                 if let Some((k, d)) = nearest {
                     if d < cfg.job.line_width_m / 2.0 {
                         counts[k] += 1;
+                        // The columns: t_s, x_m, y_m, heading_rad, speed_m_s, wheel, engaged.
+                        let at = |i: usize| v.get(i).copied().unwrap_or(f64::NAN);
+                        events.push((at(0), k, at(4), at(6) > 0.5));
                     }
                 }
             }
         }
         prev = Some(along);
     }
-    counts
+    (counts, events)
 }
