@@ -126,10 +126,10 @@ struct CuspParams {
     min_speed: f64,
 }
 
-/// Control periods between two status frames (at least 1).
 /// A control period this many dt after the previous one follows a pause of the loop's.
 const LATE_PERIOD: f64 = 1.5;
 
+/// Control periods between two status frames (at least 1).
 fn status_every(status_period: f64, dt: f64) -> u64 {
     ((status_period / dt).round() as u64).max(1)
 }

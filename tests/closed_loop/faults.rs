@@ -334,22 +334,30 @@ fn can_flood_of_unrelated_ids_changes_nothing() {
 /// gives it back, with the wheel angle's fault.
 #[test]
 fn a_freeze_of_the_whole_machine_up_to_the_timeout_keeps_the_steering() {
-    let cfg = config();
-    let dt = cfg.dt();
-    let timeout = cfg.safety.wheel_angle_timeout_s;
-    let mut b = Bench::new(&cfg);
-    b.engage(dt);
-    for _ in 0..50 {
-        assert!(b.period(dt, &[]).engaged);
+    // The demo's configuration, and another control period and wheel-angle timeout (the GNSS
+    // timeout, 0.3 s, still above the longer freeze less its credit).
+    for variant in [None, Some((0.01, 0.15))] {
+        let mut cfg = config();
+        if let Some((dt_s, timeout_s)) = variant {
+            cfg.control.dt_s = dt_s;
+            cfg.safety.wheel_angle_timeout_s = timeout_s;
+        }
+        let dt = cfg.dt();
+        let timeout = cfg.safety.wheel_angle_timeout_s;
+        let mut b = Bench::new(&cfg);
+        b.engage(dt);
+        for _ in 0..50 {
+            assert!(b.period(dt, &[]).engaged);
+        }
+        let freeze = timeout - dt / 2.0;
+        let cmd = b.frozen_period(dt, freeze);
+        assert!(cmd.engaged, "{variant:?}: a {freeze} s freeze: {cmd:?}");
+        for _ in 0..50 {
+            assert!(b.period(dt, &[]).engaged);
+        }
+        let freeze = 2.0 * timeout + dt;
+        let cmd = b.frozen_period(dt, freeze);
+        assert!(!cmd.engaged, "{variant:?}: a {freeze} s freeze");
+        assert_eq!(cmd.fault, agsteer::safety::FaultCode::WheelAngleTimeout);
     }
-    let freeze = timeout - dt / 2.0;
-    let cmd = b.frozen_period(dt, freeze);
-    assert!(cmd.engaged, "a {freeze} s freeze: {cmd:?}");
-    for _ in 0..50 {
-        assert!(b.period(dt, &[]).engaged);
-    }
-    let freeze = 2.0 * timeout + dt;
-    let cmd = b.frozen_period(dt, freeze);
-    assert!(!cmd.engaged, "a {freeze} s freeze");
-    assert_eq!(cmd.fault, agsteer::safety::FaultCode::WheelAngleTimeout);
 }
