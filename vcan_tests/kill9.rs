@@ -7,7 +7,9 @@ use std::time::{Duration, Instant};
 /// each time: the daemon never auto-engages, no finished line is driven twice, none is
 /// skipped, and the job finishes. Judged from the simulator's true trajectory, not from the
 /// daemon's own bookkeeping ([`line_record`]): a line is driven when its middle is crossed in
-/// its work direction under automatic steering, finished when its end is reached so. A line
+/// its work direction, finished when it comes within `guidance.end_distance_m` of its end so, as
+/// the daemon counts it (steered automatically or by the driver, who keeps straight while the
+/// daemon is down: the implement works either way). A line
 /// left mid-way and resumed out of the engage gate is driven again from its start (the
 /// approach's design: it was not finished, so nothing is missed), which is allowed; a finished
 /// line driven again, or a line finished without being driven, is not.
@@ -172,13 +174,11 @@ type Crossing = (f64, usize, f64, bool, bool);
 /// One work line, from the trajectory.
 #[derive(Debug, Default, Clone)]
 struct LineRecord {
-    /// Crossings of its middle in its work direction under automatic steering, before it was
-    /// finished.
+    /// Crossings of its middle in its work direction, before it was finished.
     driven: u32,
     /// The same after it was finished.
     driven_after_finish: u32,
-    /// Simulator time its end was first reached in its work direction under automatic
-    /// steering, s.
+    /// Simulator time its end was first reached in its work direction, s.
     finished_at: Option<f64>,
 }
 
@@ -240,7 +240,8 @@ fn line_record(path: &str, set: &str) -> Record {
             prev = None;
             continue;
         };
-        if engaged && along >= length - 1.0 && lines[k].finished_at.is_none() {
+        // Finished as the daemon counts it: within `guidance.end_distance_m` of the end.
+        if along >= length - cfg.guidance.end_distance_m && lines[k].finished_at.is_none() {
             lines[k].finished_at = Some(t);
         }
         if let Some((pk, pa)) = prev.filter(|p| p.0 == k) {
@@ -248,7 +249,7 @@ fn line_record(path: &str, set: &str) -> Record {
             if (pa < half) != (along < half) {
                 let work = pa < half;
                 crossings.push((t, pk, speed, engaged, work));
-                if work && engaged {
+                if work {
                     if lines[k].finished_at.is_some() {
                         lines[k].driven_after_finish += 1;
                     } else {
