@@ -212,6 +212,7 @@ fn line_record(path: &str, set: &str) -> Record {
         .map(|e| e.expect("every line in the plan's order"))
         .collect();
     let length = plan.line_length();
+    let half = length / 2.0;
     let mut lines = vec![LineRecord::default(); n];
     let mut crossings = Vec::new();
     let mut prev: Option<(usize, f64)> = None;
@@ -244,11 +245,10 @@ fn line_record(path: &str, set: &str) -> Record {
         if along >= length - cfg.guidance.end_distance_m && lines[k].finished_at.is_none() {
             lines[k].finished_at = Some(t);
         }
-        if let Some((pk, pa)) = prev.filter(|p| p.0 == k) {
-            let half = length / 2.0;
+        if let Some((_, pa)) = prev.filter(|p| p.0 == k) {
             if (pa < half) != (along < half) {
                 let work = pa < half;
-                crossings.push((t, pk, speed, engaged, work));
+                crossings.push((t, k, speed, engaged, work));
                 if work {
                     if lines[k].finished_at.is_some() {
                         lines[k].driven_after_finish += 1;
