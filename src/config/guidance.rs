@@ -33,7 +33,8 @@ pub struct GuidanceConfig {
     /// job's start, or resuming it after a restart, a pause or a manual drive) (|XTE| ≥ `safety.max_engage_xte_m` or heading error ≥
     /// `safety.max_engage_heading_error_deg`), plan a continuous-curvature path (reversing
     /// where shorter, κ_max = 1/`vehicle.r_min_m`, σ_max = `vehicle.max_curvature_rate_per_m2`)
-    /// from the vehicle to the line start, inside the field when the job has one, and drive
+    /// from the vehicle to the line start (on a line partly worked: where its work stopped),
+    /// inside the field when the job has one, and drive
     /// it first. false = refuse to engage there, as without approach paths.
     pub approach_paths: bool,
     /// One step of the operator's nudge (OperatorCommand nudge): the job's lines shift by

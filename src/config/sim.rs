@@ -33,9 +33,11 @@ pub struct SimConfig {
     pub actuator_tau_s: f64,
     /// Steering actuator rate limit, degrees/s.
     pub actuator_rate_deg_s: f64,
-    /// Initial lateral offset of the vehicle from line A→B (positive = left), m.
+    /// Initial lateral offset of the vehicle from line A→B (positive = left), m. A field job
+    /// or a resumed one starts this far left of its current path's start.
     pub start_offset_m: f64,
-    /// Initial heading error relative to A→B, degrees.
+    /// Initial heading error relative to A→B (a field or resumed job: its current path),
+    /// degrees.
     pub start_heading_deg: f64,
     /// Stop the simulation after this much simulated time even if unfinished, s (0 = auto).
     pub max_time_s: f64,

@@ -148,7 +148,8 @@ impl Controller {
 
     /// On an engage request at time `t`: when the vehicle is too far from the path to engage
     /// (at the job's start, or resumed after a restart or a manual drive), plan an approach
-    /// path to the start of the current line (in a turn: the next line) and drive it first. `None` when no approach is needed (or approaches are off);
+    /// path to where the current line's work stopped (its start if not worked yet; in a turn:
+    /// the next line's start) and drive it first. `None` when no approach is needed (or approaches are off);
     /// else the number of parts (1 + cusps) or why none could be planned. Runs the analytic
     /// connection and the field check only (well under a millisecond).
     pub fn plan_approach(
@@ -254,6 +255,13 @@ impl Controller {
         if let Some((xte, he)) = self.guidance.errors(&est.pose) {
             out.xte = Some(xte);
             out.heading_error = Some(he);
+            // Inside the engage gate the line is being worked (engaged or steered by the
+            // driver): a resume out of the gate rejoins it where this stopped.
+            if let Some(a) = &self.approach {
+                if xte.abs() < a.params.max_xte && he.abs() < a.params.max_heading_error {
+                    self.guidance.mark_worked();
+                }
+            }
         }
         let direction = self.guidance.direction();
         out.direction = direction;

@@ -352,11 +352,15 @@ impl Outputs {
         }
         stats.bus_up = self.bus_up;
         let had_events = node.controller().guidance().has_events();
-        if had_events {
+        // A line change, or the work advanced a checkpoint along the line.
+        let checkpoint = node.controller_mut().guidance_mut().take_checkpoint();
+        if had_events || checkpoint {
             let p = node.controller().guidance().progress();
             if self.progress.try_send(p).is_err() {
                 tracing::warn!("progress writer busy; this save is skipped");
             }
+        }
+        if had_events {
             for ev in node.controller_mut().guidance_mut().drain_events() {
                 tracing::info!("{ev}");
             }

@@ -176,7 +176,9 @@ struct SegmentScore {
 /// What to record and where to start.
 #[derive(Debug, Clone, Default)]
 pub struct DemoOptions {
-    /// Continue this saved progress instead of starting the job afresh.
+    /// Continue this saved progress instead of starting the job afresh (the vehicle starts at
+    /// the current path's start, `sim.start_offset_m` left of it, turned by
+    /// `sim.start_heading_deg`).
     pub resume: Option<Progress>,
     /// Stop (as at a power loss) once this many lines have been finished in this run.
     pub stop_after_lines: Option<u64>,
@@ -377,7 +379,7 @@ fn default_max_time(cfg: &Config, speed: f64) -> f64 {
     60.0 + 3.0 * lines * per_line / speed
 }
 
-/// Run the job closed-loop. `on_progress` is called at every line change with the snapshot to
+/// Run the job closed-loop. `on_progress` is called at every line change and work checkpoint with the snapshot to
 /// persist; `on_event` with every guidance event.
 pub fn run(
     cfg: &Config,
@@ -412,15 +414,18 @@ pub fn run(
         node.controller().guidance().job_plan(),
         JobPlan::Segments(_)
     );
+    // A segment job or a resumed one starts at its current path's start (a resumed turn: the
+    // turn's), offset and turned as configured; a new AB job at A.
     let start = match &opts.resume {
-        None if segment_job => node.controller().path_start_pose().map(|p| {
-            let normal = left_normal(&crate::geo::heading_vec(p.heading));
-            let pos = p.pos + normal * sim_setup.start_offset;
-            Pose::new(pos.x, pos.y, p.heading + sim_setup.start_heading)
-        }),
         Some(_) => node.controller().path_start_pose(),
+        None if segment_job => node.controller().path_start_pose(),
         None => None,
     }
+    .map(|p| {
+        let normal = left_normal(&crate::geo::heading_vec(p.heading));
+        let pos = p.pos + normal * sim_setup.start_offset;
+        Pose::new(pos.x, pos.y, p.heading + sim_setup.start_heading)
+    })
     .unwrap_or_else(|| {
         let ab = &resolved.planning.ab;
         let dir = (ab.point_b - ab.point_a).normalize();
@@ -561,6 +566,12 @@ pub fn run(
             }
         }
 
+        // Progress is saved at line changes and work checkpoints along a line, as the daemon does.
+        if node.controller_mut().guidance_mut().take_checkpoint()
+            && !node.controller().guidance().has_events()
+        {
+            on_progress(&node.controller().guidance().progress());
+        }
         if node.controller().guidance().has_events() {
             on_progress(&node.controller().guidance().progress());
             let g = node.controller_mut().guidance_mut();

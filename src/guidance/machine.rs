@@ -64,6 +64,11 @@ impl std::fmt::Display for Event {
     }
 }
 
+/// Work advanced along a line between two progress checkpoints (a save without an event), m.
+/// A restart out of the engage gate rejoins the line at most this far behind where the work
+/// stopped (plus what the driver drove while the daemon was down).
+pub const CHECKPOINT_STEP_M: f64 = 5.0;
+
 /// Tuning of the state machine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GuidanceParams {
@@ -111,6 +116,18 @@ pub struct Guidance {
     /// The operator's nudge: the job shifted left of its reference direction, m (saved
     /// with progress).
     nudge_m: f64,
+    /// How far the current work line (or work segment) has been worked: the furthest point of
+    /// `path` passed inside the engage gate ([`Guidance::mark_worked`]) and its distance from
+    /// the line's start along it, m. `None` until then and off work lines. Kept while an
+    /// approach is driven; saved with progress.
+    worked: Option<(usize, f64)>,
+    /// `worked`'s distance at the last progress checkpoint, m.
+    checkpoint_m: f64,
+    /// The work advanced [`CHECKPOINT_STEP_M`] since the last checkpoint: progress is due.
+    checkpoint_due: bool,
+    /// While approaching: the point of the line the approach rejoins (index into the line's
+    /// points) and the phase the job was in (what progress saves).
+    rejoin: (usize, Phase),
 }
 
 impl Guidance {
@@ -136,6 +153,10 @@ impl Guidance {
             approach: Vec::new(),
             approach_index: None,
             nudge_m: 0.0,
+            worked: None,
+            checkpoint_m: 0.0,
+            checkpoint_due: false,
+            rejoin: (0, Phase::Work),
         };
         g.start_work_line()?;
         Ok(g)
@@ -183,6 +204,16 @@ impl Guidance {
                 None => g.start_work_line()?,
             },
         }
+        if let Some(station) = saved.line_worked_m.filter(|_| g.phase == Phase::Work) {
+            let length = path_length(&g.path);
+            if !(station.is_finite() && station >= 0.0 && station <= length + 1.0) {
+                return Err(GuidanceError::Impossible(format!(
+                    "line_worked_m {station}: the line at index_block {block}, index_rank {rank} is {length:.1} m long"
+                )));
+            }
+            let (k, at) = point_at_distance(&g.path, station);
+            g.set_worked(k, at);
+        }
         Ok(g)
     }
 
@@ -209,7 +240,8 @@ impl Guidance {
             if self.phase == Phase::Finished {
                 return Ok(());
             }
-            self.index_global = nearest_global(&self.path, &pose.pos, 0, 4);
+            // From the new path's first point, or where an approach rejoined the line.
+            self.index_global = nearest_global(&self.path, &pose.pos, self.index_global, 4);
         }
         if self.local.built_for() != Some(self.index_global) {
             self.local.rebuild(&self.path, self.index_global);
@@ -246,6 +278,7 @@ impl Guidance {
             return;
         };
         let i = self.index_rank;
+        (self.worked, self.checkpoint_m) = (None, 0.0);
         job.points_into(i, &mut self.path);
         let work = job.segments().get(i).is_some_and(|s| s.is_work());
         self.phase = if work { Phase::Work } else { Phase::Turn };
@@ -330,6 +363,7 @@ impl Guidance {
             return Ok(());
         };
         let to = (self.index_block, self.index_rank);
+        (self.worked, self.checkpoint_m) = (None, 0.0);
         self.path.clear();
         plan.turn_points(from, to, &mut self.path)?;
         self.phase = Phase::Turn;
@@ -346,6 +380,7 @@ impl Guidance {
             self.start_segment();
             return Ok(());
         };
+        (self.worked, self.checkpoint_m) = (None, 0.0);
         self.path.clear();
         plan.work_line_points(self.index_block, self.index_rank, &mut self.path);
         self.phase = Phase::Work;
@@ -386,9 +421,69 @@ impl Guidance {
             job: self.job.clone(),
             index_block: self.index_block,
             index_rank: self.index_rank as u64,
-            phase: self.phase,
+            phase: self.saved_phase(),
             lines_done: self.lines_done,
             nudge_m: self.nudge_m,
+            line_worked_m: self.worked.map(|(_, at)| at),
+        }
+    }
+
+    /// The phase progress saves: while approaching, the one the approach was planned in.
+    fn saved_phase(&self) -> Phase {
+        if self.approach_index.is_some() {
+            self.rejoin.1
+        } else {
+            self.phase
+        }
+    }
+
+    /// Work advanced [`CHECKPOINT_STEP_M`] along the line since the last checkpoint: save
+    /// progress now (clears the flag; events are save points of their own).
+    pub fn take_checkpoint(&mut self) -> bool {
+        std::mem::take(&mut self.checkpoint_due)
+    }
+
+    /// The vehicle is on the current work line (inside the engage gate, where an engage needs
+    /// no approach): the line counts as worked up to its nearest point, never back. Does
+    /// nothing in a turn, while approaching or once finished. No allocation; the distance is
+    /// summed over the points passed since the last call only.
+    pub fn mark_worked(&mut self) {
+        if self.phase != Phase::Work || self.approach_index.is_some() || self.path.len() < 2 {
+            return;
+        }
+        let k = self.index_global.min(self.path.len() - 1);
+        let (from, mut at) = match self.worked {
+            Some((from, _)) if k <= from => return,
+            Some(w) => w,
+            None => (0, 0.0),
+        };
+        at += path_length(&self.path[from..=k]);
+        self.worked = Some((k, at));
+        if at - self.checkpoint_m >= CHECKPOINT_STEP_M {
+            self.checkpoint_m = at;
+            self.checkpoint_due = true;
+        }
+    }
+
+    /// How far the current line has been worked, m from its start (`None` before, in a turn).
+    pub fn worked_m(&self) -> Option<f64> {
+        self.worked.map(|(_, at)| at)
+    }
+
+    fn set_worked(&mut self, k: usize, at: f64) {
+        self.worked = Some((k, at));
+        self.checkpoint_m = at;
+        self.index_global = k;
+    }
+
+    /// The point of the current path an approach leads to: on a work line, where the work
+    /// stopped (the furthest point worked, wherever the vehicle now is: a driver who wants to
+    /// work a stretch again drives onto the line there, inside the gate, and engages without an
+    /// approach); its start before the line was worked and in a turn.
+    fn rejoin_index(&self) -> usize {
+        match self.worked {
+            Some((k, _)) if self.phase == Phase::Work && self.approach_index.is_none() => k,
+            _ => 0,
         }
     }
 
@@ -560,11 +655,11 @@ impl Guidance {
     }
 
     /// Drive `segments` (an approach path from the vehicle to [`Guidance::approach_target`],
-    /// split at its cusps) before the line, which is then driven from its start. Not once
+    /// split at its cusps) before the line, which is then driven from that target on. Not once
     /// finished nor while approaching; `false` when refused. An empty list is accepted and
     /// changes nothing. In a turn of an AB job the approach replaces the rest of the turn
-    /// (a turn is no work); on a work line the line is driven again from its start (it is
-    /// not finished, so it counts once).
+    /// (a turn is no work); on a work line the line is driven on from where its work stopped
+    /// (from its start if it was not worked yet; it is not finished, so it counts once).
     pub fn set_approach(&mut self, segments: Vec<JobSegment>) -> bool {
         if !self.approach_allowed() {
             return false;
@@ -572,6 +667,7 @@ impl Guidance {
         if segments.is_empty() {
             return true;
         }
+        self.rejoin = (self.rejoin_index(), self.phase);
         self.approach = segments;
         self.load_approach_segment(0);
         true
@@ -585,9 +681,10 @@ impl Guidance {
         self.approach_index.is_none() && self.phase != Phase::Finished && self.path.len() >= 2
     }
 
-    /// Where an approach path leads: the start of the current work line — in a turn of an AB
-    /// job, of the line the turn leads to — or of the current segment of a segment job.
-    /// Allocates (once per engage request, never per cycle).
+    /// Where an approach path leads: on a work line (or work segment) that was worked, where
+    /// the work stopped ([`Guidance::mark_worked`]); else the start of the current work line — in a turn of an AB job, of
+    /// the line the turn leads to — or of the current segment of a segment job, facing along
+    /// it. Allocates (once per engage request, never per cycle).
     pub fn approach_target(&self) -> Option<Pose> {
         let mut line = Vec::new();
         let points: &[PathPoint] = match (&self.plan, self.phase) {
@@ -597,7 +694,8 @@ impl Guidance {
             }
             _ => &self.path,
         };
-        let (a, b) = (points.first()?.pos, points.get(1)?.pos);
+        let i = self.rejoin_index().min(points.len().saturating_sub(2));
+        let (a, b) = (points.get(i)?.pos, points.get(i + 1)?.pos);
         let d = b - a;
         Some(Pose::new(a.x, a.y, d.y.atan2(d.x)))
     }
@@ -633,7 +731,16 @@ impl Guidance {
         }
         self.approach_index = None;
         self.approach.clear();
-        self.start_work_line()
+        let worked = self.worked;
+        self.start_work_line()?;
+        let k = self.rejoin.0.min(self.path.len().saturating_sub(1));
+        if let Some((_, at)) = worked.filter(|_| k > 0 && self.phase == Phase::Work) {
+            // Rejoined where the work stopped: on from there (`at` ≥ the distance to `k`).
+            let to_k = path_length(&self.path[..=k]);
+            self.set_worked(k, to_k.min(at));
+        }
+        self.rejoin = (0, Phase::Work);
+        Ok(())
     }
 
     /// Tag of the path being driven.
@@ -643,6 +750,27 @@ impl Guidance {
             _ => Tag::Work,
         }
     }
+}
+
+/// Length of a polyline of path points, m.
+fn path_length(points: &[PathPoint]) -> f64 {
+    points
+        .windows(2)
+        .map(|w| (w[1].pos - w[0].pos).norm())
+        .sum()
+}
+
+/// The last point of `points` at most `distance` along them from the first, and its distance.
+fn point_at_distance(points: &[PathPoint], distance: f64) -> (usize, f64) {
+    let mut at = 0.0;
+    for (i, w) in points.windows(2).enumerate() {
+        let next = at + (w[1].pos - w[0].pos).norm();
+        if next > distance {
+            return (i, at);
+        }
+        at = next;
+    }
+    (points.len().saturating_sub(1), at)
 }
 
 #[cfg(test)]

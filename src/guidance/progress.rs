@@ -175,6 +175,17 @@ pub fn check_against_plan(p: &Progress, plan: &crate::plan::job::JobPlan) -> Res
     if !(p.nudge_m.is_finite() && p.nudge_m.abs() <= MAX_NUDGE_M) {
         return Err(format!("nudge_m {}: beyond ±{MAX_NUDGE_M} m", p.nudge_m));
     }
+    if let Some(s) = p.line_worked_m {
+        if !(s.is_finite() && s >= 0.0) {
+            return Err(format!("line_worked_m {s}: not a distance along the line"));
+        }
+        if p.phase != Phase::Work {
+            return Err(format!(
+                "line_worked_m {s} in phase {:?}: only a work line is worked",
+                p.phase
+            ));
+        }
+    }
     let (block, rank) = (p.index_block, p.index_rank);
     let (expected_done, last) = match plan {
         JobPlan::Ab(ab) => {
@@ -255,6 +266,13 @@ pub struct Progress {
     /// point 5; 0 in files written before it).
     #[serde(default)]
     pub nudge_m: f64,
+    /// How far the work line (or work segment) at (block, rank) was worked when saved: m from
+    /// its start along it, to the furthest point the vehicle passed inside the engage gate,
+    /// saved every [`super::machine::CHECKPOINT_STEP_M`] of work and at every event. A resume
+    /// out of the engage gate rejoins the line there instead of at its start. Absent before the
+    /// line was worked, in a turn, and in files written before it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line_worked_m: Option<f64>,
 }
 
 /// Why a progress file cannot be trusted.
@@ -333,6 +351,7 @@ mod tests {
             phase: Phase::Turn,
             lines_done: 23,
             nudge_m: 0.0,
+            line_worked_m: None,
         }
     }
 

@@ -101,3 +101,143 @@ fn resumed_on_a_work_line_the_approach_leads_to_its_start() {
     let target = g.approach_target().unwrap();
     assert!((target.pos - g.global_path()[0].pos).norm() < 1e-9);
 }
+
+/// Drive line 0 of the job (20 m) on the line, marking it worked as the controller does inside
+/// the engage gate, until `station` m; returns the machine there.
+fn worked_to(cfg: &Config, station: f64) -> Guidance {
+    let mut g = new_guidance(cfg);
+    let start = g.global_path()[0].pos;
+    let mut s = 0.0;
+    while s <= station {
+        let p = start + v2(0.0, s);
+        g.update(&Pose::new(p.x, p.y, std::f64::consts::FRAC_PI_2))
+            .unwrap();
+        g.mark_worked();
+        s += 0.1;
+    }
+    g.drain_events().for_each(drop);
+    g
+}
+
+#[test]
+fn resumed_on_a_worked_line_the_approach_rejoins_where_the_work_stopped() {
+    let cfg = config();
+    let mut g = worked_to(&cfg, 12.05);
+    assert_eq!((g.current_line(), g.phase()), (0, Phase::Work));
+    let worked = g.worked_m().unwrap();
+    assert!((worked - 12.0).abs() < 1e-9, "{worked}");
+    // The driver took the tractor 5 m off the line, facing away, and on: the approach leads
+    // back to where the work stopped, facing along the line.
+    let start = g.global_path()[0].pos;
+    g.update(&Pose::new(start.x + 5.0, start.y + 17.0, 0.0))
+        .unwrap();
+    // (Out of the engage gate the controller does not mark the line worked.)
+    let target = g.approach_target().unwrap();
+    let line_dir = std::f64::consts::FRAC_PI_2;
+    assert!(
+        (target.pos - (start + v2(0.0, 12.0))).norm() < 1e-9,
+        "{target:?}"
+    );
+    assert!((target.heading - line_dir).abs() < 1e-9);
+    // Driven there: the line goes on from 12 m, is finished once, and nothing before 12 m is
+    // driven again.
+    let approach = JobSegment {
+        kind: SegmentKind::Transit,
+        direction: Direction::Forward,
+        cell: 0,
+        points: vec![target.pos - v2(3.0, 3.0), target.pos],
+    };
+    assert!(g.set_approach(vec![approach]));
+    assert_eq!(
+        g.progress().phase,
+        Phase::Work,
+        "saved as the line it rejoins"
+    );
+    assert_eq!(g.progress().line_worked_m, Some(worked));
+    g.update(&Pose::new(target.pos.x, target.pos.y, line_dir))
+        .unwrap();
+    assert!(!g.is_approaching());
+    assert_eq!((g.current_line(), g.phase()), (0, Phase::Work));
+    assert_eq!(g.worked_m(), Some(worked));
+    assert!(
+        (g.global_path()[g.index_global()].pos - target.pos).norm() < 1e-9,
+        "the line is taken up at the rejoin point"
+    );
+    assert_eq!(drive(&mut g, &|_| false), vec![0, 1, 2]);
+}
+
+#[test]
+fn the_approach_rejoins_where_the_work_stopped_wherever_the_vehicle_is() {
+    let cfg = config();
+    let mut g = worked_to(&cfg, 15.0);
+    let start = g.global_path()[0].pos;
+    // Reversed along the line to 6 m (the work is never marked back), then off it and away.
+    for k in 0..=90 {
+        let p = start + v2(0.0, 15.0 - k as f64 * 0.1);
+        g.update(&Pose::new(p.x, p.y, std::f64::consts::FRAC_PI_2))
+            .unwrap();
+        g.mark_worked();
+    }
+    assert!((g.worked_m().unwrap() - 15.0).abs() < 1e-9, "never back");
+    for p in [v2(-4.0, 6.0), v2(5.0, -3.0), v2(2.0, 19.5)] {
+        g.update(&Pose::new(start.x + p.x, start.y + p.y, 3.0))
+            .unwrap();
+        let target = g.approach_target().unwrap();
+        assert!(
+            (target.pos - (start + v2(0.0, 15.0))).norm() < 1e-9,
+            "from {p:?}: {target:?}"
+        );
+    }
+}
+
+#[test]
+fn the_worked_distance_is_saved_at_checkpoints_and_restored() {
+    use super::machine::CHECKPOINT_STEP_M;
+    let cfg = config();
+    let mut g = new_guidance(&cfg);
+    let start = g.global_path()[0].pos;
+    let mut checkpoints = Vec::new();
+    for k in 0..=180 {
+        let p = start + v2(0.0, k as f64 * 0.1);
+        g.update(&Pose::new(p.x, p.y, std::f64::consts::FRAC_PI_2))
+            .unwrap();
+        g.mark_worked();
+        if g.take_checkpoint() {
+            checkpoints.push(g.progress().line_worked_m.unwrap());
+        }
+        assert!(!g.take_checkpoint(), "taken once");
+    }
+    assert_eq!(
+        checkpoints,
+        vec![
+            CHECKPOINT_STEP_M,
+            2.0 * CHECKPOINT_STEP_M,
+            3.0 * CHECKPOINT_STEP_M
+        ]
+    );
+    // Saved mid-line and resumed (a restart): the approach rejoins at the saved distance.
+    let saved = g.progress();
+    assert_eq!(saved.line_worked_m, Some(18.0));
+    let plan = AbPlan::new(cfg.ab_params()).unwrap();
+    let params = cfg.control_params().guidance;
+    let mut r =
+        Guidance::resume(plan.clone(), cfg.job_definition(), params.clone(), &saved).unwrap();
+    assert_eq!(r.worked_m(), Some(18.0));
+    r.update(&Pose::new(start.x + 3.0, start.y + 19.0, 0.0))
+        .unwrap();
+    let target = r.approach_target().unwrap();
+    assert!(
+        (target.pos - (start + v2(0.0, 18.0))).norm() < 1e-9,
+        "{target:?}"
+    );
+    // In a turn the next line's start, as before: nothing was worked on it.
+    assert_eq!(drive(&mut r, &|g| g.phase() == Phase::Turn), vec![0]);
+    assert_eq!(r.progress().line_worked_m, None);
+    // A saved distance beyond the line is refused, naming it.
+    let mut bad = saved.clone();
+    bad.line_worked_m = Some(25.0);
+    let e = Guidance::resume(plan, cfg.job_definition(), params, &bad)
+        .err()
+        .unwrap();
+    assert!(e.to_string().contains("line_worked_m 25"), "{e}");
+}

@@ -21,6 +21,7 @@ fn progress(job: &JobDefinition) -> Progress {
         phase: Phase::Work,
         lines_done: 3,
         nudge_m: 0.0,
+        line_worked_m: None,
     }
 }
 

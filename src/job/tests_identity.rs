@@ -154,6 +154,7 @@ fn save_progress(
         phase,
         lines_done,
         nudge_m: 0.0,
+        line_worked_m: None,
     };
     progress_file::save(&progress_file::progress_path(dir.path()), &p).unwrap();
     dir

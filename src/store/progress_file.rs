@@ -309,6 +309,7 @@ mod tests {
             phase: Phase::Work,
             lines_done: 3,
             nudge_m: 0.0,
+            line_worked_m: None,
         }
     }
 

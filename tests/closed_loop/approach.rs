@@ -108,3 +108,61 @@ fn a_field_job_approaches_inside_the_field() {
         .report;
     assert_eq!(r.engaged_fraction, 0.0, "{r:?}");
 }
+
+#[test]
+fn resumed_out_of_the_gate_mid_line_the_approach_rejoins_where_the_work_stopped() {
+    // Stopped about half-way along the first 40 m line: progress was saved at the work's
+    // checkpoints (every 5 m along it).
+    let mut cfg = config(0.0, 0.0);
+    cfg.sim.max_time_s = 16.0;
+    let mut saved = None;
+    let first = run(
+        &cfg,
+        &DemoOptions::default(),
+        &mut |p| saved = Some(p.clone()),
+        &mut |_, _| {},
+    )
+    .unwrap();
+    assert!(!first.report.finished && first.finished_lines.is_empty());
+    let saved = saved.expect("progress saved along the line");
+    let worked = saved.line_worked_m.expect("the line's work saved");
+    assert!((10.0..=35.0).contains(&worked), "{saved:?}");
+    // Resumed with the tractor 6 m left of the line at its start, facing away: the approach
+    // leads to where the work stopped, and the line is worked on from there, not again from
+    // its start.
+    let mut cfg = config(6.0, 90.0);
+    cfg.sim.max_time_s = 200.0;
+    // Where line 0 is first driven on (within 0.3 m of it) after the resume, m along it.
+    let taken_up = |resume: agsteer::guidance::progress::Progress| {
+        let rest = run(
+            &cfg,
+            &DemoOptions {
+                resume: Some(resume),
+                record_work: true,
+                ..Default::default()
+            },
+            &mut |_| {},
+            &mut |_, _| {},
+        )
+        .unwrap();
+        assert!(rest.report.finished, "{:?}", rest.report);
+        assert_eq!(rest.finished_lines, vec![0, 1]);
+        rest.work[0]
+            .samples
+            .iter()
+            .filter(|s| s.xte_m.abs() < 0.3)
+            .map(|s| s.along_m)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let at = taken_up(saved.clone());
+    assert!(
+        (worked - 1.5..=worked + 0.5).contains(&at),
+        "line 0 taken up at {at:.2} m, its work stopped at {worked:.2} m"
+    );
+    // The same resume without the saved distance (a file from before it) starts over.
+    let at = taken_up(agsteer::guidance::progress::Progress {
+        line_worked_m: None,
+        ..saved
+    });
+    assert!(at < 2.0, "line 0 taken up at {at:.2} m");
+}

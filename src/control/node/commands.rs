@@ -13,7 +13,11 @@ impl ControllerNode {
                 match self.ctrl.plan_approach(t) {
                     Some(Ok(parts)) => {
                         self.approach_refused = false;
-                        tracing::info!(parts, "approach path to the line start planned")
+                        tracing::info!(
+                            parts,
+                            line_worked_m = ?self.ctrl.guidance().worked_m(),
+                            "approach path planned: to where the line's work stopped (its start when none)"
+                        )
                     }
                     // Logged once per run of refusals (an operator may hold the button).
                     Some(Err(e)) if !self.approach_refused => {
