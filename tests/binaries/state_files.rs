@@ -40,6 +40,7 @@ fn kill_during_write_leaves_old_or_new_file() {
         phase: Phase::Work,
         lines_done: 0,
         nudge_m: 0.0,
+        line_worked_m: Some(12.5),
     };
     progress_file::save(&path, &template).unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(20);
