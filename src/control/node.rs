@@ -44,6 +44,9 @@ pub struct NodeStatus {
     pub state: SafetyState,
     pub fault: FaultCode,
     pub engaged: bool,
+    /// Why the operator's last engage request was refused (`none` when it engaged, or
+    /// before any): the engage gate's reason (`xte_too_large`, `line_unfollowable`, …).
+    pub engage_refusal: FaultCode,
     pub fix: FixQuality,
     pub xte_m: Option<f64>,
     pub heading_error_deg: Option<f64>,
@@ -213,6 +216,7 @@ impl ControllerNode {
                 state: SafetyState::Disengaged,
                 fault: FaultCode::None,
                 engaged: false,
+                engage_refusal: FaultCode::None,
                 fix: FixQuality::None,
                 xte_m: None,
                 heading_error_deg: None,
@@ -722,11 +726,17 @@ impl ControllerNode {
         if let Some(rest) = out.get_mut(first..) {
             rest.rotate_right(rest.len() - commands_at.min(rest.len()));
         }
+        let refusal = self.supervisor.last_refusal();
+        if refusal != self.status.engage_refusal && refusal != FaultCode::None {
+            // Once per change: an operator holding the button logs one line.
+            tracing::warn!(reason = ?refusal, "engage refused");
+        }
         let g = self.ctrl.guidance();
         self.status = NodeStatus {
             state: cmd.state,
             fault: cmd.fault,
             engaged: cmd.engaged,
+            engage_refusal: refusal,
             xte_m: c.xte,
             heading_error_deg: c.heading_error.map(f64::to_degrees),
             line: g.current_line(),
