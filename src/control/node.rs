@@ -53,6 +53,9 @@ pub struct NodeStatus {
     pub line: u64,
     pub block: u64,
     pub lines_done: u64,
+    /// How far the current line has been worked, m from its start (saved with progress; a
+    /// resume out of the engage gate rejoins it there). `None` in a turn or before.
+    pub line_worked_m: Option<f64>,
     pub finished: bool,
     pub wheel_angle_command_deg: f64,
     /// The steering's lost motion (backlash + actuator deadband) learnt so far, degrees.
@@ -223,6 +226,7 @@ impl ControllerNode {
                 line: 0,
                 block: 0,
                 lines_done: 0,
+                line_worked_m: None,
                 finished: false,
                 wheel_angle_command_deg: 0.0,
                 steering_lost_motion_deg: 0.0,
@@ -742,6 +746,7 @@ impl ControllerNode {
             line: g.current_line(),
             block: g.index_block(),
             lines_done: g.lines_done(),
+            line_worked_m: g.worked_m(),
             finished: g.is_finished(),
             wheel_angle_command_deg: angle_deg,
             steering_lost_motion_deg: self.ctrl.lost_motion().to_degrees(),

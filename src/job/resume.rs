@@ -85,6 +85,7 @@ pub fn resume_or_start(job: &PreparedJob, path: &Path) -> Option<Progress> {
                 lines_done = p.lines_done,
                 block = p.index_block,
                 rank = p.index_rank,
+                line_worked_m = ?p.line_worked_m,
                 "resuming the job from {}",
                 path.display()
             );
@@ -134,6 +135,7 @@ pub fn require_resume(
                 lines_done = p.lines_done,
                 block = p.index_block,
                 rank = p.index_rank,
+                line_worked_m = ?p.line_worked_m,
                 "resuming from {}",
                 path.display()
             );
