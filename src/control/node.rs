@@ -105,6 +105,8 @@ pub struct ControllerNode {
     cusp: bool,
     /// The last approach request was refused (already logged).
     approach_refused: bool,
+    /// An engage or resume to answer once the supervisor has decided on it.
+    engage_reply: Option<crate::can::codec::OperatorReplyCommand>,
     /// Guidance failed in the previous period (its error already logged).
     guidance_failing: bool,
     /// The work line the supervisor watches (None: none).
@@ -200,6 +202,7 @@ impl ControllerNode {
             },
             cusp: false,
             approach_refused: false,
+            engage_reply: None,
             guidance_failing: false,
             supervised_line: None,
             last_request: None,
@@ -670,8 +673,8 @@ impl ControllerNode {
         }
         if !self.operator.replies.is_empty() {
             let nudge = self.ctrl.guidance().nudge_m();
-            for (command, result) in std::mem::take(&mut self.operator.replies) {
-                let reply = self.operator.frame(command, result, nudge);
+            for (command, result, reason) in std::mem::take(&mut self.operator.replies) {
+                let reply = self.operator.frame(command, result, reason, nudge);
                 if let Ok(f) = self.packer.pack(&reply) {
                     out.push(f);
                 }
@@ -684,6 +687,14 @@ impl ControllerNode {
                 .step(t, c.wheel_angle, c.xte, c.heading_error),
         };
         self.calibration_sent(t, &cmd);
+        if let Some(command) = self.engage_reply.take() {
+            // The supervisor decided on the engage in this step: answered with the next period.
+            let reason = match self.supervisor.last_refusal() {
+                FaultCode::None => cmd.fault,
+                r => r,
+            };
+            self.operator.reply_engage(command, cmd.engaged, reason);
+        }
         self.ctrl.set_engaged(cmd.engaged && calibration.is_none());
         let angle_deg = cmd.wheel_angle.to_degrees().clamp(-90.0, 90.0);
         // The steering servos the sensor's reading: command in its terms.

@@ -1,6 +1,11 @@
-//! Operator commands beyond engage and disengage (issue 16 point 5), each answered by an
-//! OperatorReply frame (command, result, the job now driven, the job's total nudge):
+//! Operator commands beyond disengage (issue 16 point 5), each answered by an OperatorReply
+//! frame (command, result, the job now driven, the job's total nudge, and for a refused engage
+//! the reason):
 //!
+//! - **engage**, **resume**: answered once the supervisor has decided, in the control period
+//!   after: `done` (engaged) or `refused` with `Reason` the safety fault code of why (the
+//!   engage gate's `xte_too_large`, `heading_error_too_large`, `line_unfollowable`, or the fault
+//!   that holds the system), so a terminal can say why nothing happened.
 //! - **nudge**: the job's lines shift by `Nudge` × `guidance.nudge_step_m`, left of the job's
 //!   reference direction (A→B) for steps > 0, at once and while engaged (a correction of the
 //!   line, as a terminal's nudge buttons do); the total is saved with the progress
@@ -52,8 +57,13 @@ pub struct OperatorState {
     pub point_a: Option<Vec2>,
     /// A job change waiting for the job layer.
     pub pending: Option<JobRequest>,
-    /// Replies to send with the next control period.
-    pub replies: Vec<(OperatorReplyCommand, OperatorReplyResult)>,
+    /// Replies to send with the next control period: command, result, reason (a
+    /// [`crate::safety::FaultCode`], `None` unless refused).
+    pub replies: Vec<(
+        OperatorReplyCommand,
+        OperatorReplyResult,
+        crate::safety::FaultCode,
+    )>,
     /// The job driven: 0 the configured one, k the k-th recorded line.
     pub job: u8,
 }
@@ -62,7 +72,29 @@ impl OperatorState {
     /// Queue a reply (a few at most per period; an operator presses buttons slowly).
     pub fn reply(&mut self, command: OperatorReplyCommand, result: OperatorReplyResult) {
         if self.replies.len() < 8 {
-            self.replies.push((command, result));
+            self.replies
+                .push((command, result, crate::safety::FaultCode::None));
+        }
+    }
+
+    /// Queue the answer to an engage or resume: `done` when engaged, else `refused` naming
+    /// `reason`.
+    pub fn reply_engage(
+        &mut self,
+        command: OperatorReplyCommand,
+        engaged: bool,
+        reason: crate::safety::FaultCode,
+    ) {
+        if self.replies.len() < 8 {
+            self.replies.push(if engaged {
+                (
+                    command,
+                    OperatorReplyResult::Done,
+                    crate::safety::FaultCode::None,
+                )
+            } else {
+                (command, OperatorReplyResult::Refused, reason)
+            });
         }
     }
 
@@ -71,6 +103,7 @@ impl OperatorState {
         &self,
         command: OperatorReplyCommand,
         result: OperatorReplyResult,
+        reason: crate::safety::FaultCode,
         nudge_m: f64,
     ) -> OperatorReply {
         OperatorReply {
@@ -78,6 +111,7 @@ impl OperatorState {
             result: Some(result),
             job: Some(self.job as f64),
             nudge: Some((nudge_m * 1e3).round().clamp(-32000.0, 32000.0)),
+            reason: Some(reason as u8 as f64).filter(|&r| r <= 61.0),
         }
     }
 }

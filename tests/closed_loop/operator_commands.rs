@@ -1,6 +1,6 @@
 //! Operator commands from the DBC (issue 16 point 5) through the controller node on an
-//! in-memory bus, closed-loop with the simulator: nudge, set A / set B, select job, each
-//! answered by an OperatorReply frame; the nudge saved with the progress and the recorded
+//! in-memory bus, closed-loop with the simulator: engage, nudge, set A / set B, select job, each
+//! answered by an OperatorReply frame (a refused engage with its reason); the nudge saved with the progress and the recorded
 //! lines in the job book across a restart.
 
 use agsteer::can::codec::{
@@ -107,13 +107,22 @@ impl Rig {
             frame: f,
         });
         self.run(2.0 * self.resolved.control.dt);
-        if matches!(code, Code::Engage | Code::Disengage) {
+        // An engage is answered once the supervisor decides (after the address claim's
+        // 250 ms at the start).
+        for _ in 0..50 {
+            if code != Code::Engage || !self.replies.is_empty() {
+                break;
+            }
+            self.run(self.resolved.control.dt);
+        }
+        if matches!(code, Code::Disengage) {
             assert!(self.replies.is_empty(), "{:?}", self.replies);
             return OperatorReply {
                 command: None,
                 result: None,
                 job: None,
                 nudge: None,
+                reason: None,
             };
         }
         assert_eq!(
@@ -268,4 +277,39 @@ fn set_a_set_b_builds_a_job_on_the_spot_and_select_job_switches_jobs() {
         (ra - pa).norm() < 1e-3 && (rb - pb).norm() < 1e-3,
         "{ra:?} {rb:?}"
     );
+}
+
+#[test]
+fn a_refused_engage_is_answered_with_its_reason() {
+    use agsteer::safety::FaultCode;
+    let mut cfg = config();
+    cfg.guidance.approach_paths = false;
+    // 3 m beside line A→B (north), facing along it: beyond the 1 m engage gate.
+    let mut rig = Rig::new(&cfg, Pose::new(3.0, 0.0, std::f64::consts::FRAC_PI_2));
+    rig.run(1.0);
+    let r = rig.send(Code::Engage, 0.0, 0.0);
+    reply(OperatorReplyCommand::Engage, Res::Refused)(&r);
+    assert_eq!(r.reason, Some(FaultCode::XteTooLarge as u8 as f64), "{r:?}");
+    assert_eq!(rig.node.status().engage_refusal, FaultCode::XteTooLarge);
+    assert!(!rig.node.status().engaged);
+    // Driving across the line (east): engaged on it, the heading is the reason.
+    let mut rig = Rig::new(&cfg, Pose::new(-4.0, 0.0, 0.0));
+    while rig.position().x < -0.2 {
+        rig.run(0.02);
+    }
+    let r = rig.send(Code::Engage, 0.0, 0.0);
+    reply(OperatorReplyCommand::Engage, Res::Refused)(&r);
+    assert_eq!(
+        r.reason,
+        Some(FaultCode::HeadingErrorTooLarge as u8 as f64),
+        "{r:?}"
+    );
+    // On the line and along it: engaged, answered done with no reason.
+    let mut rig = Rig::new(&cfg, Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
+    rig.run(1.0);
+    let r = rig.send(Code::Engage, 0.0, 0.0);
+    reply(OperatorReplyCommand::Engage, Res::Done)(&r);
+    assert_eq!(r.reason, Some(0.0));
+    assert!(rig.node.status().engaged);
+    assert_eq!(rig.node.status().engage_refusal, FaultCode::None);
 }

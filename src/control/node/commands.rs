@@ -26,7 +26,11 @@ impl ControllerNode {
                     }
                     _ => {}
                 }
-                self.supervisor.request_engage()
+                self.supervisor.request_engage();
+                self.engage_reply = Some(match command {
+                    OperatorCommand::Resume => OperatorReplyCommand::Resume,
+                    _ => OperatorReplyCommand::Engage,
+                });
             }
             OperatorCommand::Disengage | OperatorCommand::Pause => {
                 self.supervisor.request_disengage();
