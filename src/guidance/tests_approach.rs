@@ -241,3 +241,79 @@ fn the_worked_distance_is_saved_at_checkpoints_and_restored() {
         .unwrap();
     assert!(e.to_string().contains("line_worked_m 25"), "{e}");
 }
+
+#[test]
+fn a_headland_ring_resumed_out_of_the_gate_is_rejoined_where_its_work_stopped() {
+    use crate::plan::job::{JobPlan, SegmentJob};
+    // A closed 20 × 20 m ring (a headland pass: it ends where it starts), then a line.
+    let mut ring = Vec::new();
+    for (a, b) in [
+        (v2(0.0, 0.0), v2(20.0, 0.0)),
+        (v2(20.0, 0.0), v2(20.0, 20.0)),
+        (v2(20.0, 20.0), v2(0.0, 20.0)),
+        (v2(0.0, 20.0), v2(0.0, 0.5)),
+    ] {
+        let n = ((b - a).norm() / 0.5).round() as usize;
+        ring.extend((0..n).map(|k| a + (b - a) * (k as f64 / n as f64)));
+    }
+    ring.push(v2(0.0, 0.5));
+    let seg = |kind, points| JobSegment {
+        kind,
+        direction: Direction::Forward,
+        cell: 0,
+        points,
+    };
+    let line: Vec<_> = (0..=20).map(|k| v2(5.0, 5.0 + k as f64 * 0.5)).collect();
+    let plan = JobPlan::from(
+        SegmentJob::new(vec![
+            seg(SegmentKind::Work, ring.clone()),
+            seg(SegmentKind::Transit, vec![v2(0.0, 0.5), v2(5.0, 5.0)]),
+            seg(SegmentKind::Work, line),
+        ])
+        .unwrap(),
+    );
+    let cfg = Config::default();
+    let job = cfg.job_definition().with_plan(&plan);
+    let params = cfg.control_params().guidance;
+    let mut g = Guidance::new(plan.clone(), job.clone(), params.clone()).unwrap();
+    // Worked along the ring to the third side's middle (50 m), marked as inside the gate.
+    for p in &ring[..=100] {
+        g.update(&Pose::new(p.x, p.y, 0.0)).unwrap();
+        g.mark_worked();
+    }
+    let worked = g.worked_m().unwrap();
+    assert!((worked - 50.0).abs() < 0.6, "{worked}");
+    // Saved, restarted, and the tractor is beside the ring's start (which is also its end):
+    // the rejoin is where the work stopped, not the nearest point of the ring.
+    let saved = g.progress();
+    let mut r = Guidance::resume(plan, job, params, &saved).unwrap();
+    r.update(&Pose::new(-3.0, 1.0, 0.0)).unwrap();
+    let target = r.approach_target().unwrap();
+    assert!((target.pos - v2(10.0, 20.0)).norm() < 0.6, "{target:?}");
+    assert!(
+        (target.heading.abs() - std::f64::consts::PI).abs() < 1e-9,
+        "{target:?}"
+    );
+    assert!(r.set_approach(vec![seg(
+        SegmentKind::Transit,
+        vec![v2(-3.0, 1.0), target.pos]
+    )]));
+    r.update(&Pose::new(target.pos.x, target.pos.y, target.heading))
+        .unwrap();
+    assert!(!r.is_approaching());
+    // Driven on from there to the ring's end: finished once, then the rest of the job.
+    let mut finished = Vec::new();
+    for p in &ring[100..] {
+        r.update(&Pose::new(p.x, p.y, 0.0)).unwrap();
+        for ev in r.drain_events() {
+            if let Event::LineFinished { line, .. } = ev {
+                finished.push(line);
+            }
+        }
+        if !finished.is_empty() {
+            break;
+        }
+        assert_eq!(r.index_rank(), 0, "still the ring at {p:?}");
+    }
+    assert_eq!(finished, vec![0]);
+}
