@@ -125,9 +125,8 @@ pub struct Guidance {
     checkpoint_m: f64,
     /// The work advanced [`CHECKPOINT_STEP_M`] since the last checkpoint: progress is due.
     checkpoint_due: bool,
-    /// While approaching: the point of the line the approach rejoins (index into the line's
-    /// points) and the phase the job was in (what progress saves).
-    rejoin: (usize, Phase),
+    /// While approaching: where the approach leads.
+    rejoin: Rejoin,
 }
 
 impl Guidance {
@@ -156,7 +155,7 @@ impl Guidance {
             worked: None,
             checkpoint_m: 0.0,
             checkpoint_due: false,
-            rejoin: (0, Phase::Work),
+            rejoin: Rejoin::default(),
         };
         g.start_work_line()?;
         Ok(g)
@@ -431,7 +430,7 @@ impl Guidance {
     /// The phase progress saves: while approaching, the one the approach was planned in.
     fn saved_phase(&self) -> Phase {
         if self.approach_index.is_some() {
-            self.rejoin.1
+            self.rejoin.phase
         } else {
             self.phase
         }
@@ -605,7 +604,7 @@ impl Guidance {
                 None => match &self.plan {
                     JobPlan::Segments(job) => job
                         .segments()
-                        .get(self.index_rank)
+                        .get(self.rejoin.segment.unwrap_or(self.index_rank))
                         .map(|s| s.direction)
                         .unwrap_or_default(),
                     JobPlan::Ab(_) => Direction::Forward,
@@ -667,7 +666,11 @@ impl Guidance {
         if segments.is_empty() {
             return true;
         }
-        self.rejoin = (self.rejoin_index(), self.phase);
+        self.rejoin = Rejoin {
+            index: self.rejoin_index(),
+            phase: self.phase,
+            segment: self.next_work_segment(),
+        };
         self.approach = segments;
         self.load_approach_segment(0);
         true
@@ -682,9 +685,11 @@ impl Guidance {
     }
 
     /// Where an approach path leads: on a work line (or work segment) that was worked, where
-    /// the work stopped ([`Guidance::mark_worked`]); else the start of the current work line — in a turn of an AB job, of
-    /// the line the turn leads to — or of the current segment of a segment job, facing along
-    /// it. Allocates (once per engage request, never per cycle).
+    /// the work stopped ([`Guidance::mark_worked`]); else the start of the current work line;
+    /// in a turn, the start of the line it leads to (an AB job's next line, a segment job's
+    /// next work segment: the turns, transits and manoeuvres before it are no work and are
+    /// replaced by the approach; the current segment's start when no work segment follows).
+    /// Facing along the line there. Allocates (once per engage request, never per cycle).
     pub fn approach_target(&self) -> Option<Pose> {
         let mut line = Vec::new();
         let points: &[PathPoint] = match (&self.plan, self.phase) {
@@ -692,6 +697,13 @@ impl Guidance {
                 plan.work_line_points(self.index_block, self.index_rank, &mut line);
                 &line
             }
+            (JobPlan::Segments(job), Phase::Turn) => match self.next_work_segment() {
+                Some(j) => {
+                    job.points_into(j, &mut line);
+                    &line
+                }
+                None => &self.path,
+            },
             _ => &self.path,
         };
         let i = self.rejoin_index().min(points.len().saturating_sub(2));
@@ -731,16 +743,38 @@ impl Guidance {
         }
         self.approach_index = None;
         self.approach.clear();
+        let rejoin = std::mem::take(&mut self.rejoin);
+        if let Some(j) = rejoin.segment {
+            // The non-work segments the approach replaced count as done, as driven ones do.
+            self.lines_done += (j - self.index_rank) as u64;
+            self.index_rank = j;
+        }
         let worked = self.worked;
         self.start_work_line()?;
-        let k = self.rejoin.0.min(self.path.len().saturating_sub(1));
+        let k = rejoin.index.min(self.path.len().saturating_sub(1));
         if let Some((_, at)) = worked.filter(|_| k > 0 && self.phase == Phase::Work) {
             // Rejoined where the work stopped: on from there (`at` ≥ the distance to `k`).
             let to_k = path_length(&self.path[..=k]);
             self.set_worked(k, to_k.min(at));
         }
-        self.rejoin = (0, Phase::Work);
         Ok(())
+    }
+
+    /// In a non-work segment of a segment job (not approaching): the next work segment, which
+    /// an approach leads to.
+    fn next_work_segment(&self) -> Option<usize> {
+        let JobPlan::Segments(job) = &self.plan else {
+            return None;
+        };
+        if self.phase != Phase::Turn || self.approach_index.is_some() {
+            return None;
+        }
+        let from = self.index_rank + 1;
+        job.segments()
+            .get(from..)?
+            .iter()
+            .position(|s| s.is_work())
+            .map(|k| from + k)
     }
 
     /// Tag of the path being driven.
@@ -748,6 +782,28 @@ impl Guidance {
         match self.phase {
             Phase::Turn => Tag::Turn,
             _ => Tag::Work,
+        }
+    }
+}
+
+/// Where an approach leads (kept while it is driven).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Rejoin {
+    /// The point of the line the approach rejoins (index into the line's points).
+    index: usize,
+    /// The phase the job was in when the approach was planned (what progress saves).
+    phase: Phase,
+    /// A segment job's work segment the approach leads to, past the non-work segments it
+    /// replaces (`None`: the current segment).
+    segment: Option<usize>,
+}
+
+impl Default for Rejoin {
+    fn default() -> Self {
+        Rejoin {
+            index: 0,
+            phase: Phase::Work,
+            segment: None,
         }
     }
 }

@@ -317,3 +317,74 @@ fn a_headland_ring_resumed_out_of_the_gate_is_rejoined_where_its_work_stopped() 
     }
     assert_eq!(finished, vec![0]);
 }
+
+#[test]
+fn a_segment_job_resumed_in_a_turn_is_approached_to_its_next_work_segment() {
+    use crate::plan::job::{JobPlan, SegmentJob};
+    let seg = |kind, points| JobSegment {
+        kind,
+        direction: Direction::Forward,
+        cell: 0,
+        points,
+    };
+    let up: Vec<_> = (0..=30).map(|y| v2(0.0, y as f64)).collect();
+    let down: Vec<_> = (0..=30).rev().map(|y| v2(20.0, y as f64)).collect();
+    // A long transit and a reversing manoeuvre between the two work segments.
+    let transit: Vec<_> = (0..=40)
+        .map(|k| v2(k as f64 * 0.5, 30.0 + k as f64 * 0.25))
+        .collect();
+    let back = vec![v2(20.0, 40.0), v2(20.0, 35.0), v2(20.0, 30.0)];
+    let mut reverse = seg(SegmentKind::Turn, back);
+    reverse.direction = Direction::Reverse;
+    let plan = JobPlan::from(
+        SegmentJob::new(vec![
+            seg(SegmentKind::Work, up),
+            seg(SegmentKind::Transit, transit),
+            reverse,
+            seg(SegmentKind::Work, down),
+        ])
+        .unwrap(),
+    );
+    let cfg = Config::default();
+    let job = cfg.job_definition().with_plan(&plan);
+    let params = cfg.control_params().guidance;
+    let mut g = Guidance::new(plan.clone(), job.clone(), params.clone()).unwrap();
+    assert_eq!(drive(&mut g, &|g| g.index_rank() == 1), vec![0]);
+    assert_eq!((g.phase(), g.lines_done()), (Phase::Turn, 1));
+    let saved = g.progress();
+    let mut r = Guidance::resume(plan, job, params, &saved).unwrap();
+    // Off the transit: the approach leads to the next work segment's start, facing down it.
+    r.update(&Pose::new(8.0, 20.0, 0.0)).unwrap();
+    let target = r.approach_target().unwrap();
+    assert!((target.pos - v2(20.0, 30.0)).norm() < 1e-9, "{target:?}");
+    assert!((target.heading + std::f64::consts::FRAC_PI_2).abs() < 1e-9);
+    assert!(r.set_approach(vec![seg(
+        SegmentKind::Transit,
+        vec![v2(8.0, 20.0), v2(14.0, 34.0), target.pos]
+    )]));
+    assert_eq!(
+        r.next_direction(),
+        Some(Direction::Forward),
+        "the work segment's"
+    );
+    assert_eq!(
+        r.progress().index_rank,
+        1,
+        "saved as the turn until the approach ends"
+    );
+    r.update(&Pose::new(target.pos.x, target.pos.y, target.heading))
+        .unwrap();
+    assert!(!r.is_approaching());
+    // The transit and the manoeuvre are replaced and count as done; the work segment is next.
+    assert_eq!(
+        (r.index_rank(), r.phase(), r.lines_done()),
+        (3, Phase::Work, 3)
+    );
+    let p = r.progress();
+    assert!(
+        super::progress::check_against_plan(&p, r.job_plan()).is_ok(),
+        "{p:?}"
+    );
+    assert_eq!(drive(&mut r, &|_| false), vec![3]);
+    assert!(r.is_finished());
+}
