@@ -149,7 +149,8 @@ impl Controller {
     /// On an engage request at time `t`: when the vehicle is too far from the path to engage
     /// (at the job's start, or resumed after a restart or a manual drive), plan an approach
     /// path to where the current line's work stopped (its start if not worked yet; in a turn:
-    /// the next line's start) and drive it first. `None` when no approach is needed (or approaches are off);
+    /// the next work line's start, or where no clear way leads there in a field plan's
+    /// transit, the start of the segment it is in) and drive it first. `None` when no approach is needed (or approaches are off);
     /// else the number of parts (1 + cusps) or why none could be planned. Runs the analytic
     /// connection and the field check only (well under a millisecond).
     pub fn plan_approach(
@@ -166,27 +167,38 @@ impl Controller {
         if xte.abs() < a.params.max_xte && heading_error.abs() < a.params.max_heading_error {
             return None;
         }
-        let to = g.approach_target()?;
         let always = |_: &crate::plan::maneuver::path::CurvePath| true;
         let clear: &dyn Fn(&crate::plan::maneuver::path::CurvePath) -> bool = match &a.clear {
             Some(c) => c.as_ref(),
             None => &always,
         };
-        let result = crate::plan::maneuver::approach::approach_path(
-            &est.pose,
-            &to,
-            &a.params.curve,
-            a.params.spacing,
-            clear,
-        )
-        .map(|(_, parts)| {
+        let plan = |skip: bool| {
+            let to = g.approach_target_with(skip)?;
+            Some(crate::plan::maneuver::approach::approach_path(
+                &est.pose,
+                &to,
+                &a.params.curve,
+                a.params.spacing,
+                clear,
+            ))
+        };
+        // In a field plan's turn or transit: to the next work segment, else (no clear way
+        // there) back to the start of the segment it is in.
+        let mut skip = true;
+        let mut result = plan(true)?;
+        if result.is_err() && g.approach_can_skip() {
+            if let Some(r) = plan(false).filter(Result::is_ok) {
+                (result, skip) = (r, false);
+            }
+        }
+        let result = result.map(|(_, parts)| {
             let n = parts.len();
             let segments = crate::plan::job::JobSegment::from_driven_parts(
                 parts,
                 crate::plan::coverage::SegmentKind::Transit,
             );
             // Accepted: approach_allowed() held above.
-            self.guidance.set_approach(segments);
+            self.guidance.set_approach_with(segments, skip);
             n
         });
         Some(result)

@@ -660,6 +660,11 @@ impl Guidance {
     /// (a turn is no work); on a work line the line is driven on from where its work stopped
     /// (from its start if it was not worked yet; it is not finished, so it counts once).
     pub fn set_approach(&mut self, segments: Vec<JobSegment>) -> bool {
+        self.set_approach_with(segments, true)
+    }
+
+    /// [`Guidance::set_approach`] to [`Guidance::approach_target_with`]`(skip)`.
+    pub fn set_approach_with(&mut self, segments: Vec<JobSegment>, skip: bool) -> bool {
         if !self.approach_allowed() {
             return false;
         }
@@ -669,7 +674,7 @@ impl Guidance {
         self.rejoin = Rejoin {
             index: self.rejoin_index(),
             phase: self.phase,
-            segment: self.next_work_segment(),
+            segment: self.next_work_segment().filter(|_| skip),
         };
         self.approach = segments;
         self.load_approach_segment(0);
@@ -691,19 +696,33 @@ impl Guidance {
     /// replaced by the approach; the current segment's start when no work segment follows).
     /// Facing along the line there. Allocates (once per engage request, never per cycle).
     pub fn approach_target(&self) -> Option<Pose> {
+        self.approach_target_with(true)
+    }
+
+    /// Whether [`Guidance::approach_target`] leads past the segment the vehicle is in (a
+    /// segment job's turn, transit or manoeuvre followed by a work segment).
+    pub fn approach_can_skip(&self) -> bool {
+        self.next_work_segment().is_some()
+    }
+
+    /// [`Guidance::approach_target`]; with `skip` false, in a segment job's non-work segment,
+    /// that segment's own start (the fallback where no clear way leads to the next one).
+    pub fn approach_target_with(&self, skip: bool) -> Option<Pose> {
         let mut line = Vec::new();
         let points: &[PathPoint] = match (&self.plan, self.phase) {
             (JobPlan::Ab(plan), Phase::Turn) => {
                 plan.work_line_points(self.index_block, self.index_rank, &mut line);
                 &line
             }
-            (JobPlan::Segments(job), Phase::Turn) => match self.next_work_segment() {
-                Some(j) => {
-                    job.points_into(j, &mut line);
-                    &line
+            (JobPlan::Segments(job), Phase::Turn) => {
+                match self.next_work_segment().filter(|_| skip) {
+                    Some(j) => {
+                        job.points_into(j, &mut line);
+                        &line
+                    }
+                    None => &self.path,
                 }
-                None => &self.path,
-            },
+            }
             _ => &self.path,
         };
         let i = self.rejoin_index().min(points.len().saturating_sub(2));

@@ -352,6 +352,24 @@ fn a_segment_job_resumed_in_a_turn_is_approached_to_its_next_work_segment() {
     assert_eq!(drive(&mut g, &|g| g.index_rank() == 1), vec![0]);
     assert_eq!((g.phase(), g.lines_done()), (Phase::Turn, 1));
     let saved = g.progress();
+    // Where no clear way leads there, the fallback: back to the transit's own start, which is
+    // then driven (and the manoeuvre) before the work segment.
+    let mut f = Guidance::resume(plan.clone(), job.clone(), params.clone(), &saved).unwrap();
+    f.update(&Pose::new(8.0, 20.0, 0.0)).unwrap();
+    assert!(f.approach_can_skip());
+    let back = f.approach_target_with(false).unwrap();
+    assert!((back.pos - v2(0.0, 30.0)).norm() < 1e-9, "{back:?}");
+    assert!(f.set_approach_with(
+        vec![seg(SegmentKind::Transit, vec![v2(8.0, 20.0), back.pos])],
+        false
+    ));
+    f.update(&Pose::new(back.pos.x, back.pos.y, back.heading))
+        .unwrap();
+    assert_eq!(
+        (f.index_rank(), f.phase(), f.lines_done()),
+        (1, Phase::Turn, 1)
+    );
+    assert_eq!(drive(&mut f, &|_| false), vec![3]);
     let mut r = Guidance::resume(plan, job, params, &saved).unwrap();
     // Off the transit: the approach leads to the next work segment's start, facing down it.
     r.update(&Pose::new(8.0, 20.0, 0.0)).unwrap();
