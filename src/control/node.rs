@@ -216,7 +216,11 @@ impl ControllerNode {
             } else {
                 0.0
             },
-            operator: OperatorState::default(),
+            operator: OperatorState {
+                // Replies are queued in the control period: room for them up front.
+                replies: Vec::with_capacity(crate::control::operator::MAX_REPLIES),
+                ..OperatorState::default()
+            },
             calibration: calibration::CalibrationState::new(),
             status: NodeStatus {
                 state: SafetyState::Disengaged,
@@ -673,12 +677,15 @@ impl ControllerNode {
         }
         if !self.operator.replies.is_empty() {
             let nudge = self.ctrl.guidance().nudge_m();
-            for (command, result, reason) in std::mem::take(&mut self.operator.replies) {
+            // Sent in place and cleared: the queue keeps its room (no allocation per reply).
+            for i in 0..self.operator.replies.len() {
+                let (command, result, reason) = self.operator.replies[i];
                 let reply = self.operator.frame(command, result, reason, nudge);
                 if let Ok(f) = self.packer.pack(&reply) {
                     out.push(f);
                 }
             }
+            self.operator.replies.clear();
         }
         let cmd = match calibration {
             Some(demand) => self.supervisor.step(t, demand, Some(0.0), Some(0.0)),

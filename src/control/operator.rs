@@ -28,6 +28,8 @@ use crate::geo::Vec2;
 
 /// The shortest line set A / set B accepts, m (a shorter baseline makes a poor heading).
 pub const MIN_LINE_LENGTH_M: f64 = 5.0;
+/// Replies queued at most per control period (an operator presses buttons slowly).
+pub const MAX_REPLIES: usize = 8;
 /// The largest total nudge, m (the reply's range is ±32 m).
 pub const MAX_NUDGE_M: f64 = 32.0;
 
@@ -71,7 +73,7 @@ pub struct OperatorState {
 impl OperatorState {
     /// Queue a reply (a few at most per period; an operator presses buttons slowly).
     pub fn reply(&mut self, command: OperatorReplyCommand, result: OperatorReplyResult) {
-        if self.replies.len() < 8 {
+        if self.replies.len() < MAX_REPLIES {
             self.replies
                 .push((command, result, crate::safety::FaultCode::None));
         }
@@ -85,7 +87,7 @@ impl OperatorState {
         engaged: bool,
         reason: crate::safety::FaultCode,
     ) {
-        if self.replies.len() < 8 {
+        if self.replies.len() < MAX_REPLIES {
             self.replies.push(if engaged {
                 (
                     command,
