@@ -107,6 +107,8 @@ pub struct ControllerNode {
     approach_refused: bool,
     /// An engage or resume to answer once the supervisor has decided on it.
     engage_reply: Option<crate::can::codec::OperatorReplyCommand>,
+    /// The last engage beyond the gate found no approach path (its refusal says so).
+    no_approach: bool,
     /// Guidance failed in the previous period (its error already logged).
     guidance_failing: bool,
     /// The work line the supervisor watches (None: none).
@@ -203,6 +205,7 @@ impl ControllerNode {
             cusp: false,
             approach_refused: false,
             engage_reply: None,
+            no_approach: false,
             guidance_failing: false,
             supervised_line: None,
             last_request: None,
@@ -578,6 +581,18 @@ impl ControllerNode {
         }
     }
 
+    /// Why the last engage was refused (`None`: it engaged, or none yet): the supervisor's
+    /// reason, or `no_approach_path` where the gate refused because no approach path could
+    /// bring the vehicle into it.
+    fn engage_refusal(&self) -> FaultCode {
+        match self.supervisor.last_refusal() {
+            FaultCode::XteTooLarge | FaultCode::HeadingErrorTooLarge if self.no_approach => {
+                FaultCode::NoApproachPath
+            }
+            r => r,
+        }
+    }
+
     /// Tells the supervisor which work line is driven (work lines driven forward; not turns,
     /// approaches or reversing) and, when it changes, the line's sharpest curvature.
     fn supervise_line(&mut self) {
@@ -696,7 +711,7 @@ impl ControllerNode {
         self.calibration_sent(t, &cmd);
         if let Some(command) = self.engage_reply.take() {
             // The supervisor decided on the engage in this step: answered with the next period.
-            let reason = match self.supervisor.last_refusal() {
+            let reason = match self.engage_refusal() {
                 FaultCode::None => cmd.fault,
                 r => r,
             };
@@ -748,7 +763,7 @@ impl ControllerNode {
         if let Some(rest) = out.get_mut(first..) {
             rest.rotate_right(rest.len() - commands_at.min(rest.len()));
         }
-        let refusal = self.supervisor.last_refusal();
+        let refusal = self.engage_refusal();
         if refusal != self.status.engage_refusal && refusal != FaultCode::None {
             // Once per change: an operator holding the button logs one line.
             tracing::warn!(reason = ?refusal, "engage refused");

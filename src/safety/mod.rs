@@ -69,11 +69,15 @@ pub enum FaultCode {
     /// `safety.heading_mismatch_deg` off for `safety.heading_mismatch_time_s`: the heading is
     /// wrong, and every steering decision with it ([`heading`]).
     HeadingMismatch = 21,
+    /// An engage beyond the engage gate found no approach path to the line (every one would
+    /// leave the field or cross an obstacle): refused. Never a fault of the running system;
+    /// only an engage's refusal reason (OperatorReply, `engage_refusal` in the status).
+    NoApproachPath = 22,
 }
 
 impl FaultCode {
     /// Every code, in bus order.
-    pub const ALL: [FaultCode; 22] = [
+    pub const ALL: [FaultCode; 23] = [
         FaultCode::None,
         FaultCode::GnssTimeout,
         FaultCode::FixQuality,
@@ -96,6 +100,7 @@ impl FaultCode {
         FaultCode::OffLine,
         FaultCode::LineUnfollowable,
         FaultCode::HeadingMismatch,
+        FaultCode::NoApproachPath,
     ];
 }
 

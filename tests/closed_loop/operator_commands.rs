@@ -312,4 +312,27 @@ fn a_refused_engage_is_answered_with_its_reason() {
     assert_eq!(r.reason, Some(0.0));
     assert!(rig.node.status().engaged);
     assert_eq!(rig.node.status().engage_refusal, FaultCode::None);
+    // Approach paths on, but none is clear (a field check that refuses them all, as from
+    // outside a field): the reason is the missing approach, not the gate's XTE.
+    let mut cfg = config();
+    cfg.guidance.approach_paths = true;
+    let mut rig = Rig::new(&cfg, Pose::new(3.0, 0.0, std::f64::consts::FRAC_PI_2));
+    rig.node
+        .controller_mut()
+        .set_approach_clearance(std::sync::Arc::new(|_| false));
+    rig.run(1.0);
+    let r = rig.send(Code::Engage, 0.0, 0.0);
+    reply(OperatorReplyCommand::Engage, Res::Refused)(&r);
+    assert_eq!(
+        r.reason,
+        Some(FaultCode::NoApproachPath as u8 as f64),
+        "{r:?}"
+    );
+    assert_eq!(rig.node.status().engage_refusal, FaultCode::NoApproachPath);
+    // With the field check passing, the same engage drives an approach.
+    let mut rig = Rig::new(&cfg, Pose::new(3.0, 0.0, std::f64::consts::FRAC_PI_2));
+    rig.run(1.0);
+    let r = rig.send(Code::Engage, 0.0, 0.0);
+    reply(OperatorReplyCommand::Engage, Res::Done)(&r);
+    assert!(rig.node.controller().guidance().is_approaching());
 }

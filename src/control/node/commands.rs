@@ -10,7 +10,9 @@ impl ControllerNode {
     pub(super) fn on_operator(&mut self, t: f64, command: OperatorCommand) {
         match command {
             OperatorCommand::Engage | OperatorCommand::Resume => {
-                match self.ctrl.plan_approach(t) {
+                let approach = self.ctrl.plan_approach(t);
+                self.no_approach = matches!(approach, Some(Err(_)));
+                match approach {
                     Some(Ok(parts)) => {
                         self.approach_refused = false;
                         tracing::info!(
