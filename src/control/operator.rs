@@ -5,8 +5,8 @@
 //! - **engage**, **resume**: answered once the supervisor has decided, in the control period
 //!   after: `done` (engaged) or `refused` with `Reason` the safety fault code of why (the
 //!   engage gate's `xte_too_large`, `heading_error_too_large`, `line_unfollowable`, beyond it
-//!   `no_approach_path`, or the fault
-//!   that holds the system), so a terminal can say why nothing happened.
+//!   `no_approach_path`, or the fault that holds the system), so a terminal can say why
+//!   nothing happened.
 //! - **nudge**: the job's lines shift by `Nudge` × `guidance.nudge_step_m`, left of the job's
 //!   reference direction (A→B) for steps > 0, at once and while engaged (a correction of the
 //!   line, as a terminal's nudge buttons do); the total is saved with the progress
