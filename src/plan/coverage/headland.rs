@@ -202,6 +202,14 @@ fn left_bisector(ring: &[Vec2], i: usize) -> Option<Vec2> {
 /// where `ring` turns right (reflex for the area on its left), centred `r − d` beyond the
 /// vertex on the right: a pass going round them bends on radius `r` and stays `d` clear.
 fn corner_discs(ring: &[Vec2], d: f64, r: f64) -> Vec<Area> {
+    corner_disc_centres(ring, d, r)
+        .into_iter()
+        .map(|c| disc(c, r))
+        .collect()
+}
+
+/// The centres of [`corner_discs`]`(ring, d, r)`.
+fn corner_disc_centres(ring: &[Vec2], d: f64, r: f64) -> Vec<Vec2> {
     if r <= d {
         return Vec::new();
     }
@@ -211,7 +219,7 @@ fn corner_discs(ring: &[Vec2], d: f64, r: f64) -> Vec<Area> {
             let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
             cross(&(b - a), &(c - b)) < -1e-9
         })
-        .filter_map(|i| left_bisector(ring, i).map(|m| disc(ring[i] - m * (r - d), r)))
+        .filter_map(|i| left_bisector(ring, i).map(|m| ring[i] - m * (r - d)))
         .collect()
 }
 
@@ -225,6 +233,30 @@ fn difference(a: &[Area], b: &[Area]) -> Vec<Area> {
     let a = geo::MultiPolygon::new(a.iter().map(super::geometry::to_geo).collect());
     let b = geo::MultiPolygon::new(b.iter().map(super::geometry::to_geo).collect());
     super::geometry::from_geo(&a.difference(&b))
+}
+
+/// `a` minus the union of `b`, whose areas may overlap each other (the default even-odd rule
+/// of [`difference`] would keep where an even number of them overlap).
+fn difference_of_union(a: &[Area], b: &[Area]) -> Vec<Area> {
+    use geo::algorithm::bool_ops::FillRule;
+    // Non-zero winding: outer rings counter-clockwise, holes clockwise.
+    let oriented = |areas: &[Area]| {
+        geo::MultiPolygon::new(
+            areas
+                .iter()
+                .map(|(outer, holes)| {
+                    let cw: Vec<Vec<Vec2>> = holes
+                        .iter()
+                        .map(|h| h.iter().rev().copied().collect())
+                        .collect();
+                    super::geometry::to_geo(&(outer.clone(), cw))
+                })
+                .collect(),
+        )
+    };
+    super::geometry::from_geo(
+        &oriented(a).difference_with_fill_rule(&oriented(b), FillRule::NonZero),
+    )
 }
 
 /// Closed tracks (first point repeated last) along every ring of `areas`, resampled.
@@ -352,26 +384,8 @@ pub fn passes_around(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoveragePar
     let mut out = Passes::default();
     for k in 0..passes(p) {
         let d = pass_offset(p, k);
-        let mut area = offset(&[(boundary.to_vec(), vec![])], -d);
-        let mut discs = corner_discs(boundary, d, rs);
-        if !discs.is_empty() {
-            area = difference(&area, &discs);
-        }
-        if !obstacles.is_empty() {
-            let rings: Vec<Area> = obstacles.iter().map(|o| (o.clone(), vec![])).collect();
-            // An obstacle's convex corners turn right for the field around it: walk each
-            // obstacle clockwise so they are the right-hand turns.
-            discs = obstacles
-                .iter()
-                .flat_map(|o| {
-                    let cw: Vec<Vec2> = o.iter().rev().copied().collect();
-                    corner_discs(&cw, d, rs)
-                })
-                .collect();
-            let grown = union(&offset(&rings, d), &discs);
-            area = difference(&area, &grown);
-        }
-        let opened = open_without_kinks(&area, rs, p);
+        let eroded = eroded_pass_area(boundary, obstacles, d, rs);
+        let opened = open_without_kinks(&eroded, rs, p);
         for (outer, holes) in &opened {
             out.field
                 .extend(tracks_of(&[(outer.clone(), vec![])], p.point_spacing));
@@ -384,13 +398,47 @@ pub fn passes_around(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoveragePar
     out
 }
 
-/// `area` opened by `rs` (convex corners rounded), with the concave kinks that the offsets
-/// made (where offsets of distant edges meet) cut away by discs and opened again.
-fn open_without_kinks(area: &[Area], rs: f64, p: &CoverageParams) -> Vec<Area> {
+/// The area of pass centres at offset `d` (boundary shrunk by `d`, obstacles grown by `d`, the
+/// discs of radius `rs` at the sharp corners taken out: [`corner_discs`]) shrunk by a further
+/// `rs`: the first half of the opening of radius `rs`. Shrinking distributes over those steps
+/// (shrinking by `d` then `rs` is shrinking by `d + rs`; an area minus a set, shrunk by `rs`, is
+/// the area shrunk minus the set grown by `rs`; a disc grown by `rs` is the disc of radius
+/// `r + rs`), so this is one offset of the field's own rings instead of an offset of the
+/// offset, whose many arc vertices made the clipper cross every edge with every other where
+/// the area is narrow (up to 0.3 s a pass).
+fn eroded_pass_area(boundary: &[Vec2], obstacles: &[Vec<Vec2>], d: f64, rs: f64) -> Vec<Area> {
+    let mut area = offset(&[(boundary.to_vec(), vec![])], -(d + rs));
+    let mut discs: Vec<Area> = corner_disc_centres(boundary, d, rs)
+        .into_iter()
+        .map(|c| disc(c, 2.0 * rs))
+        .collect();
+    if !obstacles.is_empty() {
+        let rings: Vec<Area> = obstacles.iter().map(|o| (o.clone(), vec![])).collect();
+        discs.extend(offset(&rings, d + rs));
+        // An obstacle's convex corners turn right for the field around it: walk each
+        // obstacle clockwise so they are the right-hand turns.
+        discs.extend(obstacles.iter().flat_map(|o| {
+            let cw: Vec<Vec2> = o.iter().rev().copied().collect();
+            corner_disc_centres(&cw, d, rs)
+                .into_iter()
+                .map(|c| disc(c, 2.0 * rs))
+        }));
+    }
+    if !discs.is_empty() && !area.is_empty() {
+        area = difference_of_union(&area, &discs);
+    }
+    area
+}
+
+/// The opening of radius `rs` (convex corners rounded) of the area whose first half is
+/// `eroded` (the area shrunk by `rs`, [`eroded_pass_area`]), with the concave kinks that the
+/// offsets made (where offsets of distant edges meet) cut away by discs of radius `rs` and
+/// opened again (the kink discs grown by `rs` taken out of `eroded`, grown back by `rs`).
+fn open_without_kinks(eroded: &[Area], rs: f64, p: &CoverageParams) -> Vec<Area> {
     // Each round opens the area minus all the discs so far: opening an opened area again
     // shrinks its arcs of radius rs to points, and the polygon clipping of those degenerate
     // offsets took seconds.
-    let mut opened = offset(&offset(area, -rs), rs);
+    let mut opened = offset(eroded, rs);
     let mut kink_discs: Vec<Area> = Vec::new();
     for _ in 0..KINK_ROUNDS {
         let kinks = concave_kinks(&opened, p.point_spacing, p.r_min);
@@ -400,9 +448,9 @@ fn open_without_kinks(area: &[Area], rs: f64, p: &CoverageParams) -> Vec<Area> {
         kink_discs.extend(
             kinks
                 .iter()
-                .map(|(q, out)| disc(q + out * (rs - KINK_DISC_DEPTH), rs)),
+                .map(|(q, out)| disc(q + out * (rs - KINK_DISC_DEPTH), 2.0 * rs)),
         );
-        opened = offset(&offset(&difference(area, &kink_discs), -rs), rs);
+        opened = offset(&difference_of_union(eroded, &kink_discs), rs);
     }
     opened
 }
@@ -415,32 +463,11 @@ pub fn headland_tracks(boundary: &[Vec2], p: &CoverageParams) -> Vec<Vec<Vec2>> 
     let rs = p.r_min * SMOOTHING_RADIUS_FACTOR;
     let mut tracks = Vec::new();
     for k in 0..passes(p) {
-        let d = pass_offset(p, k);
-        let mut area = offset(&[(boundary.to_vec(), vec![])], -d);
-        let discs = corner_discs(boundary, d, rs);
-        if !discs.is_empty() {
-            area = difference(&area, &discs);
-        }
-        // The opening rounds the convex corners; concave kinks that the offset itself made
-        // (where offsets of distant edges meet) are cut away by discs and opened again.
-        // Each round opens the area minus all the discs so far: opening an opened area again
-        // shrinks its arcs of radius rs to points, and the polygon clipping of those
-        // degenerate offsets took seconds.
-        let mut opened = offset(&offset(&area, -rs), rs);
-        let mut kink_discs: Vec<Area> = Vec::new();
-        for _ in 0..KINK_ROUNDS {
-            let kinks = concave_kinks(&opened, p.point_spacing, p.r_min);
-            if kinks.is_empty() {
-                break;
-            }
-            kink_discs.extend(
-                kinks
-                    .iter()
-                    .map(|(q, out)| disc(q + out * (rs - KINK_DISC_DEPTH), rs)),
-            );
-            opened = offset(&offset(&difference(&area, &kink_discs), -rs), rs);
-        }
-        tracks.extend(tracks_of(&opened, p.point_spacing));
+        let eroded = eroded_pass_area(boundary, &[], pass_offset(p, k), rs);
+        tracks.extend(tracks_of(
+            &open_without_kinks(&eroded, rs, p),
+            p.point_spacing,
+        ));
     }
     tracks
 }
