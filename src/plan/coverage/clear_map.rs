@@ -70,15 +70,19 @@ impl<'a> ClearMap<'a> {
     /// Is the implement clear at `q` (inside the boundary, off the obstacles, `half` m from
     /// every edge)? The same answer as [`implement_clear`].
     pub(super) fn clear(&self, q: &Vec2) -> bool {
-        let i = ((q.x - self.origin.x) / self.cell).floor();
-        let j = ((q.y - self.origin.y) / self.cell).floor();
-        if !(i >= 0.0 && j >= 0.0 && (i as usize) < self.nx && (j as usize) < self.ny) {
+        let x = (q.x - self.origin.x) / self.cell;
+        let y = (q.y - self.origin.y) / self.cell;
+        // Off the grid (or not a number): checked directly. On it, the cast truncates a
+        // non-negative coordinate, as `floor` would (without the libm call per point).
+        if !(x >= 0.0 && y >= 0.0 && (x as usize) < self.nx && (y as usize) < self.ny) {
             return implement_clear(self.field, self.half, q);
         }
-        let k = j as usize * self.nx + i as usize;
+        let (i, j) = (x as usize, y as usize);
+        let k = j * self.nx + i;
         let known = self.state.borrow()[k];
         let state = if known == UNKNOWN {
-            let centre = self.origin + v2((i + 0.5) * self.cell, (j + 0.5) * self.cell);
+            let centre =
+                self.origin + v2((i as f64 + 0.5) * self.cell, (j as f64 + 0.5) * self.cell);
             let s = self.classify(centre);
             self.state.borrow_mut()[k] = s;
             s
