@@ -4,6 +4,8 @@
 //! ring is known, so a point there is checked against those few edges (its distance to each,
 //! and the parity of the edges crossed on the way to the reference point) instead of against
 //! every edge of the field: plan time on a boundary of many vertices no longer grows with them.
+//! A cell is classified against the edges near its block of [`BLOCK`] × [`BLOCK`] cells (found
+//! once per block), not against every edge: an edge far from the block is far from its cells.
 
 use super::{implement_clear, Field};
 use crate::geo::polygon::{bbox, contains_point, point_segment_distance};
@@ -33,6 +35,13 @@ const BLOCKED: u32 = 2;
 /// States from here on: near an edge, `locals[state - NEAR]`.
 const NEAR: u32 = 3;
 
+/// Cells per side of a block, whose edges within reach are found once for all its cells.
+const BLOCK: usize = 8;
+
+/// The edges of the rings within reach of one block of cells, in ring order and edge order
+/// within a ring: (ring: 0 the boundary, k obstacle k − 1; a; b).
+type BlockEdges = std::rc::Rc<[(usize, Vec2, Vec2)]>;
+
 /// [`implement_clear`] of one field and half width through a grid of cells.
 pub(super) struct ClearMap<'a> {
     field: &'a Field,
@@ -43,6 +52,8 @@ pub(super) struct ClearMap<'a> {
     ny: usize,
     state: RefCell<Vec<u32>>,
     locals: RefCell<Vec<Local>>,
+    /// Per block (row-major, `nx.div_ceil(BLOCK)` a row): its edges, `None` until first needed.
+    blocks: RefCell<Vec<Option<BlockEdges>>>,
 }
 
 impl<'a> ClearMap<'a> {
@@ -64,6 +75,7 @@ impl<'a> ClearMap<'a> {
             ny,
             state: RefCell::new(vec![UNKNOWN; nx * ny]),
             locals: RefCell::new(Vec::new()),
+            blocks: RefCell::new(vec![None; nx.div_ceil(BLOCK) * ny.div_ceil(BLOCK)]),
         }
     }
 
@@ -83,7 +95,7 @@ impl<'a> ClearMap<'a> {
         let state = if known == UNKNOWN {
             let centre =
                 self.origin + v2((i as f64 + 0.5) * self.cell, (j as f64 + 0.5) * self.cell);
-            let s = self.classify(centre);
+            let s = self.classify(centre, &self.block_edges(i / BLOCK, j / BLOCK));
             self.state.borrow_mut()[k] = s;
             s
         } else {
@@ -100,24 +112,71 @@ impl<'a> ClearMap<'a> {
         }
     }
 
-    /// The state of the cell about `centre`.
-    fn classify(&self, centre: Vec2) -> u32 {
+    /// The edges within reach of block (`bi`, `bj`): every edge within `half + reach + 1e-6` of
+    /// the centre of one of its cells (reach: the cell's half diagonal) is within `half` plus
+    /// the block's half diagonal of the block's centre, since a cell's centre lies at most
+    /// (BLOCK − 1) half cell diagonals from it.
+    fn block_edges(&self, bi: usize, bj: usize) -> BlockEdges {
+        let k = bj * self.nx.div_ceil(BLOCK) + bi;
+        if let Some(Some(edges)) = self.blocks.borrow().get(k) {
+            return edges.clone();
+        }
+        let half_block = BLOCK as f64 * 0.5 * self.cell;
+        let centre = self.origin
+            + v2(bi as f64, bj as f64) * (BLOCK as f64 * self.cell)
+            + v2(half_block, half_block);
+        // The block's half diagonal, a millimetre wider for rounding.
+        let within = self.half + half_block * std::f64::consts::SQRT_2 + 1e-3;
+        let rings = std::iter::once(&self.field.boundary).chain(self.field.obstacles.iter());
+        let mut edges = Vec::new();
+        for (r, ring) in rings.enumerate() {
+            let n = ring.len();
+            for e in 0..n {
+                let (a, b) = (ring[e], ring[(e + 1) % n]);
+                if point_segment_distance(&centre, &a, &b) <= within {
+                    edges.push((r, a, b));
+                }
+            }
+        }
+        let edges: BlockEdges = edges.into();
+        if let Some(slot) = self.blocks.borrow_mut().get_mut(k) {
+            *slot = Some(edges.clone());
+        }
+        edges
+    }
+
+    /// The state of the cell about `centre`, whose block's edges are `block`
+    /// ([`Self::block_edges`]).
+    fn classify(&self, centre: Vec2, block: &[(usize, Vec2, Vec2)]) -> u32 {
         // Every point of the cell lies within `reach` of its centre.
         let reach = self.cell * std::f64::consts::FRAC_1_SQRT_2;
-        if implement_clear(self.field, self.half + reach, &centre) {
+        // implement_clear(field, half + reach, centre); the edges off the block's list are
+        // farther than that from the centre.
+        let clear_of_edges = block
+            .iter()
+            .all(|(_, a, b)| point_segment_distance(&centre, a, b) >= self.half + reach - 1e-6);
+        if clear_of_edges
+            && contains_point(&self.field.boundary, &centre)
+            && self
+                .field
+                .obstacles
+                .iter()
+                .all(|o| !contains_point(o, &centre))
+        {
             return CLEAR;
         }
         let rings = std::iter::once(&self.field.boundary).chain(self.field.obstacles.iter());
         let mut edges = Vec::new();
         let mut near_rings = Vec::new();
         let mut far: Vec<(usize, &Vec<Vec2>)> = Vec::new();
+        let mut next = 0;
         for (r, ring) in rings.enumerate() {
             let start = edges.len();
-            let n = ring.len();
-            for e in 0..n {
-                let (a, b) = (ring[e], ring[(e + 1) % n]);
-                // Edges a point of the cell could come within `half` of, or cross on its way
-                // to the reference point (both within `reach` of the centre).
+            // Edges a point of the cell could come within `half` of, or cross on its way to
+            // the reference point (both within `reach` of the centre): of this ring's edges
+            // on the block's list (the others are farther).
+            while let Some(&(_, a, b)) = block.get(next).filter(|e| e.0 == r) {
+                next += 1;
                 if point_segment_distance(&centre, &a, &b) <= self.half + reach + 1e-6 {
                     edges.push((a, b));
                 }
