@@ -204,7 +204,7 @@ fn contention_with_a_lower_name() {
             std::thread::sleep(Duration::from_millis(500));
         }
         let st = status().unwrap();
-        let cap = parse_candump(&dump.stop());
+        let cap = parse_candump(&dump.stop_caught_up());
         let stalls = probe.stop();
         let t_lower = cap
             .iter()

@@ -103,6 +103,28 @@ impl Candump {
     pub fn stop(self) -> Vec<String> {
         self.stop_counting_drops().0
     }
+    /// [`Candump::stop`] once the capture has caught up with now: a frame stamped at or after
+    /// this moment is in (waiting up to 5 s). candump runs at normal priority beside the
+    /// real-time daemon and simulator and can read its socket hundreds of milliseconds late;
+    /// killing it loses what it has not read yet, the last moments a test wants to see.
+    pub fn stop_caught_up(self) -> Vec<String> {
+        let now = wall_s();
+        let t0 = Instant::now();
+        while t0.elapsed() < Duration::from_secs(5) {
+            let last = self
+                .lines
+                .lock()
+                .unwrap()
+                .iter()
+                .rev()
+                .find_map(|l| parse_candump(std::slice::from_ref(l)).first().map(|f| f.0));
+            if last.is_some_and(|t| t >= now) {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        self.stop()
+    }
     /// The captured frame lines and the number of frames the capture's socket dropped.
     pub fn stop_counting_drops(mut self) -> (Vec<String>, u64) {
         let _ = self.child.kill();
