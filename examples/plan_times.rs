@@ -4,8 +4,13 @@
 //! point (equal fingerprints: the same plan), then the total, median, worst and how many are
 //! over 20 ms. Seconds where the criterion bench takes minutes, for A/B runs of two builds.
 //! `cargo run --release --example plan_times [-- FILTER]` (FILTER: part of "field wW_rR").
-use agsteer::plan::coverage::{plan_field, CoverageParams, Field};
+use agsteer::plan::coverage::plan_field;
 
+#[path = "../benches/common/real_fields.rs"]
+mod real_fields;
+use real_fields::real_cases;
+
+/// The calling thread's CPU time, s.
 fn thread_cpu() -> f64 {
     let mut ts = libc::timespec {
         tv_sec: 0,
@@ -14,41 +19,6 @@ fn thread_cpu() -> f64 {
     // SAFETY: clock_gettime writes the given timespec.
     unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
     ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
-
-fn real_cases() -> Vec<(String, Field, CoverageParams)> {
-    let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tools/fields/real"));
-    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
-        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
-    files.retain(|p| p.extension().is_some_and(|e| e == "geojson"));
-    files.sort();
-    let cfg = agsteer::config::Config::default();
-    let mut cases = Vec::new();
-    for path in files {
-        let Ok(text) = std::fs::read_to_string(&path) else {
-            continue;
-        };
-        let Ok(loaded) = agsteer::field::load_field(&text, &cfg.field_load_options()) else {
-            continue;
-        };
-        if loaded.cleanup.area_after_m2 > 100e4 {
-            continue;
-        }
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().to_string())
-            .unwrap_or_default();
-        for w in [3.0, 6.0, 12.0, 36.0] {
-            for r in [5.0, 8.0] {
-                let mut p = cfg.coverage_params();
-                p.line_width = w;
-                p.r_min = r;
-                cases.push((name.clone(), loaded.field.clone(), p));
-            }
-        }
-    }
-    cases
 }
 
 fn main() {

@@ -581,18 +581,6 @@ impl ControllerNode {
         }
     }
 
-    /// Why the last engage was refused (`None`: it engaged, or none yet): the supervisor's
-    /// reason, or `no_approach_path` where the gate refused because no approach path could
-    /// bring the vehicle into it.
-    fn engage_refusal(&self) -> FaultCode {
-        match self.supervisor.last_refusal() {
-            FaultCode::XteTooLarge | FaultCode::HeadingErrorTooLarge if self.no_approach => {
-                FaultCode::NoApproachPath
-            }
-            r => r,
-        }
-    }
-
     /// Tells the supervisor which work line is driven (work lines driven forward; not turns,
     /// approaches or reversing) and, when it changes, the line's sharpest curvature.
     fn supervise_line(&mut self) {
@@ -709,14 +697,7 @@ impl ControllerNode {
                 .step(t, c.wheel_angle, c.xte, c.heading_error),
         };
         self.calibration_sent(t, &cmd);
-        if let Some(command) = self.engage_reply.take() {
-            // The supervisor decided on the engage in this step: answered with the next period.
-            let reason = match self.engage_refusal() {
-                FaultCode::None => cmd.fault,
-                r => r,
-            };
-            self.operator.reply_engage(command, cmd.engaged, reason);
-        }
+        self.answer_engage(&cmd);
         self.ctrl.set_engaged(cmd.engaged && calibration.is_none());
         let angle_deg = cmd.wheel_angle.to_degrees().clamp(-90.0, 90.0);
         // The steering servos the sensor's reading: command in its terms.

@@ -5,8 +5,33 @@ use super::ControllerNode;
 use crate::can::codec::{OperatorReplyCommand, OperatorReplyResult};
 use crate::control::operator::{JobRequest, MAX_NUDGE_M, MIN_LINE_LENGTH_M};
 use crate::input::OperatorCommand;
+use crate::safety::FaultCode;
 
 impl ControllerNode {
+    /// Why the last engage was refused (`None`: it engaged, or none yet): the supervisor's
+    /// reason, or `no_approach_path` where the gate refused because no approach path could
+    /// bring the vehicle into it.
+    pub(super) fn engage_refusal(&self) -> FaultCode {
+        match self.supervisor.last_refusal() {
+            FaultCode::XteTooLarge | FaultCode::HeadingErrorTooLarge if self.no_approach => {
+                FaultCode::NoApproachPath
+            }
+            r => r,
+        }
+    }
+
+    /// The supervisor decided on an engage or resume in this step: its answer goes out with
+    /// the next period.
+    pub(super) fn answer_engage(&mut self, cmd: &crate::safety::SteeringCommand) {
+        if let Some(command) = self.engage_reply.take() {
+            let reason = match self.engage_refusal() {
+                FaultCode::None => cmd.fault,
+                r => r,
+            };
+            self.operator.reply_engage(command, cmd.engaged, reason);
+        }
+    }
+
     pub(super) fn on_operator(&mut self, t: f64, command: OperatorCommand) {
         match command {
             OperatorCommand::Engage | OperatorCommand::Resume => {
