@@ -191,11 +191,15 @@ fn contention_with_a_lower_name() {
         std::thread::sleep(Duration::from_millis(700));
         let mut term = Terminal::new(&iface);
         if self_configurable {
-            assert!(
-                term.engage(Duration::from_secs(5)),
-                "engaged again at the new address: {:?}",
-                status()
-            );
+            if !term.engage(Duration::from_secs(5)) {
+                // What the daemon said meanwhile (engages given back, refusals, faults).
+                let log = std::fs::read_to_string("/tmp/agsteerd.log").unwrap_or_default();
+                let tail: Vec<&str> = log.lines().rev().take(25).collect();
+                panic!(
+                    "engaged again at the new address: {:?}\nlog tail: {tail:#?}",
+                    status()
+                );
+            }
             std::thread::sleep(Duration::from_millis(300));
         } else {
             term.send(1);
