@@ -193,11 +193,10 @@ fn contention_with_a_lower_name() {
         if self_configurable {
             if !term.engage(Duration::from_secs(5)) {
                 // What the daemon said meanwhile (engages given back, refusals, faults).
-                let log = std::fs::read_to_string("/tmp/agsteerd.log").unwrap_or_default();
-                let tail: Vec<&str> = log.lines().rev().take(25).collect();
                 panic!(
-                    "engaged again at the new address: {:?}\nlog tail: {tail:#?}",
-                    status()
+                    "engaged again at the new address: {:?}\nlog tail: {:#?}",
+                    status(),
+                    daemon_log_tail(25)
                 );
             }
             std::thread::sleep(Duration::from_millis(300));

@@ -81,11 +81,10 @@ fn kill_9_resume(lines: u64, kill_count: u32) {
         // speed).
         term.direction(1);
         if !term.engage(Duration::from_secs(10)) {
-            let log = std::fs::read_to_string("/tmp/agsteerd.log").unwrap_or_default();
-            let tail: Vec<&str> = log.lines().rev().take(15).collect();
             panic!(
-                "not re-engaged after kill {kills}: status {:?}\nlog tail: {tail:#?}",
-                status()
+                "not re-engaged after kill {kills}: status {:?}\nlog tail: {:#?}",
+                status(),
+                daemon_log_tail(15)
             );
         }
     }

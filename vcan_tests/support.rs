@@ -528,6 +528,12 @@ impl Terminal {
     }
 }
 
+/// The daemon's last `n` log lines, newest first (for a failure message).
+pub fn daemon_log_tail(n: usize) -> Vec<String> {
+    let log = std::fs::read_to_string("/tmp/agsteerd.log").unwrap_or_default();
+    log.lines().rev().take(n).map(str::to_string).collect()
+}
+
 /// Seconds since the epoch, the clock candump -L stamps frames with.
 pub fn wall_s() -> f64 {
     std::time::SystemTime::now()

@@ -567,13 +567,12 @@ pub fn run(
         }
 
         // Progress is saved at line changes and work checkpoints along a line, as the daemon does.
-        if node.controller_mut().guidance_mut().take_checkpoint()
-            && !node.controller().guidance().has_events()
-        {
+        let checkpoint = node.controller_mut().guidance_mut().take_checkpoint();
+        let had_events = node.controller().guidance().has_events();
+        if had_events || checkpoint {
             on_progress(&node.controller().guidance().progress());
         }
-        if node.controller().guidance().has_events() {
-            on_progress(&node.controller().guidance().progress());
+        if had_events {
             let g = node.controller_mut().guidance_mut();
             let mut turn_started = false;
             for ev in g.drain_events() {

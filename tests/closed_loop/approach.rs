@@ -130,10 +130,11 @@ fn resumed_out_of_the_gate_mid_line_the_approach_rejoins_where_the_work_stopped(
     // Resumed with the tractor 6 m left of the line at its start, facing away: the approach
     // leads to where the work stopped, and the line is worked on from there, not again from
     // its start.
-    let mut cfg = config(6.0, 90.0);
-    cfg.sim.max_time_s = 200.0;
-    // Where line 0 is first driven on (within 0.3 m of it) after the resume, m along it.
-    let taken_up = |resume: agsteer::guidance::progress::Progress| {
+    // Where line 0 is first driven on (within 0.3 m of it) after a resume from `offset` m
+    // left of its start, turned by `heading` degrees, m along it.
+    let taken_up = |resume: agsteer::guidance::progress::Progress, offset: f64, heading: f64| {
+        let mut cfg = config(offset, heading);
+        cfg.sim.max_time_s = 200.0;
         let rest = run(
             &cfg,
             &DemoOptions {
@@ -154,15 +155,22 @@ fn resumed_out_of_the_gate_mid_line_the_approach_rejoins_where_the_work_stopped(
             .map(|s| s.along_m)
             .fold(f64::INFINITY, f64::min)
     };
-    let at = taken_up(saved.clone());
-    assert!(
-        (worked - 1.5..=worked + 0.5).contains(&at),
-        "line 0 taken up at {at:.2} m, its work stopped at {worked:.2} m"
-    );
+    // Also 5 m right of it, facing across the line (a pose the test was not tuned on).
+    for (offset, heading) in [(6.0, 90.0), (-5.0, 80.0)] {
+        let at = taken_up(saved.clone(), offset, heading);
+        assert!(
+            (worked - 1.5..=worked + 0.5).contains(&at),
+            "from {offset} m / {heading}°: line 0 taken up at {at:.2} m, its work stopped at {worked:.2} m"
+        );
+    }
     // The same resume without the saved distance (a file from before it) starts over.
-    let at = taken_up(agsteer::guidance::progress::Progress {
-        line_worked_m: None,
-        ..saved
-    });
+    let at = taken_up(
+        agsteer::guidance::progress::Progress {
+            line_worked_m: None,
+            ..saved
+        },
+        6.0,
+        90.0,
+    );
     assert!(at < 2.0, "line 0 taken up at {at:.2} m");
 }

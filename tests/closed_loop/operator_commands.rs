@@ -279,6 +279,14 @@ fn set_a_set_b_builds_a_job_on_the_spot_and_select_job_switches_jobs() {
     );
 }
 
+/// The engage was refused for `reason`, in the reply and in the status.
+fn refused_for(rig: &Rig, r: &OperatorReply, reason: agsteer::safety::FaultCode) {
+    reply(OperatorReplyCommand::Engage, Res::Refused)(r);
+    assert_eq!(r.reason, Some(reason as u8 as f64), "{r:?}");
+    assert_eq!(rig.node.status().engage_refusal, reason);
+    assert!(!rig.node.status().engaged);
+}
+
 #[test]
 fn a_refused_engage_is_answered_with_its_reason() {
     use agsteer::safety::FaultCode;
@@ -288,22 +296,14 @@ fn a_refused_engage_is_answered_with_its_reason() {
     let mut rig = Rig::new(&cfg, Pose::new(3.0, 0.0, std::f64::consts::FRAC_PI_2));
     rig.run(1.0);
     let r = rig.send(Code::Engage, 0.0, 0.0);
-    reply(OperatorReplyCommand::Engage, Res::Refused)(&r);
-    assert_eq!(r.reason, Some(FaultCode::XteTooLarge as u8 as f64), "{r:?}");
-    assert_eq!(rig.node.status().engage_refusal, FaultCode::XteTooLarge);
-    assert!(!rig.node.status().engaged);
+    refused_for(&rig, &r, FaultCode::XteTooLarge);
     // Driving across the line (east): engaged on it, the heading is the reason.
     let mut rig = Rig::new(&cfg, Pose::new(-4.0, 0.0, 0.0));
     while rig.position().x < -0.2 {
         rig.run(0.02);
     }
     let r = rig.send(Code::Engage, 0.0, 0.0);
-    reply(OperatorReplyCommand::Engage, Res::Refused)(&r);
-    assert_eq!(
-        r.reason,
-        Some(FaultCode::HeadingErrorTooLarge as u8 as f64),
-        "{r:?}"
-    );
+    refused_for(&rig, &r, FaultCode::HeadingErrorTooLarge);
     // On the line and along it: engaged, answered done with no reason.
     let mut rig = Rig::new(&cfg, Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
     rig.run(1.0);
@@ -322,13 +322,7 @@ fn a_refused_engage_is_answered_with_its_reason() {
         .set_approach_clearance(std::sync::Arc::new(|_| false));
     rig.run(1.0);
     let r = rig.send(Code::Engage, 0.0, 0.0);
-    reply(OperatorReplyCommand::Engage, Res::Refused)(&r);
-    assert_eq!(
-        r.reason,
-        Some(FaultCode::NoApproachPath as u8 as f64),
-        "{r:?}"
-    );
-    assert_eq!(rig.node.status().engage_refusal, FaultCode::NoApproachPath);
+    refused_for(&rig, &r, FaultCode::NoApproachPath);
     // With the field check passing, the same engage drives an approach.
     let mut rig = Rig::new(&cfg, Pose::new(3.0, 0.0, std::f64::consts::FRAC_PI_2));
     rig.run(1.0);
