@@ -157,6 +157,10 @@ impl Controller {
         &mut self,
         t: f64,
     ) -> Option<Result<usize, crate::plan::maneuver::approach::ApproachError>> {
+        self.approach.as_ref()?;
+        // An approach left from an engage that was refused (or given back before it was
+        // driven) leads from where the vehicle was then: plan again from here.
+        self.cancel_approach();
         let a = self.approach.as_ref()?;
         let g = &self.guidance;
         if !g.approach_allowed() {
@@ -202,6 +206,14 @@ impl Controller {
             n
         });
         Some(result)
+    }
+
+    /// Drop an approach planned for an engage the supervisor refused: the job is back on its
+    /// line (status and the gate measure to it) until the next engage plans again.
+    pub fn cancel_approach(&mut self) {
+        if !self.engaged {
+            self.guidance.cancel_approach();
+        }
     }
 
     /// The estimate at `t` in the job's frame: moved right by the operator's nudge, so that

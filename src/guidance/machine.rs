@@ -127,6 +127,8 @@ pub struct Guidance {
     checkpoint_due: bool,
     /// While approaching: where the approach leads.
     rejoin: Rejoin,
+    /// While approaching: the path and `index_global` before it, restored if it is cancelled.
+    before_approach: (Vec<PathPoint>, usize),
 }
 
 impl Guidance {
@@ -156,6 +158,7 @@ impl Guidance {
             checkpoint_m: 0.0,
             checkpoint_due: false,
             rejoin: Rejoin::default(),
+            before_approach: (Vec::new(), 0),
         };
         g.start_work_line()?;
         Ok(g)
@@ -282,6 +285,7 @@ impl Guidance {
         let work = job.segments().get(i).is_some_and(|s| s.is_work());
         self.phase = if work { Phase::Work } else { Phase::Turn };
         self.index_global = 0;
+        self.local.invalidate();
         self.events.push(if work {
             Event::LineStarted {
                 block: 0,
@@ -367,6 +371,7 @@ impl Guidance {
         plan.turn_points(from, to, &mut self.path)?;
         self.phase = Phase::Turn;
         self.index_global = 0;
+        self.local.invalidate();
         self.events.push(Event::TurnStarted {
             from_line: plan.line_of(from.0, from.1),
             to_line: plan.line_of(to.0, to.1),
@@ -384,6 +389,7 @@ impl Guidance {
         plan.work_line_points(self.index_block, self.index_rank, &mut self.path);
         self.phase = Phase::Work;
         self.index_global = 0;
+        self.local.invalidate();
         self.events.push(Event::LineStarted {
             block: self.index_block,
             rank: self.index_rank as u64,

@@ -406,3 +406,87 @@ fn a_segment_job_resumed_in_a_turn_is_approached_to_its_next_work_segment() {
     assert_eq!(drive(&mut r, &|_| false), vec![3]);
     assert!(r.is_finished());
 }
+
+/// An approach set on an engage the supervisor then refused (or the operator gave back before
+/// it was driven) is dropped: the job is back on the path it was on, where it was, and the
+/// next engage plans a new approach from wherever the vehicle is then (before, the stale
+/// approach kept the gate measuring XTE to it: every later engage was refused).
+#[test]
+fn a_cancelled_approach_leaves_the_job_as_it_was() {
+    let cfg = config();
+    let mut g = worked_to(&cfg, 12.05);
+    let start = g.global_path()[0].pos;
+    let line_before = g.global_path().to_vec();
+    let off = Pose::new(start.x + 5.0, start.y + 17.0, 0.0);
+    g.update(&off).unwrap();
+    let (index_before, saved_before) = (g.index_global(), g.progress());
+    let target = g.approach_target().unwrap();
+    let approach = JobSegment {
+        kind: SegmentKind::Transit,
+        direction: Direction::Forward,
+        cell: 0,
+        points: vec![off.pos, target.pos - v2(0.0, 3.0), target.pos],
+    };
+    assert!(g.set_approach(vec![approach]));
+    g.update(&off).unwrap();
+    assert!(g.is_approaching());
+    assert!(!g.approach_allowed());
+    g.cancel_approach();
+    assert!(!g.is_approaching());
+    assert!(g.approach_allowed(), "the next engage may plan again");
+    assert_eq!(g.global_path(), &line_before[..]);
+    assert_eq!((g.phase(), g.index_global()), (Phase::Work, index_before));
+    assert_eq!(g.progress(), saved_before);
+    assert_eq!(
+        g.approach_target().unwrap(),
+        target,
+        "still where the work stopped"
+    );
+    // The local path follows the line again, not the dropped approach (one cycle).
+    g.update(&off).unwrap();
+    let near_line = g
+        .local_path()
+        .points()
+        .iter()
+        .all(|p| (p.x - start.x).abs() < 0.05);
+    assert!(
+        near_line,
+        "local path on the line: {:?}",
+        g.local_path().points()
+    );
+    // Nothing to cancel: a no-op.
+    g.cancel_approach();
+    assert_eq!(g.global_path(), &line_before[..]);
+}
+
+/// The local path is rebuilt whenever the global path is replaced, even where the nearest
+/// point's index stays the same (an approach set where the vehicle is nearest the line's first
+/// point: both indices 0).
+#[test]
+fn the_local_path_follows_an_approach_set_at_index_zero() {
+    let cfg = config();
+    let mut g = new_guidance(&cfg);
+    let start = g.global_path()[0].pos;
+    // Behind the line's start and 6 m to its side: nearest the line's first point.
+    let off = Pose::new(start.x + 6.0, start.y - 4.0, 0.0);
+    g.update(&off).unwrap();
+    assert_eq!(g.index_global(), 0);
+    let target = g.approach_target().unwrap();
+    let approach = JobSegment {
+        kind: SegmentKind::Transit,
+        direction: Direction::Forward,
+        cell: 0,
+        points: (0..=20)
+            .map(|k| off.pos + (target.pos - off.pos) * (k as f64 / 20.0))
+            .collect(),
+    };
+    assert!(g.set_approach(vec![approach]));
+    g.update(&off).unwrap();
+    assert_eq!(g.index_global(), 0);
+    let first = g.local_path().points()[0];
+    assert!(
+        (first - off.pos).norm() < 1.0,
+        "the local path starts at the approach's start {:?}, not the line's: {first:?}",
+        off.pos
+    );
+}

@@ -86,6 +86,12 @@ impl LocalPath {
         self.built_for
     }
 
+    /// The global path it was built from was replaced: rebuild at the next chance, whatever
+    /// `index_global` is then.
+    pub fn invalidate(&mut self) {
+        self.built_for = None;
+    }
+
     /// Sampled points, about `spacing` apart.
     pub fn points(&self) -> &[Vec2] {
         &self.points

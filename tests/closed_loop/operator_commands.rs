@@ -330,3 +330,54 @@ fn a_refused_engage_is_answered_with_its_reason() {
     reply(OperatorReplyCommand::Engage, Res::Done)(&r);
     assert!(rig.node.controller().guidance().is_approaching());
 }
+
+/// An engage refused after its approach was planned (here: RTK float, which the supervisor does
+/// not engage on) drops the approach: the vehicle drives on by hand and the next engage plans
+/// a new one from where it is then. Before, the stale approach stayed: the gate measured XTE to
+/// it and every later engage was refused (`xte_too_large`, seen on vcan under load).
+#[test]
+fn an_engage_refused_after_its_approach_was_planned_plans_again_on_the_next() {
+    use agsteer::sim::can_node::{Fault, FaultKind};
+    let mut cfg = config();
+    cfg.guidance.approach_paths = true;
+    let start = Pose::new(3.0, 0.0, std::f64::consts::FRAC_PI_2);
+    let mut rig = Rig::new(&cfg, start);
+    let float = Fault {
+        kind: FaultKind::RtkFloat,
+        at_s: 0.0,
+        duration_s: 1.5,
+    };
+    rig.sim = SimNode::new(
+        Simulator::new(cfg.sim_params(), start, cfg.speed()),
+        *rig.node.enu(),
+        Default::default(),
+        Scenario { fault: vec![float] },
+    );
+    rig.run(1.0);
+    let r = rig.send(Code::Engage, 0.0, 0.0);
+    reply(OperatorReplyCommand::Engage, Res::Refused)(&r);
+    let g = rig.node.controller().guidance();
+    assert!(
+        !g.is_approaching(),
+        "the refused engage's approach is dropped"
+    );
+    assert_eq!(g.global_path()[0].pos, rig.line().0, "back on line 0");
+    // Driven on by hand (straight north, 6 m), the fix RTK fixed again.
+    rig.run(3.0);
+    let here = rig.position();
+    let r = rig.send(Code::Engage, 0.0, 0.0);
+    reply(OperatorReplyCommand::Engage, Res::Done)(&r);
+    let g = rig.node.controller().guidance();
+    assert!(g.is_approaching());
+    let from = g.global_path()[0].pos;
+    assert!(
+        (from - here).norm() < 1.0,
+        "the new approach starts where the vehicle is, {here:?}: {from:?}"
+    );
+    // And it is driven: on the line within the run.
+    rig.run(30.0);
+    let g = rig.node.controller().guidance();
+    assert!(!g.is_approaching());
+    assert!(rig.node.status().engaged);
+    assert!(rig.position().x.abs() < 0.2, "{:?}", rig.position());
+}

@@ -29,6 +29,9 @@ impl ControllerNode {
                 r => r,
             };
             self.operator.reply_engage(command, cmd.engaged, reason);
+            if !cmd.engaged {
+                self.ctrl.cancel_approach();
+            }
         }
     }
 

@@ -82,6 +82,8 @@ impl Guidance {
             segment: self.next_work_segment().filter(|_| skip),
         };
         self.approach = segments;
+        self.before_approach.0.clone_from(&self.path);
+        self.before_approach.1 = self.index_global;
         self.load_approach_segment(0);
         true
     }
@@ -136,6 +138,22 @@ impl Guidance {
         Some(Pose::new(a.x, a.y, d.y.atan2(d.x)))
     }
 
+    /// Drop an approach that was set but is not wanted: the engage it was planned for was
+    /// refused, or the operator gave back while driving it. The job is back on the path it was
+    /// on before, at the same point and phase, with its worked distance; the next engage plans
+    /// a new approach from wherever the vehicle is then. Nothing while not approaching.
+    pub fn cancel_approach(&mut self) {
+        if self.approach_index.take().is_none() {
+            return;
+        }
+        self.approach.clear();
+        let rejoin = std::mem::take(&mut self.rejoin);
+        std::mem::swap(&mut self.path, &mut self.before_approach.0);
+        self.index_global = self.before_approach.1;
+        self.phase = rejoin.phase;
+        self.local.invalidate();
+    }
+
     /// Whether an approach path is being driven.
     pub fn is_approaching(&self) -> bool {
         self.approach_index.is_some()
@@ -154,6 +172,7 @@ impl Guidance {
         self.approach_index = Some(i);
         self.phase = Phase::Turn;
         self.index_global = 0;
+        self.local.invalidate();
     }
 
     /// An approach segment is done: load the next one, or the line it leads to.
