@@ -148,6 +148,14 @@ impl PathPoint {
     }
 }
 
+/// Length along a path of [`PathPoint`]s, m.
+pub fn path_length(points: &[PathPoint]) -> f64 {
+    points
+        .windows(2)
+        .map(|w| (w[1].pos - w[0].pos).norm())
+        .sum()
+}
+
 /// Signed lateral offset of `p` from the infinite line through `a` with unit direction `dir`:
 /// positive to the left of the direction of travel.
 #[inline]

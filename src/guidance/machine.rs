@@ -7,7 +7,7 @@
 //! and events are pushed only when something changes.
 
 use super::progress::{JobDefinition, Phase, Progress, PROGRESS_VERSION};
-use crate::geo::{signed_offset, wrap_angle, Direction, PathPoint, Pose, Tag, Vec2};
+use crate::geo::{path_length, signed_offset, wrap_angle, Direction, PathPoint, Pose, Tag, Vec2};
 use crate::plan::abline::AbPlan;
 use crate::plan::job::{JobPlan, JobSegment};
 use crate::plan::types::PlanError;
@@ -581,10 +581,7 @@ impl Guidance {
             return 0.0;
         }
         let i = self.index_global.min(n - 1);
-        let rest: f64 = self.path[i..]
-            .windows(2)
-            .map(|w| (w[1].pos - w[0].pos).norm())
-            .sum();
+        let rest = path_length(&self.path[i..]);
         let d = self.path[(i + 1).min(n - 1)].pos - self.path[i.min(n - 2)].pos;
         let len = d.norm();
         let ahead = if len > 0.0 {
@@ -619,7 +616,7 @@ impl Guidance {
 }
 
 mod approach;
-use approach::{path_length, point_at_distance, Rejoin};
+use approach::{point_at_distance, Rejoin};
 
 #[cfg(test)]
 mod tests;

@@ -410,10 +410,6 @@ mod tests {
             .fold(0.0, f64::max)
     }
 
-    fn polyline_length(a: &[PathPoint]) -> f64 {
-        a.windows(2).map(|s| (s[1].pos - s[0].pos).norm()).sum()
-    }
-
     #[test]
     fn turns_from_the_cache_are_the_turns_solved_in_place() {
         // Finite and endless jobs, odd and even blocks, pi and bulb turns, arcs and
@@ -455,7 +451,10 @@ mod tests {
                 let what = format!("{w} {r} {a} {n} {rate} {from:?}");
                 assert!(hausdorff(&cached, &solved) < 0.01, "{what}");
                 assert!(hausdorff(&solved, &cached) < 0.01, "{what}");
-                let (lc, ls) = (polyline_length(&cached), polyline_length(&solved));
+                let (lc, ls) = (
+                    crate::geo::path_length(&cached),
+                    crate::geo::path_length(&solved),
+                );
                 assert!((lc - ls).abs() < 0.005 * ls, "{what}: {lc} vs {ls} m");
                 assert!(cached.iter().all(|q| q.tag == solved[0].tag), "{what}");
                 assert_eq!(cached.first().map(|q| q.pos), Some(e1));

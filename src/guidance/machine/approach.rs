@@ -3,7 +3,7 @@
 //! to the next work line from a turn (docs/METHODS.md, Progress survives power loss).
 
 use super::{Guidance, GuidanceError, CHECKPOINT_STEP_M};
-use crate::geo::{PathPoint, Pose, Tag};
+use crate::geo::{path_length, PathPoint, Pose, Tag};
 use crate::guidance::progress::Phase;
 use crate::plan::job::{JobPlan, JobSegment};
 
@@ -241,14 +241,6 @@ impl Default for Rejoin {
             segment: None,
         }
     }
-}
-
-/// Length of a polyline of path points, m.
-pub(super) fn path_length(points: &[PathPoint]) -> f64 {
-    points
-        .windows(2)
-        .map(|w| (w[1].pos - w[0].pos).norm())
-        .sum()
 }
 
 /// The last point of `points` at most `distance` along them from the first, and its distance.
