@@ -110,8 +110,16 @@ fn kill_9_resume(lines: u64, kill_count: u32) {
     // The daemon finishes the last line when its estimate is within `guidance.end_distance_m`
     // of the end; the simulator's trajectory (0.05 s samples, written by a process a frozen
     // guest may not have run yet) gets there a moment later: the tractor drives on past the
-    // end, so wait for the file to show it before judging the last line.
-    std::thread::sleep(Duration::from_millis(1500));
+    // end, so wait (up to 10 s) for the file to show every line's end before judging them.
+    let until = std::time::Instant::now() + Duration::from_secs(10);
+    while std::time::Instant::now() < until
+        && line_record(traj, &set)
+            .lines
+            .iter()
+            .any(|l| l.finished_at.is_none())
+    {
+        std::thread::sleep(Duration::from_millis(200));
+    }
     let cap = parse_candump(&dump.stop());
     let stalls = probe.stop();
     let cmds = steering_frames(&cap);
