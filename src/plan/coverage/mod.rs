@@ -246,16 +246,21 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
     );
     let loose = |q: &Vec2| loose_map.clear(q);
     // Waypoints for detours and transits that cannot go direct: grids of clear points over
-    // the field. (Built on first need: most plans never need them.)
-    let grid_of = |usable: &dyn Fn(&Vec2) -> bool| {
-        let (lo, hi) = crate::geo::polygon::bbox(field.boundary.iter())
-            .unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
-        transit::WaypointGrid::new(lo, hi, 2.0 * p.r_min, 20_000, usable)
-    };
+    // the field, each with the test of its curves. (Built on first need: most plans never
+    // need them.)
+    let (grid_lo, grid_hi) =
+        crate::geo::polygon::bbox(field.boundary.iter()).unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
+    let grid_step = 2.0 * p.r_min;
     let waypoint_grid = std::cell::OnceCell::new();
-    let waypoint_grid = || waypoint_grid.get_or_init(|| grid_of(&clear));
+    let waypoint_grid = || {
+        waypoint_grid
+            .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, &clear))
+    };
     let loose_grid = std::cell::OnceCell::new();
-    let loose_grid = || loose_grid.get_or_init(|| grid_of(&loose));
+    let loose_grid = || {
+        loose_grid
+            .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, &loose))
+    };
     let warnings = std::cell::RefCell::new(Vec::<String>::new());
 
     // Cells and their swath directions.
@@ -406,17 +411,10 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
                 Way::Direct => transit::transit(f, hf, q, hq, r, step, ok)
                     .and_then(|(pts, ok)| ok.then_some(pts)),
                 Way::Headland => rings.transit(f, hf, q, hq, r, step, ok),
-                Way::Waypoints => transit::route_graph(
-                    f,
-                    hf,
-                    q,
-                    hq,
-                    r,
-                    step,
-                    ok,
-                    loose_grid(),
-                    ROUTE_MAX_EXPANSIONS,
-                ),
+                // (Only relaxed: the loose grid's test is `ok`.)
+                Way::Waypoints => {
+                    transit::route_graph(f, hf, q, hq, r, step, loose_grid(), ROUTE_MAX_EXPANSIONS)
+                }
             };
             if let Some(pts) = pts {
                 tracing::trace!(t, ?way, relaxed, "transit found");
@@ -507,7 +505,6 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
             h1,
             p.r_min,
             p.point_spacing,
-            &clear,
             waypoint_grid(),
             DETOUR_MAX_EXPANSIONS,
         )

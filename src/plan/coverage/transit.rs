@@ -82,36 +82,66 @@ impl Csc {
         })
     }
 
-    /// Points evenly spaced along the exact curve (arc, straight, arc), about `step` m apart,
-    /// the last one the goal: every point lies on the curve and the chords are all alike, so
-    /// three-point curvature never reads more than 1/r, even across the joins of the pieces.
-    /// Checked one by one as they are made: `None` at the first point where `clear` fails.
-    fn points(&self, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> Option<Vec<Vec2>> {
-        let n = (self.length / step).ceil().max(1.0) as usize;
+    /// Point `k` of `n` + 1 evenly spaced along the exact curve (arc, straight, arc); point
+    /// `n` is the goal.
+    fn point_at(&self, k: usize, n: usize) -> Vec2 {
         let l2 = self.l1 + self.straight;
         let r = self.r;
         let on_arc = |c: Vec2, h0: f64, s: f64, along: f64| {
             c - left_normal(&heading_vec(h0 + s * along / r)) * (s * r)
         };
+        let at = self.length * k as f64 / n as f64;
+        if k == n {
+            self.p2
+        } else if at <= self.l1 {
+            on_arc(self.c1, self.h1, self.s1, at)
+        } else if at <= l2 {
+            self.t1 + heading_vec(self.theta) * (at - self.l1)
+        } else {
+            on_arc(self.c2, self.theta, self.s2, at - l2)
+        }
+    }
+
+    /// Points evenly spaced along the exact curve (arc, straight, arc), about `step` m apart,
+    /// the last one the goal: every point lies on the curve and the chords are all alike, so
+    /// three-point curvature never reads more than 1/r, even across the joins of the pieces.
+    /// `None` when `clear` fails at a point: every [`CHECK_STRIDE`]th point is checked first
+    /// (a blocked curve is blocked along a stretch, found after a few checks), then the rest.
+    fn points(&self, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> Option<Vec<Vec2>> {
+        let n = (self.length / step).ceil().max(1.0) as usize;
+        let coarse = |k: usize| k % CHECK_STRIDE == CHECK_STRIDE / 2;
+        if !(CHECK_STRIDE / 2..=n)
+            .step_by(CHECK_STRIDE)
+            .all(|k| clear(&self.point_at(k, n)))
+        {
+            return None;
+        }
         let mut pts = Vec::with_capacity(n + 1);
         for k in 0..=n {
-            let at = self.length * k as f64 / n as f64;
-            let q = if k == n {
-                self.p2
-            } else if at <= self.l1 {
-                on_arc(self.c1, self.h1, self.s1, at)
-            } else if at <= l2 {
-                self.t1 + heading_vec(self.theta) * (at - self.l1)
-            } else {
-                on_arc(self.c2, self.theta, self.s2, at - l2)
-            };
-            if !clear(&q) {
+            let q = self.point_at(k, n);
+            if !coarse(k) && !clear(&q) {
                 return None;
             }
             pts.push(q);
         }
         Some(pts)
     }
+}
+
+/// Points of a curve checked first (every this many, then the rest): the same answer as
+/// checking them in order, with fewer checks of a curve that is not clear.
+const CHECK_STRIDE: usize = 8;
+
+/// Is `clear` true at every point of `pts` (each moved by `base`)? Every
+/// [`CHECK_STRIDE`]th point first, then the rest.
+fn all_clear(pts: &[Vec2], base: Vec2, clear: &dyn Fn(&Vec2) -> bool) -> bool {
+    (0..CHECK_STRIDE).all(|o| {
+        let o = (o + CHECK_STRIDE / 2) % CHECK_STRIDE;
+        pts.iter()
+            .skip(o)
+            .step_by(CHECK_STRIDE)
+            .all(|q| clear(&(base + q)))
+    })
 }
 
 /// Points of the Dubins CSC path from (`p1`, heading `h1`) to (`p2`, heading `h2`) with turn
@@ -179,9 +209,10 @@ pub fn transit(
     Some((csc(p1, h1, p2, h2, *a, *b, r, step, true)?.1, false))
 }
 
-/// Clear waypoints on a square grid: the nodes of [`route_graph`].
-#[derive(Debug, Clone)]
-pub struct WaypointGrid {
+/// Clear waypoints on a square grid: the nodes of [`route_graph`], with the test of the points
+/// of its curves (the one its nodes were chosen by).
+#[derive(Clone)]
+pub struct WaypointGrid<'a> {
     /// Position of node (0, 0), m.
     pub origin: Vec2,
     /// Node spacing, m.
@@ -190,6 +221,8 @@ pub struct WaypointGrid {
     pub ny: usize,
     /// Node (i, j) at `j * nx + i` is usable.
     pub usable: Vec<bool>,
+    /// Is a point of a curve clear?
+    clear: &'a dyn Fn(&Vec2) -> bool,
     /// The curves between nodes, solved once (see [`EdgeTable`]).
     edges: RefCell<EdgeTable>,
 }
@@ -219,6 +252,11 @@ struct EdgeTable {
     /// Length of each edge's shortest word, m; infinite where the edge arrives against its
     /// direction (see [`arrival_headings`]) or has no word.
     shortest: Vec<f64>,
+    /// Edges between nodes whose points were checked, by every search on the grid (they are
+    /// the same curves checked by the same test): (state, state) → the first clear word and
+    /// its length, `None` when none is clear. (Plans of many transits search the same ground
+    /// again: a third to half of the edges a search checks were checked before.)
+    checked: CheckedEdges,
 }
 
 impl EdgeTable {
@@ -238,6 +276,7 @@ impl EdgeTable {
         }
         let n = EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS * GRAPH_HEADINGS;
         self.key = key;
+        self.checked.clear();
         self.slots = vec![None; n];
         self.shortest = vec![f64::INFINITY; n];
         for di in -EDGE_REACH..=EDGE_REACH {
@@ -257,15 +296,16 @@ impl EdgeTable {
     }
 }
 
-impl WaypointGrid {
-    /// Nodes every `step` m over the box `lo`–`hi` where `usable` holds; at most `max_nodes`
-    /// (the step grows to fit).
+impl<'a> WaypointGrid<'a> {
+    /// Nodes every `step` m over the box `lo`–`hi` where `clear` holds; at most `max_nodes`
+    /// (the step grows to fit). The curves of every search on the grid keep `clear` at every
+    /// point.
     pub fn new(
         lo: Vec2,
         hi: Vec2,
         step: f64,
         max_nodes: usize,
-        usable: &dyn Fn(&Vec2) -> bool,
+        clear: &'a dyn Fn(&Vec2) -> bool,
     ) -> Self {
         let span = hi - lo;
         let step = step.max((span.x.max(0.0) * span.y.max(0.0) / max_nodes.max(1) as f64).sqrt());
@@ -277,11 +317,12 @@ impl WaypointGrid {
             nx,
             ny,
             usable: vec![false; nx * ny],
+            clear,
             edges: RefCell::default(),
         };
         for j in 0..ny {
             for i in 0..nx {
-                grid.usable[j * nx + i] = usable(&grid.node(i, j));
+                grid.usable[j * nx + i] = clear(&grid.node(i, j));
             }
         }
         grid
@@ -407,13 +448,14 @@ fn arrival_headings(dir: Vec2, from: Option<usize>) -> impl Iterator<Item = usiz
 
 /// A clear transit through several waypoints: A* over (waypoint, heading) states joined by
 /// clear CSC curves to the waypoints within two grid steps, from the start pose to the goal
-/// pose; at most `max_expansions` states are expanded. `None` when no clear way was found.
+/// pose, every point clear by the grid's test; at most `max_expansions` states are expanded.
+/// `None` when no clear way was found.
 ///
 /// The search is lazy: a state is queued with the length of its edge's shortest word, and the
 /// edge's points are checked only when the state comes off the queue (then it is queued again
 /// with a longer word's length, or dropped when no word is clear), so each expansion checks
 /// one curve instead of the sixty it could reach. The edges between nodes come from the grid's
-/// [`EdgeTable`].
+/// [`EdgeTable`], their checks kept there for the grid's later searches.
 #[allow(clippy::too_many_arguments)]
 pub fn route_graph(
     p1: Vec2,
@@ -422,10 +464,10 @@ pub fn route_graph(
     h2: f64,
     r: f64,
     step: f64,
-    clear: &dyn Fn(&Vec2) -> bool,
     grid: &WaypointGrid,
     max_expansions: usize,
 ) -> Option<Vec<Vec2>> {
+    let clear = grid.clear;
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
     const H: usize = GRAPH_HEADINGS;
@@ -505,12 +547,21 @@ pub fn route_graph(
         let (known, fresh) = match checked.get(&(from, s as u32)) {
             Some(k) => (*k, false),
             None => {
-                let (base, words) = words_of(from, s);
-                let k = words
-                    .iter()
-                    .enumerate()
-                    .find(|(_, w)| w.pts.iter().all(|q| clear(&(base + q))))
-                    .map(|(w, found)| (w as u8, found.length));
+                let earlier = (from != START)
+                    .then(|| grid.edges.borrow().checked.get(&(from, s as u32)).copied())
+                    .flatten();
+                let k = earlier.unwrap_or_else(|| {
+                    let (base, words) = words_of(from, s);
+                    let k = words
+                        .iter()
+                        .enumerate()
+                        .find(|(_, w)| all_clear(&w.pts, base, clear))
+                        .map(|(w, found)| (w as u8, found.length));
+                    if from != START {
+                        grid.edges.borrow_mut().checked.insert((from, s as u32), k);
+                    }
+                    k
+                });
                 checked.insert((from, s as u32), k);
                 (k, true)
             }
