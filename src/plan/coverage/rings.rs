@@ -157,6 +157,18 @@ impl Rings {
             if entries.is_empty() || exits.is_empty() {
                 continue;
             }
+            // Every way through this ring is at least as long as the straight distances to
+            // its nearest entry and from its nearest exit: none beats the best so far when
+            // those do not (a micrometre of margin for the rounding of the curves' lengths).
+            let nearest = |q: &Vec2, pts: &[usize]| {
+                pts.iter()
+                    .map(|&i| (ring.pts[i] - q).norm())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let bound = nearest(&p1, &entries) + nearest(&p2, &exits) - 1e-6;
+            if best.as_ref().is_some_and(|b| b.0 <= bound) {
+                continue;
+            }
             for dir in [1, -1] {
                 let ins: Vec<(usize, f64)> = entries
                     .iter()
@@ -170,6 +182,15 @@ impl Rings {
                         csc_length(ring.pts[j], ring.heading(j, dir), p2, h2, r).map(|l| (j, l))
                     })
                     .collect();
+                // Every join costs at least the shortest way on plus the shortest way off.
+                let least =
+                    |v: &[(usize, f64)]| v.iter().map(|e| e.1).fold(f64::INFINITY, f64::min);
+                if best
+                    .as_ref()
+                    .is_some_and(|b| b.0 <= least(&ins) + least(&outs))
+                {
+                    continue;
+                }
                 let mut joins: Vec<(f64, usize, usize)> = ins
                     .iter()
                     .flat_map(|&(i, li)| {
@@ -178,7 +199,18 @@ impl Rings {
                     })
                     .filter(|&(_, i, j)| ring.stretch_clear(i, j, dir))
                     .collect();
-                joins.sort_by(|a, b| a.0.total_cmp(&b.0));
+                // The cheapest MAX_VERIFIED in order of cost (ties in the order made, as a
+                // stable sort of them all leaves them): a selection, then a sort of those few.
+                let mut order: Vec<(f64, usize)> =
+                    joins.iter().enumerate().map(|(k, j)| (j.0, k)).collect();
+                let by_cost =
+                    |a: &(f64, usize), b: &(f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+                if order.len() > MAX_VERIFIED {
+                    order.select_nth_unstable_by(MAX_VERIFIED, by_cost);
+                    order.truncate(MAX_VERIFIED);
+                }
+                order.sort_unstable_by(by_cost);
+                joins = order.iter().map(|&(_, k)| joins[k]).collect();
                 let mut curve_in = std::collections::HashMap::new();
                 let mut curve_out = std::collections::HashMap::new();
                 for &(cost, i, j) in joins.iter().take(MAX_VERIFIED) {

@@ -17,6 +17,8 @@ struct Csc {
     s1: f64,
     s2: f64,
     theta: f64,
+    /// Direction of the straight (heading `theta`).
+    dir: Vec2,
     t1: Vec2,
     /// Lengths of the first arc and of the straight, and the whole length, m.
     l1: f64,
@@ -28,12 +30,18 @@ struct Csc {
 }
 
 impl Csc {
-    /// The Dubins CSC curve from (`p1`, heading `h1`) to (`p2`, heading `h2`) with turn senses
-    /// `s1`, `s2` (+1 left, −1 right) and radius `r`; `None` when the word has no solution.
-    #[allow(clippy::too_many_arguments)]
-    fn new(p1: Vec2, h1: f64, p2: Vec2, h2: f64, s1: f64, s2: f64, r: f64) -> Option<Self> {
-        let c1 = p1 + left_normal(&heading_vec(h1)) * (s1 * r);
-        let c2 = p2 + left_normal(&heading_vec(h2)) * (s2 * r);
+    /// The Dubins CSC curve from (`p1`, heading `h1`, left normal `n1`) to (`p2`, `h2`, `n2`)
+    /// with turn senses `s1`, `s2` (+1 left, −1 right) and radius `r`; `None` when the word
+    /// has no solution. (The normals are shared by the four words of two poses.)
+    fn with_normals(
+        (p1, h1, n1): (Vec2, f64, Vec2),
+        (p2, h2, n2): (Vec2, f64, Vec2),
+        s1: f64,
+        s2: f64,
+        r: f64,
+    ) -> Option<Self> {
+        let c1 = p1 + n1 * (s1 * r);
+        let c2 = p2 + n2 * (s2 * r);
         let d = c2 - c1;
         let dist = d.norm();
         // Tangent direction of the straight.
@@ -60,10 +68,11 @@ impl Csc {
         let a1 = sweep(h1, theta, s1);
         let a2 = sweep(theta, h2, s2);
         // Tangent points.
-        let t1 = c1 - left_normal(&heading_vec(theta)) * (s1 * r);
-        let t2 = c2 - left_normal(&heading_vec(theta)) * (s2 * r);
+        let dir = heading_vec(theta);
+        let t1 = c1 - left_normal(&dir) * (s1 * r);
+        let t2 = c2 - left_normal(&dir) * (s2 * r);
         let straight = (t2 - t1).norm();
-        if (t2 - t1).dot(&heading_vec(theta)) < -1e-6 {
+        if (t2 - t1).dot(&dir) < -1e-6 {
             return None;
         }
         Some(Csc {
@@ -73,6 +82,7 @@ impl Csc {
             s1,
             s2,
             theta,
+            dir,
             t1,
             l1: r * a1,
             straight,
@@ -96,7 +106,7 @@ impl Csc {
         } else if at <= self.l1 {
             on_arc(self.c1, self.h1, self.s1, at)
         } else if at <= l2 {
-            self.t1 + heading_vec(self.theta) * (at - self.l1)
+            self.t1 + self.dir * (at - self.l1)
         } else {
             on_arc(self.c2, self.theta, self.s2, at - l2)
         }
@@ -144,45 +154,31 @@ fn all_clear(pts: &[Vec2], base: Vec2, clear: &dyn Fn(&Vec2) -> bool) -> bool {
     })
 }
 
-/// Points of the Dubins CSC path from (`p1`, heading `h1`) to (`p2`, heading `h2`) with turn
-/// senses `s1`, `s2` (+1 left, −1 right), about `step` m apart (none unless `points`); `None`
-/// when the word has no solution. Returns (length m, points).
-#[allow(clippy::too_many_arguments)]
-fn csc(
-    p1: Vec2,
-    h1: f64,
-    p2: Vec2,
-    h2: f64,
-    s1: f64,
-    s2: f64,
-    r: f64,
-    step: f64,
-    points: bool,
-) -> Option<(f64, Vec<Vec2>)> {
-    let curve = Csc::new(p1, h1, p2, h2, s1, s2, r)?;
-    if !points {
-        return Some((curve.length, Vec::new()));
-    }
-    Some((curve.length, curve.points(step, &|_| true)?))
+/// The turn senses of the CSC words: LSL, RSR, LSR, RSL.
+const WORDS: [(f64, f64); 4] = [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)];
+
+/// The CSC curves from (`p1`, `h1`) to (`p2`, `h2`) with radius `r`, one per word that has a
+/// solution, in [`WORDS`] order.
+fn words(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> impl Iterator<Item = Csc> {
+    let a = (p1, h1, left_normal(&heading_vec(h1)));
+    let b = (p2, h2, left_normal(&heading_vec(h2)));
+    WORDS
+        .into_iter()
+        .filter_map(move |(s1, s2)| Csc::with_normals(a, b, s1, s2, r))
 }
 
-/// The CSC words from (`p1`, `h1`) to (`p2`, `h2`) with radius `r` that have a solution,
-/// shortest first: (length m, turn senses).
-fn words_by_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Vec<(f64, (f64, f64))> {
-    const WORDS: [(f64, f64); 4] = [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)];
-    let mut words: Vec<(f64, (f64, f64))> = WORDS
-        .iter()
-        .filter_map(|&(a, b)| csc(p1, h1, p2, h2, a, b, r, 1.0, false).map(|c| (c.0, (a, b))))
-        .collect();
-    words.sort_by(|a, b| a.0.total_cmp(&b.0));
+/// The CSC curves from (`p1`, `h1`) to (`p2`, `h2`) with radius `r` that have a solution,
+/// shortest first.
+fn words_by_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Vec<Csc> {
+    let mut words: Vec<Csc> = words(p1, h1, p2, h2, r).collect();
+    words.sort_by(|a, b| a.length.total_cmp(&b.length));
     words
 }
 
 /// Length of the shortest CSC curve from (`p1`, `h1`) to (`p2`, `h2`) with radius `r`, m.
 pub fn csc_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Option<f64> {
-    [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)]
-        .iter()
-        .filter_map(|&(a, b)| csc(p1, h1, p2, h2, a, b, r, 1.0, false).map(|c| c.0))
+    words(p1, h1, p2, h2, r)
+        .map(|c| c.length)
         .min_by(f64::total_cmp)
 }
 
@@ -200,13 +196,12 @@ pub fn transit(
     // Lengths first; points only for the words tried, shortest first, each given up at its
     // first point that is not clear.
     let words = words_by_length(p1, h1, p2, h2, r);
-    for &(_, (a, b)) in &words {
-        if let Some(pts) = Csc::new(p1, h1, p2, h2, a, b, r)?.points(step, clear) {
+    for curve in &words {
+        if let Some(pts) = curve.points(step, clear) {
             return Some((pts, true));
         }
     }
-    let (_, (a, b)) = words.first()?;
-    Some((csc(p1, h1, p2, h2, *a, *b, r, step, true)?.1, false))
+    Some((words.first()?.points(step, &|_| true)?, false))
 }
 
 /// Clear waypoints on a square grid: the nodes of [`route_graph`], with the test of the points
@@ -233,6 +228,16 @@ pub struct WaypointGrid<'a> {
 struct EdgeWord {
     length: f64,
     pts: Vec<Vec2>,
+}
+
+impl EdgeWord {
+    /// The word of `curve`, points about `step` m apart.
+    fn of(curve: &Csc, step: f64) -> Option<Self> {
+        Some(EdgeWord {
+            length: curve.length,
+            pts: curve.points(step, &|_| true)?,
+        })
+    }
 }
 
 /// Nodes an edge of the waypoint graph may join: up to this many grid steps apart each way.
@@ -342,9 +347,7 @@ impl<'a> WaypointGrid<'a> {
         let origin = Vec2::new(0.0, 0.0);
         let words: Rc<[EdgeWord]> = words_by_length(origin, h1, to, h2, r)
             .into_iter()
-            .filter_map(|(length, (a, b))| {
-                csc(origin, h1, to, h2, a, b, r, step, true).map(|c| EdgeWord { length, pts: c.1 })
-            })
+            .filter_map(|c| EdgeWord::of(&c, step))
             .collect();
         table.slots[slot] = Some(words.clone());
         words
@@ -488,9 +491,7 @@ pub fn route_graph(
         if parent == START {
             let words: Rc<[EdgeWord]> = words_by_length(p1, h1, q, h, r)
                 .into_iter()
-                .filter_map(|(length, (a, b))| {
-                    csc(p1, h1, q, h, a, b, r, step, true).map(|c| EdgeWord { length, pts: c.1 })
-                })
+                .filter_map(|c| EdgeWord::of(&c, step))
                 .collect();
             return (Vec2::new(0.0, 0.0), words);
         }
