@@ -157,10 +157,6 @@ impl Controller {
         &mut self,
         t: f64,
     ) -> Option<Result<usize, crate::plan::maneuver::approach::ApproachError>> {
-        self.approach.as_ref()?;
-        // An approach left from an engage that was refused (or given back before it was
-        // driven) leads from where the vehicle was then: plan again from here.
-        self.cancel_approach();
         let a = self.approach.as_ref()?;
         let g = &self.guidance;
         if !g.approach_allowed() {
@@ -208,14 +204,6 @@ impl Controller {
         Some(result)
     }
 
-    /// Drop an approach planned for an engage the supervisor refused: the job is back on its
-    /// line (status and the gate measure to it) until the next engage plans again.
-    pub fn cancel_approach(&mut self) {
-        if !self.engaged {
-            self.guidance.cancel_approach();
-        }
-    }
-
     /// The estimate at `t` in the job's frame: moved right by the operator's nudge, so that
     /// the vehicle tracks every path shifted left by it (issue 16 point 5).
     fn job_estimate(&self, t: f64) -> Option<VehicleEstimate> {
@@ -249,8 +237,14 @@ impl Controller {
 
     /// Whether the safety supervisor engaged the latest command (the actuator steers by the
     /// next ones).
+    /// An approach is kept only while engaged: one planned for an engage the supervisor
+    /// refused, or given back before it was driven, is dropped (the job back on its path;
+    /// the next engage plans from where the vehicle is then).
     pub fn set_engaged(&mut self, engaged: bool) {
         self.engaged = engaged;
+        if !engaged {
+            self.guidance.cancel_approach();
+        }
     }
 
     /// The learnt lost motion of the steering (backlash + actuator deadband), rad.

@@ -332,8 +332,8 @@ fn a_refused_engage_is_answered_with_its_reason() {
 }
 
 /// An engage refused after its approach was planned (here: RTK float, which the supervisor does
-/// not engage on) drops the approach: the vehicle drives on by hand and the next engage plans
-/// a new one from where it is then. Before, the stale approach stayed: the gate measured XTE to
+/// not engage on) drops the approach, as does a give-back while it is driven: the vehicle
+/// drives on by hand and the next engage plans a new one from where it is then. Before, the stale approach stayed: the gate measured XTE to
 /// it and every later engage was refused (`xte_too_large`, seen on vcan under load).
 #[test]
 fn an_engage_refused_after_its_approach_was_planned_plans_again_on_the_next() {
@@ -374,6 +374,18 @@ fn an_engage_refused_after_its_approach_was_planned_plans_again_on_the_next() {
         (from - here).norm() < 1.0,
         "the new approach starts where the vehicle is, {here:?}: {from:?}"
     );
+    // Given back half a second into it: dropped at once (status and gate measure to line 0
+    // again); engaged again, a new approach from there is driven onto the line.
+    rig.run(0.5);
+    rig.send(Code::Disengage, 0.0, 0.0);
+    rig.run(0.1);
+    let g = rig.node.controller().guidance();
+    assert!(!g.is_approaching(), "an approach given back is dropped");
+    assert_eq!(g.global_path()[0].pos, rig.line().0, "back on line 0");
+    rig.run(1.0);
+    let r = rig.send(Code::Engage, 0.0, 0.0);
+    reply(OperatorReplyCommand::Engage, Res::Done)(&r);
+    assert!(rig.node.controller().guidance().is_approaching());
     // And it is driven: on the line within the run.
     rig.run(30.0);
     let g = rig.node.controller().guidance();

@@ -29,9 +29,6 @@ impl ControllerNode {
                 r => r,
             };
             self.operator.reply_engage(command, cmd.engaged, reason);
-            if !cmd.engaged {
-                self.ctrl.cancel_approach();
-            }
         }
     }
 

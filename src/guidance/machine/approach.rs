@@ -139,7 +139,7 @@ impl Guidance {
     }
 
     /// Drop an approach that was set but is not wanted: the engage it was planned for was
-    /// refused, or the operator gave back while driving it. The job is back on the path it was
+    /// refused, or steering was given back while driving it. The job is back on the path it was
     /// on before, at the same point and phase, with its worked distance; the next engage plans
     /// a new approach from wherever the vehicle is then. Nothing while not approaching.
     pub fn cancel_approach(&mut self) {
