@@ -422,17 +422,14 @@ impl Config {
     /// wheels sweep at the steering's rate while the exit clothoid (κ from 1/R to 0 at the
     /// planned curvature rate σ) is driven, (1/R)/(σ·v) s. 0 for turns planned within the
     /// steering's rate ([`Config::turn_curvature_rate`]); the whole angle for turns of arcs.
-    /// Field jobs plan their turns at `vehicle.max_curvature_rate_per_m2`; an arcs job's are
-    /// counted as arcs.
+    /// Field jobs plan their turns at `vehicle.max_curvature_rate_per_m2`.
     pub fn turn_exit_slew(&self) -> f64 {
         let (f, v) = (&self.safety, &self.vehicle);
         let radius = self.turn_radius();
         let sweep = (v.wheelbase_m / radius).atan().min(self.max_wheel_angle());
         let sigma = match self.job.kind {
             JobKind::Field => v.max_curvature_rate_per_m2,
-            // Concentric lines a few metres apart take tall bulbs that cross themselves, made
-            // of arcs (`plan::turns`), and the lines start with a curvature step.
-            JobKind::Arcs => 0.0,
+            // AB and arcs jobs (their CC bulbs between lines closer than 2·r_min included).
             _ => self.turn_curvature_rate(),
         };
         let rate = f

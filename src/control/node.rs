@@ -442,10 +442,14 @@ impl ControllerNode {
     }
 
     /// A kind's source changed: logged; a change (not the first choice) disengages unless
-    /// configured otherwise.
+    /// configured otherwise. The same source chosen again after it went stale is no change
+    /// (the supervisor's input timeouts deal with the gap).
     fn on_source_change(&mut self, c: &SourceChange) {
         match c.from {
             None => tracing::info!(kind = ?c.kind, source = ?c.to, "input source selected"),
+            Some(from) if from == c.to => {
+                tracing::info!(kind = ?c.kind, source = ?c.to, "input source back")
+            }
             Some(from) => {
                 tracing::warn!(kind = ?c.kind, ?from, to = ?c.to, "input source changed");
                 if self.sources.params().disengage_on_change {

@@ -86,7 +86,14 @@ pub fn arcs_segments(p: &ArcsParams) -> Result<Vec<PlanSegment>, PlanError> {
             else {
                 break;
             };
-            let dir1 = (p1 - before).normalize();
+            // The arc's tangent at its end (the last chord turns half a step less).
+            let radial = p1 - p.centre;
+            let tangent = Vec2::new(-radial.y, radial.x).normalize();
+            let dir1 = if tangent.dot(&(p1 - before)) >= 0.0 {
+                tangent
+            } else {
+                -tangent
+            };
             let p2 = points[0];
             turn.clear();
             forward_turn(p1, dir1, p2, (p2 - p1).norm(), &p.turn, &mut turn)?;
@@ -179,6 +186,35 @@ mod tests {
             let mut p = params();
             f(&mut p);
             assert!(arcs_job(&p).is_err());
+        }
+    }
+
+    /// With a curvature rate, the turns between the arcs are continuous-curvature: their
+    /// curvature changes by at most about σ per metre (the line's tangent at its end is the
+    /// turn's start heading, so the lines are level and the CC bulb fits).
+    #[test]
+    fn turns_keep_the_curvature_rate() {
+        let mut p = params();
+        p.point_spacing = 0.5;
+        p.turn.point_spacing = 0.5;
+        p.turn.max_points = 400;
+        p.turn.max_curvature_rate = 0.02;
+        let segments = arcs_segments(&p).expect("plans");
+        let curvature = |t: &[Vec2], i: usize| {
+            crate::plan::coverage::metrics::three_point_curvature(&t[i - 1], &t[i], &t[i + 1])
+        };
+        for turn in segments.iter().filter(|s| s.kind == SegmentKind::Turn) {
+            let t = &turn.points;
+            assert!(t.len() > 10);
+            assert!(curvature(t, 1).abs() < 0.05, "the turn starts straight");
+            for i in 2..t.len() - 1 {
+                let (k0, k1) = (curvature(t, i - 1), curvature(t, i));
+                let ds = (t[i] - t[i - 1]).norm();
+                assert!(
+                    (k1 - k0).abs() <= 0.02 * ds * 1.5 + 1e-3,
+                    "curvature step {k0:.3} → {k1:.3} over {ds:.2} m at point {i}"
+                );
+            }
         }
     }
 }

@@ -64,23 +64,88 @@ impl SteeringLaw for PurePursuit {
         _wheel_angle: Option<f64>,
         params: &TrackerParams,
     ) -> TrackOutput {
-        let ld = match self.scheduled {
-            Some(ld_max) => {
-                let growth = (params.ld_gain * speed.abs()).min(ld_max);
-                scheduled_lookahead(
-                    &TrackerParams {
-                        ld_gain: 0.0,
-                        ..*params
-                    },
-                    params.response_time(),
-                    speed,
-                )
-                .max(growth)
-            }
-            None => lookahead(params, speed),
+        let Some(ld_max) = self.scheduled else {
+            return pure_pursuit_at(local, pose, lookahead(params, speed), params);
         };
-        pure_pursuit_at(local, pose, ld, params)
+        let growth = (params.ld_gain * speed.abs()).min(ld_max);
+        let ld = scheduled_lookahead(
+            &TrackerParams {
+                ld_gain: 0.0,
+                ..*params
+            },
+            params.response_time(),
+            speed,
+        )
+        .max(growth);
+        let out = pure_pursuit_at(local, pose, ld, params);
+        if out.valid {
+            within_the_rate(local, pose, speed, params, out)
+        } else {
+            out
+        }
     }
+}
+
+/// Share of the steering's rate limit a correction may ask for ([`within_the_rate`]). The
+/// whole rate: the bound then acts only where the wheels could not follow at all. (Swept on
+/// the envelope's slow-steering rows and the nominal suite: 0.5 slowed every line start after
+/// a turn, +14 % on the nominal straights; 1.5 left a 10°/s motor's R 15 m arcs at 13 cm.)
+const RATE_SHARE: f64 = 1.0;
+
+/// Bisection steps of [`within_the_rate`].
+const RATE_BISECTION_STEPS: usize = 6;
+
+/// `out` (pure pursuit at its look-ahead), or pure pursuit at the shortest longer look-ahead
+/// whose correction a rate-limited steering can follow. Pure pursuit's loop about the path
+/// oscillates at ωn = √2·v/Ld, so a correction of Δδ (the command less the wheel angle the
+/// path's curvature needs) asks the wheels for about Δδ·ωn rad/s: the larger the error, the
+/// faster. Beyond the steering's rate the wheels lag the command, the lag adds phase and a
+/// large transient (a curved line started with the wheels straight on a 10°/s motor) grows
+/// into a weave. The look-ahead is lengthened until Δδ·ωn ≤ [`RATE_SHARE`] × the rate: a
+/// describing-function bound, amplitude-dependent, so that near the path (Δδ small) nothing
+/// changes and far from it the correction is slower but converges. Pure; at most
+/// [`RATE_BISECTION_STEPS`] + 1 more pursuits, only while the bound is exceeded.
+fn within_the_rate(
+    local: &LocalPath,
+    pose: &Pose,
+    speed: f64,
+    params: &TrackerParams,
+    out: TrackOutput,
+) -> TrackOutput {
+    let rate = params.steering.rate;
+    if !(rate > 0.0 && rate.is_finite()) {
+        return out;
+    }
+    let v = speed.abs();
+    // The wheel-angle rate the correction of `o` asks for, rad/s.
+    let asks = |o: &TrackOutput| {
+        let needed = (params.wheelbase * o.path_curvature).atan();
+        (o.wheel_angle - needed).abs() * std::f64::consts::SQRT_2 * v / o.lookahead
+    };
+    let allowed = RATE_SHARE * rate;
+    let follows = |o: &TrackOutput| asks(o) <= allowed;
+    if follows(&out) {
+        return out;
+    }
+    // Δδ falls about as 1/Ld² and ωn as 1/Ld: Ld·(asks/allowed)^(1/3) is about where the bound
+    // holds; twice that brackets it.
+    let mut lo = out.lookahead;
+    let mut hi = lo * 2.0 * (asks(&out) / allowed).cbrt();
+    let mut best = pure_pursuit_at(local, pose, hi, params);
+    if !best.valid {
+        return out;
+    }
+    for _ in 0..RATE_BISECTION_STEPS {
+        let mid = 0.5 * (lo + hi);
+        let o = pure_pursuit_at(local, pose, mid, params);
+        if o.valid && follows(&o) {
+            hi = mid;
+            best = o;
+        } else {
+            lo = mid;
+        }
+    }
+    best
 }
 
 /// Half the chord over which the path's curvature at the preview point is measured, m.
@@ -131,5 +196,88 @@ pub fn pure_pursuit_at(
         alpha,
         path_curvature: curvature_along(points, local.index_local(), ld, PATH_CURVATURE_HALF_M),
         valid: true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geo::{v2, PathPoint, Vec2};
+    use crate::track::local_path::LocalPathParams;
+    use crate::track::SteeringResponse;
+
+    fn params(rate_deg_s: f64) -> TrackerParams {
+        TrackerParams {
+            wheelbase: 3.0,
+            ld_min: 3.0,
+            ld_gain: 1.2,
+            max_wheel_angle: 35f64.to_radians(),
+            steering: SteeringResponse {
+                lag: 0.1,
+                dead_time: 0.0,
+                rate: rate_deg_s.to_radians(),
+                sweep: 0.0,
+            },
+        }
+    }
+
+    fn straight_local(at: &Vec2) -> LocalPath {
+        let g: Vec<PathPoint> = (0..80)
+            .map(|i| PathPoint::work(v2(i as f64, 0.0)))
+            .collect();
+        let mut lp = LocalPath::new(&LocalPathParams {
+            nodes_before: 1,
+            nodes_after: 12,
+            ..Default::default()
+        });
+        lp.rebuild(&g, at.x.round() as usize);
+        lp.nearest(at);
+        lp
+    }
+
+    /// The wheel-angle rate pure pursuit's correction asks for, rad/s (the bound of
+    /// `within_the_rate`, on a straight path).
+    fn asked(out: &TrackOutput, speed: f64) -> f64 {
+        out.wheel_angle.abs() * std::f64::consts::SQRT_2 * speed / out.lookahead
+    }
+
+    #[test]
+    fn a_large_correction_is_slowed_to_what_the_steering_can_follow() {
+        let law = PurePursuit::predictive(4.5);
+        let speed = 10.0 / 3.6;
+        let far = Pose::new(20.0, 1.0, 0.0);
+        let local = straight_local(&far.pos);
+        // The correction of a 1 m error at the scheduled look-ahead (an unknown rate, 0) asks
+        // for more than a 10°/s steering gives: its look-ahead grows until it would not.
+        let fast = law.steer(&local, &far, speed, None, &params(30.0));
+        let slow = law.steer(&local, &far, speed, None, &params(10.0));
+        assert!(fast.valid && slow.valid);
+        assert!(asked(&fast, speed) <= 30f64.to_radians());
+        assert!(
+            slow.lookahead > fast.lookahead + 0.5,
+            "slow {} fast {}",
+            slow.lookahead,
+            fast.lookahead
+        );
+        let rate = 10f64.to_radians();
+        assert!(
+            asked(&slow, speed) <= rate * 1.001,
+            "{}",
+            asked(&slow, speed)
+        );
+        // Not longer than needed: a look-ahead 5 % shorter would ask for more than the rate.
+        let shorter = pure_pursuit_at(&local, &far, slow.lookahead * 0.95, &params(10.0));
+        assert!(asked(&shorter, speed) > rate);
+        assert!(slow.wheel_angle < 0.0 && slow.wheel_angle > fast.wheel_angle);
+        // Near the line nothing changes, and an unknown rate (0) changes nothing.
+        let near = Pose::new(20.0, 0.02, 0.0);
+        let local = straight_local(&near.pos);
+        let a = law.steer(&local, &near, speed, None, &params(10.0));
+        let b = law.steer(&local, &near, speed, None, &params(0.0));
+        assert_eq!(a, b);
+        let scheduled = law.steer(&straight_local(&far.pos), &far, speed, None, &params(0.0));
+        assert!((scheduled.lookahead - 1.2 * speed).abs() < 1e-9);
+        assert!(asked(&scheduled, speed) > rate);
+        assert!(scheduled.lookahead <= fast.lookahead && fast.lookahead < slow.lookahead);
     }
 }
