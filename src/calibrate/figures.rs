@@ -49,6 +49,9 @@ pub struct Figures {
     /// GNSS latency, ms (`None`: not measured).
     #[serde(default)]
     pub gnss_latency_ms: Option<Figure>,
+    /// The receiver's fix interval, ms (`None`: not measured).
+    #[serde(default)]
+    pub gnss_interval_ms: Option<f64>,
     /// Antenna lateral offset, m, positive left (`None`: no two-way pass).
     #[serde(default)]
     pub antenna_left_m: Option<Figure>,
@@ -70,6 +73,7 @@ impl Calibration {
             was_offset_deg: Figure::of(&self.was_offset, deg),
             fit_rms_deg: self.steering_rms * deg,
             gnss_latency_ms: self.gnss_latency.as_ref().map(|e| Figure::of(e, 1000.0)),
+            gnss_interval_ms: self.gnss_interval.map(|i| i * 1000.0),
             antenna_left_m: self.antenna_left.as_ref().map(|e| Figure::of(e, 1.0)),
         }
     }
@@ -89,6 +93,9 @@ impl Figures {
         let latency = self
             .gnss_latency_ms
             .map_or("not measured".to_string(), |f| f.show("ms", 1));
+        let interval = self
+            .gnss_interval_ms
+            .map_or("not measured".to_string(), |i| format!("{i:.0} ms"));
         let antenna = self
             .antenna_left_m
             .map_or("not measured (no two-way pass)".to_string(), |f| {
@@ -105,6 +112,7 @@ impl Figures {
              WAS offset     {}\n\
              fit residual   {:.3} ° RMS\n\
              GNSS latency   {latency}\n\
+             GNSS interval  {interval}\n\
              antenna left   {antenna}\n",
             self.dead_time_ms.show("ms", 1),
             self.lag_ms.show("ms", 1),

@@ -130,6 +130,9 @@ pub struct Calibration {
     /// GNSS latency, s (`None`: no slalom heading to time; the reason in `latency_note`).
     pub gnss_latency: Option<Estimate>,
     pub latency_note: Option<&'static str>,
+    /// The receiver's fix interval, s: the median interval of the slalom's headings (`None`
+    /// without ten of them).
+    pub gnss_interval: Option<f64>,
     /// Antenna lateral offset, m, positive left (`None`: no two-way pass).
     pub antenna_left: Option<Estimate>,
     /// RMS of the steering fit's residuals, rad.
@@ -137,6 +140,25 @@ pub struct Calibration {
     /// The fit in the sensor's terms and the sensor fit, as found.
     pub steering_fit: SteeringFit,
     pub was_fit: WasFit,
+}
+
+/// The median interval between consecutive samples of `samples` (time s, value), s; `None`
+/// with fewer than ten samples or no positive interval.
+fn median_interval(samples: &[(f64, f64)]) -> Option<f64> {
+    if samples.len() < 10 {
+        return None;
+    }
+    let mut d: Vec<f64> = samples
+        .windows(2)
+        .map(|w| w[1].0 - w[0].0)
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .collect();
+    if d.is_empty() {
+        return None;
+    }
+    let mid = d.len() / 2;
+    let (_, m, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
+    Some(*m)
 }
 
 /// Do two fits of the same steering agree? (Tolerances above the tests' own scatter: 3 σ plus
@@ -351,6 +373,7 @@ impl Session {
             was_offset,
             gnss_latency,
             latency_note,
+            gnss_interval: median_interval(&self.slalom.heading),
             antenna_left,
             steering_rms: fit.rms,
             steering_fit: fit,
@@ -383,6 +406,13 @@ impl Calibration {
             ),
             None => String::new(),
         };
+        let gnss_timeout = match self.gnss_interval {
+            Some(i) => format!(
+                "# A fix every {i:.3} s (the slalom's receiver).\ngnss_timeout_s = {:.2}\n",
+                crate::safety::gnss_timeout_for_interval(i)
+            ),
+            None => String::new(),
+        };
         let antenna = match &self.antenna_left {
             Some(e) => format!(
                 "antenna_left_m = {:.3}  # {} (two-way pass)\n",
@@ -397,6 +427,7 @@ impl Calibration {
              actuator_dead_time_s = {:.3}  # {}\n\
              actuator_tau_s = {:.3}  # {}\n\
              actuator_rate_deg_s = {:.1}  # {}\n\
+             {gnss_timeout}\
              \n[track]\n\
              # The prediction horizon covers the steering's dead time.\n\
              lead_time_s = {:.3}\n\

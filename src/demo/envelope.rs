@@ -267,6 +267,11 @@ pub fn apply_calibration(cfg: &mut Config, calibration: Calibration) {
             cfg.safety.actuator_dead_time_s = s.actuator_dead_time_s.min(0.5);
             cfg.safety.actuator_tau_s = s.actuator_tau_s;
             cfg.safety.actuator_rate_deg_s = s.actuator_rate_deg_s;
+            // The receiver's fix interval (calibration measures it from the slalom's fixes).
+            if s.gnss_rate_hz > 0.0 {
+                cfg.safety.gnss_timeout_s =
+                    crate::safety::gnss_timeout_for_interval(1.0 / s.gnss_rate_hz);
+            }
             cfg.track.lead_time_s = s.actuator_dead_time_s.min(1.0);
             cfg.vehicle.was_gain = s.was_gain;
             cfg.vehicle.was_offset_deg = s.was_bias_deg;

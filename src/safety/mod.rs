@@ -128,6 +128,20 @@ impl SafetyState {
 
 pub use crate::input::FixQuality;
 
+/// The GNSS timeout for a receiver that sends a fix every `interval` s: one and a half
+/// intervals and 0.1 s of jitter, at least the default 0.3 s (a 10 Hz receiver keeps it; a
+/// 1 Hz one needs 1.6 s). What `agsteer calibrate` writes as `safety.gnss_timeout_s` from the
+/// fix interval it measured; a longer timeout is a longer dead-reckoned stretch before a lost
+/// receiver stops the steering (1.6 s is 4.4 m at 10 km/h).
+pub fn gnss_timeout_for_interval(interval: f64) -> f64 {
+    let t = 1.5 * interval + 0.1;
+    if t.is_finite() {
+        t.max(0.3)
+    } else {
+        0.3
+    }
+}
+
 /// Inputs whose frames carry a counter and a CRC.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(usize)]
@@ -230,6 +244,8 @@ pub struct Supervisor {
     params: SafetyParams,
     state: SafetyState,
     gnss_t: Option<f64>,
+    /// The interval between the last two fixes, s (0 before the second).
+    fix_interval: f64,
     fix: FixQuality,
     float_since: Option<f64>,
     wheel_t: Option<f64>,
@@ -276,6 +292,7 @@ impl Supervisor {
             params,
             state: SafetyState::Disengaged,
             gnss_t: None,
+            fix_interval: 0.0,
             fix: FixQuality::None,
             float_since: None,
             wheel_t: None,
@@ -402,6 +419,9 @@ impl Supervisor {
     pub fn on_gnss(&mut self, t: f64, quality: FixQuality) {
         if !t.is_finite() {
             return;
+        }
+        if let Some(last) = self.gnss_t {
+            self.fix_interval = (t - last).max(0.0);
         }
         self.gnss_t = Some(t);
         if quality == FixQuality::RtkFloat {
@@ -683,6 +703,10 @@ impl Supervisor {
                 } else {
                     fault
                 }
+            } else if self.fix_interval > p.gnss_timeout {
+                // A receiver slower than the timeout (a 1 Hz one with the 0.3 s default):
+                // engaged, every fix interval would end in a timeout; refused instead.
+                FaultCode::GnssTimeout
             } else if !xte.is_some_and(|x| x.abs() < p.max_engage_xte) {
                 FaultCode::XteTooLarge
             } else if !heading_error.is_some_and(|h| h.abs() < p.max_engage_heading_error) {
