@@ -7,6 +7,7 @@
 
 pub mod bypass;
 mod clear_map;
+mod closed;
 pub mod decompose;
 pub mod geometry;
 pub mod headland;

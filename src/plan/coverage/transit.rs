@@ -2,11 +2,10 @@
 //! (LSL, RSR, LSR, RSL) with radius r_min whose points keep clear of the field edge and the
 //! obstacles, so every transit is driveable forward (curvature ≤ 1/r_min).
 
+use super::closed::{CheckedEdges, ClosedSets};
 use crate::geo::{heading_vec, left_normal, wrap_angle, Vec2};
 use std::cell::RefCell;
-use std::collections::HashMap;
 use std::f64::consts::TAU;
-use std::hash::{BuildHasherDefault, Hasher};
 use std::rc::Rc;
 
 /// One Dubins CSC curve: arc about `c1`, straight from `t1` along `theta`, arc about `c2`.
@@ -220,6 +219,8 @@ pub struct WaypointGrid<'a> {
     clear: &'a dyn Fn(&Vec2) -> bool,
     /// The curves between nodes, solved once (see [`EdgeTable`]).
     edges: RefCell<EdgeTable>,
+    /// The states of the searches that failed with nothing left to expand.
+    closed: RefCell<ClosedSets>,
 }
 
 /// One CSC word of an edge between grid nodes: its length (m) and its points relative to the
@@ -324,6 +325,7 @@ impl<'a> WaypointGrid<'a> {
             usable: vec![false; nx * ny],
             clear,
             edges: RefCell::default(),
+            closed: RefCell::default(),
         };
         for j in 0..ny {
             for i in 0..nx {
@@ -485,6 +487,23 @@ pub fn route_graph(
         let (i, j) = cell(s);
         (grid.node(i, j), graph_heading(s % H))
     };
+    // States of earlier searches that failed with nothing left to expand, from which this
+    // search cannot reach its goal either (see [`super::closed`]): left out.
+    let closed_key = (r.to_bits(), step.to_bits());
+    let goal_nodes: Vec<usize> = grid
+        .near(&p2, 3.0 * grid.step)
+        .iter()
+        .map(|e| e.0)
+        .collect();
+    let finishes = |s: usize| {
+        let (q, h) = pose(s);
+        matches!(transit(q, h, p2, h2, r, step, clear), Some((_, true)))
+    };
+    let dead = grid
+        .closed
+        .borrow()
+        .dead(closed_key, &to_goal, &goal_nodes, H, &finishes);
+    let is_dead = |s: usize| dead.as_ref().is_some_and(|d| d.has(s));
     // The words of the edge parent → s, shortest first, with the point they are placed at.
     let words_of = |parent: u32, s: usize| -> (Vec2, Rc<[EdgeWord]>) {
         let (q, h) = pose(s);
@@ -512,7 +531,7 @@ pub fn route_graph(
     // Edges whose points were checked: (parent, state) → (word, length); `None` when no word
     // is clear. When a state's best offer turns out blocked or longer than queued, the offers
     // of its expanded neighbours that were not queued are queued then, at their known lengths.
-    let mut checked: CheckedEdges = HashMap::default();
+    let mut checked = CheckedEdges::default();
     let mut from_start = vec![false; states];
     let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::new();
     // Queue the start's neighbours with their shortest words' lengths.
@@ -523,6 +542,9 @@ pub fn route_graph(
         for hk in arrival_headings(q - p1, None) {
             if let Some(len) = csc_length(p1, h1, q, graph_heading(hk), r) {
                 let s = k * H + hk;
+                if is_dead(s) {
+                    continue;
+                }
                 from_start[s] = true;
                 let f = key(len + HEURISTIC_WEIGHT * to_goal[k]);
                 if f < best[s] {
@@ -548,9 +570,20 @@ pub fn route_graph(
         let (known, fresh) = match checked.get(&(from, s as u32)) {
             Some(k) => (*k, false),
             None => {
-                let earlier = (from != START)
-                    .then(|| grid.edges.borrow().checked.get(&(from, s as u32)).copied())
-                    .flatten();
+                let earlier = if from == START {
+                    // The start's curves, solved here: each word's points made only as far as
+                    // its first one that is not clear (the same points and test as its word).
+                    let (q, h) = pose(s);
+                    Some(
+                        words_by_length(p1, h1, q, h, r)
+                            .iter()
+                            .enumerate()
+                            .find(|(_, c)| c.points(step, clear).is_some())
+                            .map(|(w, c)| (w as u8, c.length)),
+                    )
+                } else {
+                    grid.edges.borrow().checked.get(&(from, s as u32)).copied()
+                };
                 let k = earlier.unwrap_or_else(|| {
                     let (base, words) = words_of(from, s);
                     let k = words
@@ -629,10 +662,15 @@ pub fn route_graph(
                         if !done[q] || q as u32 == from {
                             continue;
                         }
+                        // (An edge with no word was never queued, so never checked.)
+                        let shortest = table[EdgeTable::slot((di, dj), ha, s % H)];
+                        if !shortest.is_finite() {
+                            continue;
+                        }
                         let length = match checked.get(&(q as u32, s as u32)) {
                             Some(Some((_, l))) => *l,
                             Some(None) => continue,
-                            None => table[EdgeTable::slot((di, dj), ha, s % H)],
+                            None => shortest,
                         };
                         if length.is_finite() {
                             offer(q as u32, length, &mut heap);
@@ -690,7 +728,7 @@ pub fn route_graph(
                 for hk in 0..H {
                     let next = k * H + hk;
                     let length = table[EdgeTable::slot((di, dj), s % H, hk)];
-                    if length.is_finite() && !done[next] {
+                    if length.is_finite() && !done[next] && !is_dead(next) {
                         let f = key(g + length + h_to_go);
                         if f < best[next] {
                             best[next] = f;
@@ -701,33 +739,12 @@ pub fn route_graph(
             }
         }
     }
+    // Nothing left to expand: the expanded states (with those left out) are closed.
+    if expansions > 0 {
+        let mut closed = grid.closed.borrow_mut();
+        closed.record(closed_key, &done, dead.as_ref(), H, &to_goal);
+    }
     None
-}
-
-/// Edges of the waypoint search whose points were checked: (parent, state) → the first clear
-/// word and its length, `None` when none is clear.
-type CheckedEdges = HashMap<(u32, u32), Option<(u8, f64)>, BuildHasherDefault<EdgeHasher>>;
-
-/// Hasher of the search's edge keys (two state indices): one multiply-rotate per word, where
-/// the standard SipHash cost as much as the lookups it served.
-#[derive(Default)]
-struct EdgeHasher(u64);
-
-impl Hasher for EdgeHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-    fn write_u32(&mut self, n: u32) {
-        self.write_u64(u64::from(n));
-    }
-    fn write_u64(&mut self, n: u64) {
-        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
 }
 
 /// A straight from `a` to `b` as points about `step` m apart.
