@@ -31,6 +31,12 @@ const CELLS: &[(&str, &str, f64)] = &[
     // 0.2 m back: 10.15 cm before).
     ("tyre_slip_firm", "curve_r15", 4.17),
     ("tractor_b", "curve_r30", 2.72),
+    // Session 13: the arcs' turns continuous-curvature (they fell back to arcs) and the
+    // look-ahead kept within the steering's rate (a 10°/s motor on R 30 m arcs: 14.6 cm
+    // before); the engage refused to a receiver slower than the GNSS timeout, which
+    // calibration sets from the fix interval (1 Hz: no cell finished before).
+    ("rate_10", "curve_r30", 0.41),
+    ("gnss_1hz", "straight_10kmh", 0.82),
 ];
 
 #[test]
