@@ -305,21 +305,9 @@ mod tests {
     use super::*;
     use crate::geo::{v2, PathPoint};
     use crate::track::local_path::LocalPathParams;
-    use crate::track::SteeringResponse;
 
     fn tracker(lag: f64, rate_deg: f64) -> TrackerParams {
-        TrackerParams {
-            wheelbase: 3.0,
-            ld_min: 3.0,
-            ld_gain: 1.2,
-            max_wheel_angle: 35f64.to_radians(),
-            steering: SteeringResponse {
-                lag,
-                dead_time: 0.0,
-                rate: rate_deg.to_radians(),
-                sweep: 0.5,
-            },
-        }
+        crate::track::tests::tracker_with_steering(lag, rate_deg, 0.5)
     }
 
     fn law_params() -> LawParams {

@@ -384,7 +384,25 @@ mod tests {
         }
     }
 
-    fn straight_local(at: &Vec2) -> LocalPath {
+    /// Tracker parameters with a steering of lag `lag` s, rate `rate_deg` °/s and turn-exit
+    /// sweep `sweep` rad (for the laws' tests).
+    pub(crate) fn tracker_with_steering(lag: f64, rate_deg: f64, sweep: f64) -> TrackerParams {
+        TrackerParams {
+            wheelbase: 3.0,
+            ld_min: 3.0,
+            ld_gain: 1.2,
+            max_wheel_angle: 35f64.to_radians(),
+            steering: SteeringResponse {
+                lag,
+                dead_time: 0.0,
+                rate: rate_deg.to_radians(),
+                sweep,
+            },
+        }
+    }
+
+    /// The local path of the straight x axis (a point a metre) near `at`.
+    pub(crate) fn straight_local(at: &Vec2) -> LocalPath {
         let g: Vec<PathPoint> = (0..50)
             .map(|i| PathPoint::work(v2(i as f64, 0.0)))
             .collect();

@@ -202,37 +202,10 @@ pub fn pure_pursuit_at(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geo::{v2, PathPoint, Vec2};
-    use crate::track::local_path::LocalPathParams;
-    use crate::track::SteeringResponse;
+    use crate::track::tests::straight_local;
 
     fn params(rate_deg_s: f64) -> TrackerParams {
-        TrackerParams {
-            wheelbase: 3.0,
-            ld_min: 3.0,
-            ld_gain: 1.2,
-            max_wheel_angle: 35f64.to_radians(),
-            steering: SteeringResponse {
-                lag: 0.1,
-                dead_time: 0.0,
-                rate: rate_deg_s.to_radians(),
-                sweep: 0.0,
-            },
-        }
-    }
-
-    fn straight_local(at: &Vec2) -> LocalPath {
-        let g: Vec<PathPoint> = (0..80)
-            .map(|i| PathPoint::work(v2(i as f64, 0.0)))
-            .collect();
-        let mut lp = LocalPath::new(&LocalPathParams {
-            nodes_before: 1,
-            nodes_after: 12,
-            ..Default::default()
-        });
-        lp.rebuild(&g, at.x.round() as usize);
-        lp.nearest(at);
-        lp
+        crate::track::tests::tracker_with_steering(0.1, rate_deg_s, 0.0)
     }
 
     /// The wheel-angle rate pure pursuit's correction asks for, rad/s (the bound of
