@@ -273,7 +273,16 @@ pub fn apply_calibration(cfg: &mut Config, calibration: Calibration) {
                     crate::safety::gnss_timeout_for_interval(1.0 / s.gnss_rate_hz);
             }
             cfg.track.lead_time_s = s.actuator_dead_time_s.min(1.0);
-            cfg.vehicle.was_gain = s.was_gain;
+            // The sensor's gain as calibration measures it: the drive's yaw rates give the true
+            // angle through the configured wheelbase, so a wheelbase error reads as a gain
+            // error, L_true / L_configured (`agsteer calibrate` on a tractor 10 % longer than
+            // configured: 1.097), which is the gain the controller needs with its wheelbase.
+            let configured = cfg.vehicle.wheelbase_m;
+            cfg.vehicle.was_gain = if configured > 0.0 {
+                s.was_gain * (configured + s.wheelbase_error_m) / configured
+            } else {
+                s.was_gain
+            };
             cfg.vehicle.was_offset_deg = s.was_bias_deg;
             cfg.track.lost_motion_initial_deg = (s.actuator_deadband_deg
                 + 0.5 * s.actuator_backlash_deg)

@@ -37,6 +37,9 @@ const CELLS: &[(&str, &str, f64)] = &[
     // calibration sets from the fix interval (1 Hz: no cell finished before).
     ("rate_10", "curve_r30", 0.41),
     ("gnss_1hz", "straight_10kmh", 0.82),
+    // The ideal calibration's WAS gain as `agsteer calibrate` measures it, relative to the
+    // configured wheelbase (0.63 cm with the sensor's own gain, `**` against Stanley's 0.29).
+    ("wheelbase_+10%", "straight_15kmh", 0.35),
 ];
 
 #[test]
