@@ -142,6 +142,20 @@ pub struct Calibration {
     pub was_fit: WasFit,
 }
 
+/// The GNSS timeout for a receiver that sends a fix every `interval` s: one and a half
+/// intervals and 0.1 s of jitter, at least the default 0.3 s (a 10 Hz receiver keeps it; a
+/// 1 Hz one needs 1.6 s). What calibration writes as `safety.gnss_timeout_s` from the fix interval
+/// it measured; a longer timeout is a longer dead-reckoned stretch before a lost
+/// receiver stops the steering (1.6 s is 4.4 m at 10 km/h).
+pub fn gnss_timeout_for_interval(interval: f64) -> f64 {
+    let t = 1.5 * interval + 0.1;
+    if t.is_finite() {
+        t.max(0.3)
+    } else {
+        0.3
+    }
+}
+
 /// The median interval between consecutive samples of `samples` (time s, value), s; `None`
 /// with fewer than ten samples or no positive interval.
 fn median_interval(samples: &[(f64, f64)]) -> Option<f64> {
@@ -409,7 +423,7 @@ impl Calibration {
         let gnss_timeout = match self.gnss_interval {
             Some(i) => format!(
                 "# A fix every {i:.3} s (the slalom's receiver).\ngnss_timeout_s = {:.2}\n",
-                crate::safety::gnss_timeout_for_interval(i)
+                gnss_timeout_for_interval(i)
             ),
             None => String::new(),
         };
@@ -455,5 +469,26 @@ impl Calibration {
             self.was_offset.value * deg,
             sd(&self.was_offset, deg, 2),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_gnss_timeout_covers_the_fix_interval() {
+        assert_eq!(
+            gnss_timeout_for_interval(0.1),
+            0.3,
+            "10 Hz keeps the default"
+        );
+        assert!((gnss_timeout_for_interval(0.2) - 0.4).abs() < 1e-12);
+        assert!((gnss_timeout_for_interval(1.0) - 1.6).abs() < 1e-12);
+        assert_eq!(gnss_timeout_for_interval(f64::NAN), 0.3);
+        let headings: Vec<(f64, f64)> = (0..20).map(|k| (k as f64 * 0.2, 0.0)).collect();
+        let interval = median_interval(&headings).expect("twenty samples");
+        assert!((interval - 0.2).abs() < 1e-9);
+        assert_eq!(median_interval(&headings[..5]), None);
     }
 }

@@ -270,7 +270,7 @@ pub fn apply_calibration(cfg: &mut Config, calibration: Calibration) {
             // The receiver's fix interval (calibration measures it from the slalom's fixes).
             if s.gnss_rate_hz > 0.0 {
                 cfg.safety.gnss_timeout_s =
-                    crate::safety::gnss_timeout_for_interval(1.0 / s.gnss_rate_hz);
+                    crate::calibrate::gnss_timeout_for_interval(1.0 / s.gnss_rate_hz);
             }
             cfg.track.lead_time_s = s.actuator_dead_time_s.min(1.0);
             // The sensor's gain as calibration measures it: the drive's yaw rates give the true

@@ -128,20 +128,6 @@ impl SafetyState {
 
 pub use crate::input::FixQuality;
 
-/// The GNSS timeout for a receiver that sends a fix every `interval` s: one and a half
-/// intervals and 0.1 s of jitter, at least the default 0.3 s (a 10 Hz receiver keeps it; a
-/// 1 Hz one needs 1.6 s). What `agsteer calibrate` writes as `safety.gnss_timeout_s` from the
-/// fix interval it measured; a longer timeout is a longer dead-reckoned stretch before a lost
-/// receiver stops the steering (1.6 s is 4.4 m at 10 km/h).
-pub fn gnss_timeout_for_interval(interval: f64) -> f64 {
-    let t = 1.5 * interval + 0.1;
-    if t.is_finite() {
-        t.max(0.3)
-    } else {
-        0.3
-    }
-}
-
 /// Inputs whose frames carry a counter and a CRC.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(usize)]
