@@ -230,8 +230,6 @@ pub struct Supervisor {
     params: SafetyParams,
     state: SafetyState,
     gnss_t: Option<f64>,
-    /// The interval between the last two fixes, s (0 before the second).
-    fix_interval: f64,
     fix: FixQuality,
     float_since: Option<f64>,
     wheel_t: Option<f64>,
@@ -278,7 +276,6 @@ impl Supervisor {
             params,
             state: SafetyState::Disengaged,
             gnss_t: None,
-            fix_interval: 0.0,
             fix: FixQuality::None,
             float_since: None,
             wheel_t: None,
@@ -405,9 +402,6 @@ impl Supervisor {
     pub fn on_gnss(&mut self, t: f64, quality: FixQuality) {
         if !t.is_finite() {
             return;
-        }
-        if let Some(last) = self.gnss_t {
-            self.fix_interval = (t - last).max(0.0);
         }
         self.gnss_t = Some(t);
         if quality == FixQuality::RtkFloat {
@@ -689,10 +683,6 @@ impl Supervisor {
                 } else {
                     fault
                 }
-            } else if self.fix_interval > p.gnss_timeout {
-                // A receiver slower than the timeout (a 1 Hz one with the 0.3 s default):
-                // engaged, every fix interval would end in a timeout; refused instead.
-                FaultCode::GnssTimeout
             } else if !xte.is_some_and(|x| x.abs() < p.max_engage_xte) {
                 FaultCode::XteTooLarge
             } else if !heading_error.is_some_and(|h| h.abs() < p.max_engage_heading_error) {

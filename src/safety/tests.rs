@@ -52,34 +52,6 @@ fn refuses_far_from_the_line() {
 }
 
 #[test]
-fn a_receiver_slower_than_the_timeout_is_refused_at_the_engage() {
-    // Fixes every 1 s against the 0.3 s default: just after a fix the inputs are fresh and
-    // the supervisor ready, but an engage would time out before the next fix.
-    let mut s = Supervisor::new(SafetyParams::default());
-    feed_good(&mut s, 0.0);
-    feed_good(&mut s, 1.0);
-    assert_eq!(
-        s.step(1.0, Some(0.0), Some(0.0), Some(0.0)).state,
-        SafetyState::Ready
-    );
-    s.request_engage();
-    let c = s.step(1.02, Some(0.0), Some(0.0), Some(0.0));
-    assert!(!c.engaged);
-    assert_eq!(s.last_refusal(), FaultCode::GnssTimeout);
-    // With the timeout calibration writes for that receiver
-    // (`calibrate::gnss_timeout_for_interval`), it engages.
-    let mut s = Supervisor::new(SafetyParams {
-        gnss_timeout: 1.6,
-        ..SafetyParams::default()
-    });
-    feed_good(&mut s, 0.0);
-    feed_good(&mut s, 1.0);
-    s.step(1.0, Some(0.0), Some(0.0), Some(0.0));
-    s.request_engage();
-    assert!(s.step(1.02, Some(0.0), Some(0.0), Some(0.0)).engaged);
-}
-
-#[test]
 fn gnss_timeout_disengages_within_one_period_and_never_reengages() {
     let (mut s, mut t) = engaged_supervisor();
     let last_gnss = t;
