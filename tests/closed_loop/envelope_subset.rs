@@ -33,8 +33,8 @@ const CELLS: &[(&str, &str, f64)] = &[
     ("tractor_b", "curve_r30", 2.72),
     // Session 13: the arcs' turns continuous-curvature (they fell back to arcs) and the
     // look-ahead kept within the steering's rate (a 10°/s motor on R 30 m arcs: 14.6 cm
-    // before); the engage refused to a receiver slower than the GNSS timeout, which
-    // calibration sets from the fix interval (1 Hz: no cell finished before).
+    // before); the GNSS timeout that calibration sets from the receiver's fix interval (1 Hz:
+    // no cell finished before).
     ("rate_10", "curve_r30", 0.41),
     ("gnss_1hz", "straight_10kmh", 0.82),
     // The ideal calibration's WAS gain as `agsteer calibrate` measures it, relative to the
