@@ -130,8 +130,8 @@ pub struct Calibration {
     /// GNSS latency, s (`None`: no slalom heading to time; the reason in `latency_note`).
     pub gnss_latency: Option<Estimate>,
     pub latency_note: Option<&'static str>,
-    /// The receiver's fix interval, s: the median interval of the slalom's headings (`None`
-    /// without ten of them).
+    /// The receiver's fix interval, s: the median interval of the slalom's position fixes
+    /// (`None` without ten of them).
     pub gnss_interval: Option<f64>,
     /// Antenna lateral offset, m, positive left (`None`: no two-way pass).
     pub antenna_left: Option<Estimate>,
@@ -148,23 +148,19 @@ pub struct Calibration {
 /// it measured; a longer timeout is a longer dead-reckoned stretch before a lost
 /// receiver stops the steering (1.6 s is 4.4 m at 10 km/h).
 pub fn gnss_timeout_for_interval(interval: f64) -> f64 {
-    let t = 1.5 * interval + 0.1;
-    if t.is_finite() {
-        t.max(0.3)
-    } else {
-        0.3
-    }
+    // f64::max takes the other operand for a NaN: 0.3.
+    (1.5 * interval + 0.1).max(0.3)
 }
 
-/// The median interval between consecutive samples of `samples` (time s, value), s; `None`
-/// with fewer than ten samples or no positive interval.
-fn median_interval(samples: &[(f64, f64)]) -> Option<f64> {
-    if samples.len() < 10 {
+/// The median interval between consecutive times of `times` (s, in order), s; `None` with
+/// fewer than ten or no positive interval.
+fn median_interval(times: &[f64]) -> Option<f64> {
+    if times.len() < 10 {
         return None;
     }
-    let mut d: Vec<f64> = samples
+    let mut d: Vec<f64> = times
         .windows(2)
-        .map(|w| w[1].0 - w[0].0)
+        .map(|w| w[1] - w[0])
         .filter(|d| d.is_finite() && *d > 0.0)
         .collect();
     if d.is_empty() {
@@ -387,7 +383,7 @@ impl Session {
             was_offset,
             gnss_latency,
             latency_note,
-            gnss_interval: median_interval(&self.slalom.heading),
+            gnss_interval: median_interval(&self.slalom_fixes),
             antenna_left,
             steering_rms: fit.rms,
             steering_fit: fit,
@@ -486,9 +482,13 @@ mod tests {
         assert!((gnss_timeout_for_interval(0.2) - 0.4).abs() < 1e-12);
         assert!((gnss_timeout_for_interval(1.0) - 1.6).abs() < 1e-12);
         assert_eq!(gnss_timeout_for_interval(f64::NAN), 0.3);
-        let headings: Vec<(f64, f64)> = (0..20).map(|k| (k as f64 * 0.2, 0.0)).collect();
-        let interval = median_interval(&headings).expect("twenty samples");
-        assert!((interval - 0.2).abs() < 1e-9);
-        assert_eq!(median_interval(&headings[..5]), None);
+        // A 5 Hz receiver with one fix late by 0.3 s: still 0.2 s.
+        let mut fixes: Vec<f64> = (0..20).map(|k| k as f64 * 0.2).collect();
+        fixes[7] += 0.3;
+        fixes[8] += 0.3;
+        fixes[9] += 0.3;
+        let interval = median_interval(&fixes).expect("twenty fixes");
+        assert!((interval - 0.2).abs() < 1e-9, "{interval}");
+        assert_eq!(median_interval(&fixes[..5]), None);
     }
 }

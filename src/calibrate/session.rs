@@ -135,6 +135,9 @@ pub struct Session {
     pub(super) steering: SteeringRecord,
     pub(super) holds: Vec<Hold>,
     pub(super) slalom: Slalom,
+    /// When the slalom's position fixes arrived, s (the receiver's fix interval: what the
+    /// supervisor's GNSS timeout times).
+    pub(super) slalom_fixes: Vec<f64>,
     /// Antenna positions (time s, local ENU m) of the out and the back pass.
     pub(super) pass_out: Vec<(f64, Vec2)>,
     pub(super) pass_back: Vec<(f64, Vec2)>,
@@ -179,6 +182,7 @@ impl Session {
             },
             holds: Vec::new(),
             slalom: Slalom::default(),
+            slalom_fixes: Vec::new(),
             pass_out: Vec::new(),
             pass_back: Vec::new(),
             out_line: None,
@@ -316,6 +320,7 @@ impl Session {
                             self.pass_out.push((p.t, pos))
                         }
                         Phase::PassBack => self.pass_back.push((p.t, pos)),
+                        Phase::Slalom => self.slalom_fixes.push(p.t),
                         _ => {}
                     }
                 }
@@ -563,6 +568,7 @@ impl Session {
                         self.slalom.sensed.reserve(n);
                         self.slalom.heading.reserve(n / 10);
                         self.slalom.speed.reserve(n / 10);
+                        self.slalom_fixes.reserve(n / 10);
                         return self.tick(t);
                     }
                 }

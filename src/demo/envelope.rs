@@ -267,22 +267,18 @@ pub fn apply_calibration(cfg: &mut Config, calibration: Calibration) {
             cfg.safety.actuator_dead_time_s = s.actuator_dead_time_s.min(0.5);
             cfg.safety.actuator_tau_s = s.actuator_tau_s;
             cfg.safety.actuator_rate_deg_s = s.actuator_rate_deg_s;
-            // The receiver's fix interval (calibration measures it from the slalom's fixes).
-            if s.gnss_rate_hz > 0.0 {
-                cfg.safety.gnss_timeout_s =
-                    crate::calibrate::gnss_timeout_for_interval(1.0 / s.gnss_rate_hz);
-            }
+            // The receiver's fix interval (calibration measures it from the slalom's fixes;
+            // the loaded configuration's rate is at least 0.5 Hz).
+            cfg.safety.gnss_timeout_s =
+                crate::calibrate::gnss_timeout_for_interval(1.0 / s.gnss_rate_hz);
             cfg.track.lead_time_s = s.actuator_dead_time_s.min(1.0);
             // The sensor's gain as calibration measures it: the drive's yaw rates give the true
             // angle through the configured wheelbase, so a wheelbase error reads as a gain
             // error, L_true / L_configured (`agsteer calibrate` on a tractor 10 % longer than
             // configured: 1.097), which is the gain the controller needs with its wheelbase.
+            // (The loaded configuration's wheelbase is at least 0.5 m.)
             let configured = cfg.vehicle.wheelbase_m;
-            cfg.vehicle.was_gain = if configured > 0.0 {
-                s.was_gain * (configured + s.wheelbase_error_m) / configured
-            } else {
-                s.was_gain
-            };
+            cfg.vehicle.was_gain = s.was_gain * (configured + s.wheelbase_error_m) / configured;
             cfg.vehicle.was_offset_deg = s.was_bias_deg;
             cfg.track.lost_motion_initial_deg = (s.actuator_deadband_deg
                 + 0.5 * s.actuator_backlash_deg)

@@ -194,12 +194,24 @@ mod tests {
     /// turn's start heading, so the lines are level and the CC bulb fits).
     #[test]
     fn turns_keep_the_curvature_rate() {
-        let mut p = params();
-        p.point_spacing = 0.5;
-        p.turn.point_spacing = 0.5;
-        p.turn.max_points = 400;
-        p.turn.max_curvature_rate = 0.02;
-        let segments = arcs_segments(&p).expect("plans");
+        // The suite's R 15 m arcs 3 m apart, and wider arcs 12 m apart started elsewhere.
+        for (r_inner, width, start_deg, sigma) in
+            [(15.0, 3.0, -90.0, 0.02), (40.0, 12.0, 30.0, 0.05)]
+        {
+            let mut p = params();
+            p.r_inner = r_inner;
+            p.width = width;
+            p.start_angle = f64::to_radians(start_deg);
+            p.point_spacing = 0.5;
+            p.turn.point_spacing = 0.5;
+            p.turn.max_points = 400;
+            p.turn.max_curvature_rate = sigma;
+            turns_of_arcs_keep(&p, sigma);
+        }
+    }
+
+    fn turns_of_arcs_keep(p: &ArcsParams, sigma: f64) {
+        let segments = arcs_segments(p).expect("plans");
         let curvature = |t: &[Vec2], i: usize| {
             crate::plan::coverage::metrics::three_point_curvature(&t[i - 1], &t[i], &t[i + 1])
         };
@@ -211,7 +223,7 @@ mod tests {
                 let (k0, k1) = (curvature(t, i - 1), curvature(t, i));
                 let ds = (t[i] - t[i - 1]).norm();
                 assert!(
-                    (k1 - k0).abs() <= 0.02 * ds * 1.5 + 1e-3,
+                    (k1 - k0).abs() <= sigma * ds * 1.5 + 1e-3,
                     "curvature step {k0:.3} → {k1:.3} over {ds:.2} m at point {i}"
                 );
             }

@@ -333,8 +333,9 @@ fn a_refused_engage_is_answered_with_its_reason() {
 
 /// An engage refused after its approach was planned (here: RTK float, which the supervisor does
 /// not engage on) drops the approach, as does a give-back while it is driven: the vehicle
-/// drives on by hand and the next engage plans a new one from where it is then. Before, the stale approach stayed: the gate measured XTE to
-/// it and every later engage was refused (`xte_too_large`, seen on vcan under load).
+/// drives on by hand and the next engage plans a new one from where it is then. Before, the
+/// stale approach stayed: the gate measured XTE to it and every later engage was refused
+/// (`xte_too_large`, seen on vcan under load).
 #[test]
 fn an_engage_refused_after_its_approach_was_planned_plans_again_on_the_next() {
     use agsteer::sim::can_node::{Fault, FaultKind};
