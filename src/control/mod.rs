@@ -16,7 +16,8 @@ use crate::guidance::{Guidance, GuidanceError, JobPlan};
 use crate::track::law::SteeringLaw;
 use crate::track::lost_motion::LostMotion;
 use crate::track::{
-    registry, steering_from_travel, travel_pose, CurvatureScale, IntegralAction, TrackOutput,
+    curvature_along, registry, steering_from_travel, travel_pose, CurvatureScale, IntegralAction,
+    TrackOutput, CURVATURE_SCALE_MIN_CURVATURE,
 };
 
 pub mod isobus;
@@ -294,6 +295,10 @@ impl Controller {
             pose = course_pose(&pose, drift, est.speed.abs(), min);
         }
         let local = self.guidance.local_path();
+        // The drift is kept per direction of straight driving (estimate::drift_memory).
+        let path_curvature = curvature_along(local.points(), local.index_local(), 1.0, 1.0);
+        self.estimator
+            .set_straight(path_curvature.abs() < CURVATURE_SCALE_MIN_CURVATURE);
         // The wheels as they are, in the driving direction, less the sensor's estimated offset.
         let sensor_offset = if needs.observer {
             self.estimator.wheel_offset()

@@ -2,18 +2,20 @@
 //! antenna → rear-axle reference point, latency compensation and dead reckoning between fixes.
 //!
 //! A fix describes the antenna `gnss_latency` before it arrived, or the latency its own time
-//! stamp gives ([`GnssFix::latency`], NMEA 0183 and UBX with a disciplined host clock), when
-//! known. With `predict` on, the
-//! estimator moves the rear-axle pose from that moment to `now + lead_time` with the kinematic
-//! bicycle model (ẋ = v·cosθ, ẏ = v·sinθ, θ̇ = v·tanδ/L), using the measured wheel angles
-//! recorded in that interval. That is both the latency compensation and the dead reckoning
-//! between 10 Hz fixes. With `predict` off it returns the latest fix as it is: the seed's plain
-//! reference. Allocation-free: the wheel-angle history is a fixed ring.
+//! stamp gives ([`GnssFix::latency`], NMEA 0183 and UBX with a disciplined host clock). With
+//! `predict` on, the estimator moves the rear-axle pose from that moment to `now + lead_time`
+//! with the kinematic bicycle model (ẋ = v·cosθ, ẏ = v·sinθ, θ̇ = v·tanδ/L), using the measured
+//! wheel angles of that interval: the latency compensation and the dead reckoning between
+//! fixes. With `predict` off it returns the latest fix as it is: the seed's plain reference.
+//! Allocation-free: the wheel-angle history is a fixed ring.
 
 use crate::geo::{
     heading_vec, left_normal, rotate, small_sin_cos, v2, vec_heading, wrap_angle, Pose, Vec2,
 };
 use nalgebra::{Matrix3, Vector3};
+
+mod drift_memory;
+use drift_memory::DriftMemory;
 
 /// GNSS antenna position relative to the rear-axle centre, m.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -72,7 +74,8 @@ pub struct EstimatorParams {
 /// * a drift velocity `d` (world frame, m/s, e.g. slip on a slope without a roll signal), from
 ///   the lateral innovation Δl ≈ (d − d̂)·n·Δt, n the vehicle's left normal. Only the component
 ///   along n is observable on a straight pass; kept as a world vector, a drift that is fixed on
-///   the ground (downhill) keeps its sign when the direction of travel flips;
+///   the ground (downhill) keeps its sign when the direction of travel flips, and per direction
+///   of straight driving where a large one flips with it (a side draft's crab, [`drift_memory`]);
 /// * a side-slope slip coefficient `c` (vehicle frame, m/s per rad of roll), see
 ///   [`ObserverParams::slip_tau`], from the same lateral innovation.
 ///
@@ -146,11 +149,10 @@ impl Default for ObserverParams {
     }
 }
 
-/// Innovations larger than these are not learnt from: lateral m (about 3.5 σ of the innovation
-/// of two fixes with 1 cm noise each), heading rad. A lateral one while moving is a jump
-/// (multipath, the onset of a float solution): while RTK fixed, the estimator coasts through
-/// it (dead reckoning) until the fixes agree with it again, for at most
-/// [`ObserverParams::coast_max`].
+/// Innovations larger than these are not learnt from: lateral m (3.5 σ of the innovation of two
+/// fixes with 1 cm noise each), heading rad. A lateral one while moving is a jump (multipath,
+/// a float solution's onset): while RTK fixed, the estimator dead-reckons through it until the
+/// fixes agree with it again, for at most [`ObserverParams::coast_max`].
 const GATE_LATERAL: f64 = 0.05;
 const GATE_HEADING: f64 = 0.02;
 /// With [`ObserverParams::robust`]: the lateral gate is this many standard deviations of the
@@ -159,7 +161,6 @@ const GATE_SIGMAS: f64 = 3.5;
 /// The noise estimate's time constant, in fixes, and its starting value, m.
 const NOISE_FIXES: f64 = 50.0;
 const NOISE_START: f64 = 0.01;
-
 /// Why the estimator is dead-reckoning instead of taking the fix positions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Coast {
@@ -298,6 +299,9 @@ pub struct Estimator {
     drift: Vec2,
     /// Estimated slope-slip coefficient, m/s per rad of roll (lateral, to the right).
     slip: f64,
+    /// The drift per direction of straight driving, and whether the path is straight.
+    drift_memory: DriftMemory,
+    straight: bool,
     /// The joint filter of the drift and the slip.
     lateral: LateralFilter,
     /// Roll of the latest fix, rad (0 without a roll signal).
@@ -341,6 +345,8 @@ impl Estimator {
             bias: 0.0,
             drift: Vec2::zeros(),
             slip: 0.0,
+            drift_memory: DriftMemory::default(),
+            straight: false,
             lateral: LateralFilter::new(),
             roll: 0.0,
             roll_prev: 0.0,
@@ -516,6 +522,9 @@ impl Estimator {
             );
             let step = self.lateral.update(&h, d_lateral / dt, dt, &o);
             self.drift += v2(step.x, step.y);
+            if drift_on {
+                self.drift_memory.learnt(dt, self.straight);
+            }
             let norm = self.drift.norm();
             if norm > o.drift_limit {
                 self.drift *= o.drift_limit / norm;
@@ -646,6 +655,9 @@ impl Estimator {
                 self.smooth_towards(&i, &pose);
             }
             _ => self.smooth = Vec2::zeros(),
+        }
+        if o.drift_tau > 0.0 {
+            self.drift_by_direction(heading);
         }
         self.fix_pose = Some(pose);
         self.fix_time = fix.t_received;

@@ -562,3 +562,52 @@ fn small_angle_sin_cos_and_rotations_match_the_library() {
     }
     assert!((sc.0 - th.sin()).abs() < 1e-13 && (sc.1 - th.cos()).abs() < 1e-13);
 }
+
+/// Four passes north and south (60 s at 3 m/s each, 3 m apart) with a drift of 5 cm/s fixed on
+/// the vehicle (to its right, a side draft's crab) or on the ground (East), driving straight
+/// (`straight`, the memory of the drift per direction on) or not: the error of the estimated
+/// drift across the heading 1 s into each pass, m/s.
+fn crab_passes(of_the_vehicle: bool, straight: bool) -> Vec<f64> {
+    let mut e = Estimator::new(EstimatorParams {
+        observer: ObserverParams {
+            drift_tau: 20.0,
+            ..ObserverParams::default()
+        },
+        ..params(true)
+    });
+    e.set_straight(straight);
+    let mut errors = Vec::new();
+    for pass in 0..4 {
+        let north = pass % 2 == 0;
+        let th = if north { FRAC_PI_2 } else { -FRAC_PI_2 };
+        let left = left_normal(&heading_vec(th));
+        let drift = if of_the_vehicle {
+            left * -0.05
+        } else {
+            v2(0.05, 0.0)
+        };
+        let t = pass as f64 * 61.0;
+        // Re-anchor at the start of each pass (a turn, not simulated, comes between).
+        e.fix_pose = None;
+        let start = Pose::new(pass as f64 * 3.0, if north { 0.0 } else { 180.0 }, th);
+        let at = drive(&mut e, t, 1.0, start, 0.0, drift, None);
+        errors.push(left.dot(&(e.drift() - drift)).abs());
+        drive(&mut e, t + 1.0, 59.0, at, 0.0, drift, None);
+    }
+    errors
+}
+
+#[test]
+fn a_drift_of_the_vehicle_is_kept_per_direction_and_one_of_the_ground_is_not_swapped() {
+    // The vehicle's drift: from the third pass on each pass starts with its own.
+    let kept = crab_passes(true, true);
+    assert!(kept[2] < 0.01 && kept[3] < 0.01, "{kept:?}");
+    // Without the memory (not straight: a curve) the world vector is exactly wrong there.
+    let world = crab_passes(true, false);
+    assert!(world[2] > 0.08 && world[3] > 0.08, "{world:?}");
+    // A drift of the ground keeps its side on every pass, memory or not.
+    for straight in [true, false] {
+        let ground = crab_passes(false, straight);
+        assert!(ground[1..].iter().all(|&e| e < 0.01), "{ground:?}");
+    }
+}

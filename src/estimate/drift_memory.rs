@@ -1,0 +1,311 @@
+//! The drift learnt per direction of travel.
+//!
+//! The observer's drift is a world vector ([`super::Estimator::drift`]): right for a drift
+//! fixed on the ground (downhill), which keeps its side of the field when the vehicle turns
+//! round. A lateral velocity fixed on the *vehicle* keeps its side of the vehicle instead: the
+//! crab of an implement's side draft, the sideways creep of tyres that carry a lateral load, the
+//! residue of an antenna or wheel-angle error the other estimates have not yet taken. After a
+//! headland turn the world vector learnt on the last pass then points the wrong way, and the
+//! observer learns it again over its time constant, a pass long, on every pass.
+//!
+//! On a straight pass only the drift across the pass is observable, so one pass cannot tell a
+//! ground drift from a vehicle one; two passes in opposite directions can, and work is driven
+//! in few directions (the AB lines of a field, its headland sides). So the drift is kept per
+//! sector of heading, for straight driving only (the guidance says when the path is straight,
+//! [`Estimator::set_straight`]; a curve sweeps through the sectors and its drift is the curve's):
+//! - while a sector is driven straight it keeps the current drift;
+//! - the first straight in a sector [`NEW_DIRECTION_SECTORS`] or more from the last pass (a
+//!   stay of [`MIN_LEARNT_S`]), the way back, learns the drift across the heading afresh (its
+//!   variance back to the initial one) when the drift carried into it is above [`MIN_DRIFT`];
+//! - a straight in a sector learnt for [`MIN_LEARNT_S`] takes its drift across the heading
+//!   where the carried one points the other way, both above half [`MIN_DRIFT`].
+//!
+//! A ground drift gives every sector the same vector and is never swapped (a growing one keeps
+//! its side, and its newest value is the right one); a vehicle drift gives each direction its
+//! own, so from the third pass on each pass starts with its drift. Smaller drifts are left as
+//! they were: what a straight pass learns from the other errors is a residue that restoring made
+//! worse (the envelope's antenna-position and GNSS-latency rows). Sectors are [`SECTORS`] of
+//! 45°; an active one is kept until the heading is [`HYSTERESIS`] past its edge, so a line along
+//! an edge does not swap the drift on noise. Fixed arrays; nothing allocates.
+
+use super::{Estimator, LateralFilter};
+use crate::geo::{heading_vec, left_normal, wrap_angle, Vec2};
+use nalgebra::Vector3;
+use std::f64::consts::TAU;
+
+/// Sectors of heading.
+pub const SECTORS: usize = 8;
+/// How far past the current sector's edge the heading must be to leave it, rad (15°).
+pub const HYSTERESIS: f64 = 0.2618;
+/// A sector's drift is restored once the observer has learnt there this long, s.
+pub const MIN_LEARNT_S: f64 = 10.0;
+/// The smallest drift across the heading the memory acts on, m/s (module docs). The drifts a
+/// straight pass learns from the other errors (an antenna mounted 0.3 m off along the vehicle,
+/// tyre transients, GNSS noise) were 0.3–0.8 cm/s in the envelope; a 5 kN side draft's crab
+/// 8 cm/s.
+pub const MIN_DRIFT: f64 = 0.02;
+/// A sector at least this many sectors (135°) from the last pass's is a new direction of
+/// work (the way back): its drift is learnt afresh.
+pub const NEW_DIRECTION_SECTORS: usize = 3;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Slot {
+    drift: Vec2,
+    /// Time learnt in this sector, s.
+    learnt: f64,
+}
+
+/// What entering a heading does to the drift.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Entered {
+    /// Still the same sector: as it is.
+    Same,
+    /// A sector learnt before: its drift (the estimator takes the component across the
+    /// heading from it; along the heading a pass does not observe it).
+    Learnt(Vec2),
+    /// A sector not learnt yet, [`NEW_DIRECTION_SECTORS`] or more from the last pass: the
+    /// drift as it is, learnt afresh (a new direction's drift is as uncertain as the first one
+    /// was). Any other sector not learnt yet goes on as it is ([`Entered::Same`]).
+    New,
+}
+
+/// The drift per sector of heading (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriftMemory {
+    slots: [Slot; SECTORS],
+    /// The sector of the heading (with the hysteresis).
+    current: Option<usize>,
+    /// The current sector's drift is in place: it has been driven straight since it was
+    /// entered.
+    active: bool,
+    /// Time learnt driving straight since the current sector became active, s.
+    stay: f64,
+    /// The last sector driven straight for [`MIN_LEARNT_S`] at a stretch (a pass).
+    last_pass: Option<usize>,
+}
+
+impl Default for DriftMemory {
+    fn default() -> Self {
+        DriftMemory {
+            slots: [Slot {
+                drift: Vec2::zeros(),
+                learnt: 0.0,
+            }; SECTORS],
+            current: None,
+            active: false,
+            stay: 0.0,
+            last_pass: None,
+        }
+    }
+}
+
+/// The sector of `heading` (rad).
+fn sector_of(heading: f64) -> usize {
+    let width = TAU / SECTORS as f64;
+    let i = (heading.rem_euclid(TAU) / width + 0.5).floor() as usize;
+    i % SECTORS
+}
+
+/// How many sectors apart `a` and `b` are (0 to [`SECTORS`] / 2).
+fn sector_distance(a: usize, b: usize) -> usize {
+    let d = a.abs_diff(b) % SECTORS;
+    d.min(SECTORS - d)
+}
+
+/// The centre of sector `i`, rad.
+fn centre(i: usize) -> f64 {
+    i as f64 * TAU / SECTORS as f64
+}
+
+impl DriftMemory {
+    /// The observer learnt for `dt` s, driving straight or not.
+    pub fn learnt(&mut self, dt: f64, straight: bool) {
+        let learning = self.active && straight && dt.is_finite() && dt > 0.0;
+        if let (Some(c), true) = (self.current, learning) {
+            self.slots[c].learnt += dt;
+            self.stay += dt;
+        }
+    }
+
+    /// The vehicle now heads `heading` (rad), driving straight or not (`straight`), with the
+    /// observer's drift `drift` (world, m/s): what to go on with.
+    /// Only straight driving takes a sector's drift: a curve sweeps through the sectors and
+    /// its drift is the curve's (tyre slip, a curvature bias), not a direction's.
+    pub fn on_heading(
+        &mut self,
+        heading: f64,
+        straight: bool,
+        drift: Vec2,
+    ) -> Entered {
+        if !heading.is_finite() {
+            return Entered::Same;
+        }
+        let half = 0.5 * TAU / SECTORS as f64;
+        // The hysteresis holds an active sector only: a sector is taken where the heading
+        // is when the straight begins.
+        let sector = match self.current {
+            Some(c) if self.active && wrap_angle(heading - centre(c)).abs() <= half + HYSTERESIS => {
+                c
+            }
+            _ => sector_of(heading),
+        };
+        if self.current != Some(sector) {
+            if let (Some(c), true) = (self.current, self.active && self.stay >= MIN_LEARNT_S) {
+                self.last_pass = Some(c);
+            }
+            self.current = Some(sector);
+            self.active = false;
+        }
+        if !straight {
+            return Entered::Same;
+        }
+        if self.active {
+            // The sector keeps the drift of its straight driving (not of a turn's start).
+            self.slots[sector].drift = drift;
+            return Entered::Same;
+        }
+        self.active = true;
+        self.stay = 0.0;
+        let slot = &self.slots[sector];
+        if slot.learnt >= MIN_LEARNT_S {
+            Entered::Learnt(slot.drift)
+        } else if self
+            .last_pass
+            .is_some_and(|p| sector_distance(p, sector) >= NEW_DIRECTION_SECTORS)
+        {
+            Entered::New
+        } else {
+            Entered::Same
+        }
+    }
+}
+
+impl Estimator {
+    /// Whether the vehicle follows a straight path (the guidance's; the drift is kept per
+    /// direction of straight driving, [the module](self)).
+    pub fn set_straight(&mut self, straight: bool) {
+        self.straight = straight;
+    }
+
+    /// The drift per direction of straight driving ([the module](self)) at a fix heading
+    /// `heading` (rad).
+    pub(super) fn drift_by_direction(&mut self, heading: f64) {
+        let entered = self
+            .drift_memory
+            .on_heading(heading, self.straight, self.drift);
+        // Only the drift across the heading is a direction's: a pass does not observe the rest.
+        let n = left_normal(&heading_vec(heading));
+        let carried = n.dot(&self.drift);
+        match entered {
+            Entered::Same => {}
+            Entered::Learnt(drift) => {
+                // The sector's own drift where the carried one points the other way across the
+                // heading: a drift of the vehicle, not of the ground (a ground drift that grows
+                // keeps its side, and its newest value is the right one).
+                let stored = n.dot(&drift);
+                if stored * carried < 0.0
+                    && stored.abs().min(carried.abs()) > 0.5 * MIN_DRIFT
+                {
+                    self.drift += n * (stored - carried);
+                }
+            }
+            Entered::New => {
+                if carried.abs() > MIN_DRIFT {
+                    self.lateral.relearn_across(&n);
+                }
+            }
+        }
+    }
+}
+
+impl LateralFilter {
+    /// Learn the drift across `n` (a unit vector) afresh: its variance along `n` back to the
+    /// initial one, the rest as it is.
+    pub(super) fn relearn_across(&mut self, n: &Vec2) {
+        let n3 = Vector3::new(n.x, n.y, 0.0);
+        let add = Self::P0[0] - n3.dot(&(self.p * n3));
+        if add > 0.0 && add.is_finite() {
+            self.p += n3 * n3.transpose() * add;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geo::v2;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn sectors_cover_the_circle() {
+        assert_eq!(sector_of(0.0), 0);
+        assert_eq!(sector_of(-0.1), 0);
+        assert_eq!(sector_of(PI), 4);
+        assert_eq!(sector_of(-PI), 4);
+        assert_eq!(sector_of(-PI / 2.0), 6);
+        assert_eq!(sector_of(3.0 * PI / 8.0 + 0.01), 2);
+    }
+
+    #[test]
+    fn each_direction_gets_back_what_it_learnt() {
+        let mut m = DriftMemory::default();
+        let north = PI / 2.0;
+        let (a, b) = (v2(0.03, 0.0), v2(-0.03, 0.0));
+        // Northwards: learns a (each straight fix keeps the current drift).
+        assert_eq!(m.on_heading(north, true, Vec2::zeros()), Entered::Same);
+        m.learnt(30.0, true);
+        assert_eq!(m.on_heading(north, true, a), Entered::Same);
+        // Southwards for the first time: learns afresh, b.
+        assert_eq!(m.on_heading(-north, true, a), Entered::New);
+        m.learnt(30.0, true);
+        assert_eq!(m.on_heading(-north, true, b), Entered::Same);
+        // Northwards again: a, whatever the drift now is; southwards: b.
+        assert_eq!(m.on_heading(north, true, b), Entered::Learnt(a));
+        assert_eq!(m.on_heading(-north, true, v2(0.01, 0.0)), Entered::Learnt(b));
+    }
+
+    #[test]
+    fn a_sector_learnt_briefly_and_the_edge_keep_the_drift() {
+        let mut m = DriftMemory::default();
+        let d = v2(0.02, 0.01);
+        m.on_heading(0.0, true, Vec2::zeros());
+        m.learnt(MIN_LEARNT_S - 1.0, true);
+        // West after a short stay east (not a pass): as it is.
+        assert_eq!(m.on_heading(PI, true, d), Entered::Same);
+        // Back east: its sector was learnt too briefly to be restored.
+        assert_eq!(m.on_heading(0.0, true, d * 2.0), Entered::Same);
+        m.learnt(MIN_LEARNT_S, true);
+        // Just past the edge of sector 0 (22.5°) but within the hysteresis: no swap.
+        assert_eq!(m.on_heading(0.5, true, d * 3.0), Entered::Same);
+        assert_eq!(m.on_heading(-0.5, true, d * 3.0), Entered::Same);
+        // Not finite: as it is.
+        assert_eq!(m.on_heading(f64::NAN, true, d), Entered::Same);
+    }
+
+    #[test]
+    fn a_curve_takes_no_sector_drift_until_it_runs_straight() {
+        let mut m = DriftMemory::default();
+        let a = v2(0.0, 0.03);
+        m.on_heading(0.0, true, Vec2::zeros());
+        m.learnt(30.0, true);
+        m.on_heading(0.0, true, a);
+        // Round a curve through the sectors and back east: nothing swapped, nothing stored
+        // from the curve.
+        for i in 1..=16 {
+            let heading = i as f64 * PI / 8.0;
+            assert_eq!(m.on_heading(heading, false, v2(0.05, 0.0)), Entered::Same);
+        }
+        // Straight again, east: what was learnt there before the curve.
+        assert_eq!(m.on_heading(0.0, true, v2(0.05, 0.0)), Entered::Learnt(a));
+        // West, curving: learning there does not count, and it is a new direction once
+        // straight.
+        m.on_heading(PI, false, a);
+        m.learnt(30.0, false);
+        assert_eq!(m.on_heading(PI, true, a), Entered::New);
+        // A quarter turn from the last pass (east, learnt 30 s) is not the way back.
+        let mut m = DriftMemory::default();
+        m.on_heading(0.0, true, a);
+        m.learnt(30.0, true);
+        assert_eq!(m.on_heading(PI / 2.0, true, a), Entered::Same);
+    }
+}
