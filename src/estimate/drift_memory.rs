@@ -131,12 +131,7 @@ impl DriftMemory {
     /// observer's drift `drift` (world, m/s): what to go on with.
     /// Only straight driving takes a sector's drift: a curve sweeps through the sectors and
     /// its drift is the curve's (tyre slip, a curvature bias), not a direction's.
-    pub fn on_heading(
-        &mut self,
-        heading: f64,
-        straight: bool,
-        drift: Vec2,
-    ) -> Entered {
+    pub fn on_heading(&mut self, heading: f64, straight: bool, drift: Vec2) -> Entered {
         if !heading.is_finite() {
             return Entered::Same;
         }
@@ -144,7 +139,9 @@ impl DriftMemory {
         // The hysteresis holds an active sector only: a sector is taken where the heading
         // is when the straight begins.
         let sector = match self.current {
-            Some(c) if self.active && wrap_angle(heading - centre(c)).abs() <= half + HYSTERESIS => {
+            Some(c)
+                if self.active && wrap_angle(heading - centre(c)).abs() <= half + HYSTERESIS =>
+            {
                 c
             }
             _ => sector_of(heading),
@@ -203,9 +200,7 @@ impl Estimator {
                 // heading: a drift of the vehicle, not of the ground (a ground drift that grows
                 // keeps its side, and its newest value is the right one).
                 let stored = n.dot(&drift);
-                if stored * carried < 0.0
-                    && stored.abs().min(carried.abs()) > 0.5 * MIN_DRIFT
-                {
+                if stored * carried < 0.0 && stored.abs().min(carried.abs()) > 0.5 * MIN_DRIFT {
                     self.drift += n * (stored - carried);
                 }
             }
@@ -261,7 +256,10 @@ mod tests {
         assert_eq!(m.on_heading(-north, true, b), Entered::Same);
         // Northwards again: a, whatever the drift now is; southwards: b.
         assert_eq!(m.on_heading(north, true, b), Entered::Learnt(a));
-        assert_eq!(m.on_heading(-north, true, v2(0.01, 0.0)), Entered::Learnt(b));
+        assert_eq!(
+            m.on_heading(-north, true, v2(0.01, 0.0)),
+            Entered::Learnt(b)
+        );
     }
 
     #[test]

@@ -40,6 +40,9 @@ const CELLS: &[(&str, &str, f64)] = &[
     // The ideal calibration's WAS gain as `agsteer calibrate` measures it, relative to the
     // configured wheelbase (0.63 cm with the sensor's own gain, `**` against Stanley's 0.29).
     ("wheelbase_+10%", "straight_15kmh", 0.35),
+    // Session 14: the drift kept per direction of straight driving (a 5 kN side draft's crab
+    // flipped with every pass: 12.08 cm RMS before).
+    ("side_draft_5kN", "straight_10kmh", 0.63),
 ];
 
 #[test]
