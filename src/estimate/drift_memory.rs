@@ -16,7 +16,8 @@
 //! - while a sector is driven straight it keeps the current drift;
 //! - the first straight in a sector [`NEW_DIRECTION_SECTORS`] or more from the last pass (a
 //!   stay of [`MIN_LEARNT_S`]), the way back, learns the drift across the heading afresh (its
-//!   variance back to the initial one) when the drift carried into it is above [`MIN_DRIFT`];
+//!   variance back to the initial one) when the drift carried into it is above [`MIN_DRIFT`]
+//!   (above 10 km/h: [`MIN_CRAB`] times the speed);
 //! - a straight in a sector learnt for [`MIN_LEARNT_S`] takes its drift across the heading
 //!   where the carried one points the other way, both above half [`MIN_DRIFT`].
 //!
@@ -44,6 +45,11 @@ pub const MIN_LEARNT_S: f64 = 10.0;
 /// tyre transients, GNSS noise) were 0.3–0.8 cm/s in the envelope; a 5 kN side draft's crab
 /// 8 cm/s.
 pub const MIN_DRIFT: f64 = 0.02;
+/// Above 10 km/h the smallest drift grows with the speed, as this crab angle, rad (0.41°: 2 cm/s
+/// at 10 km/h): the lateral slip of dynamic tyres at a line's start grows with it (soft tyres
+/// and tractor_b at 15 km/h had been relearnt on every way back at 2 cm/s: 3.0 → 3.7 and 3.9 →
+/// 6.3 cm RMS; with the angle 3.0 and 5.1 cm, the side draft's 1.8 → 1.5 cm).
+pub const MIN_CRAB: f64 = 0.0072;
 /// A sector at least this many sectors (135°) from the last pass's is a new direction of
 /// work (the way back): its drift is learnt afresh.
 pub const NEW_DIRECTION_SECTORS: usize = 3;
@@ -193,6 +199,7 @@ impl Estimator {
         // Only the drift across the heading is a direction's: a pass does not observe the rest.
         let n = left_normal(&heading_vec(heading));
         let carried = n.dot(&self.drift);
+        let min_drift = (MIN_CRAB * self.fix_speed.abs()).max(MIN_DRIFT);
         match entered {
             Entered::Same => {}
             Entered::Learnt(drift) => {
@@ -200,12 +207,12 @@ impl Estimator {
                 // heading: a drift of the vehicle, not of the ground (a ground drift that grows
                 // keeps its side, and its newest value is the right one).
                 let stored = n.dot(&drift);
-                if stored * carried < 0.0 && stored.abs().min(carried.abs()) > 0.5 * MIN_DRIFT {
+                if stored * carried < 0.0 && stored.abs().min(carried.abs()) > 0.5 * min_drift {
                     self.drift += n * (stored - carried);
                 }
             }
             Entered::New => {
-                if carried.abs() > MIN_DRIFT {
+                if carried.abs() > min_drift {
                     self.lateral.relearn_across(&n);
                 }
             }
