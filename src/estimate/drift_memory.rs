@@ -209,6 +209,10 @@ impl Estimator {
                 let stored = n.dot(&drift);
                 if stored * carried < 0.0 && stored.abs().min(carried.abs()) > 0.5 * min_drift {
                     self.drift += n * (stored - carried);
+                    let (norm, limit) = (self.drift.norm(), self.params.observer.drift_limit);
+                    if norm > limit {
+                        self.drift *= limit / norm;
+                    }
                 }
             }
             Entered::New => {
