@@ -295,10 +295,12 @@ impl Controller {
             pose = course_pose(&pose, drift, est.speed.abs(), min);
         }
         let local = self.guidance.local_path();
-        // The drift is kept per direction of straight driving (estimate::drift_memory).
-        let path_curvature = curvature_along(local.points(), local.index_local(), 1.0, 1.0);
-        self.estimator
-            .set_straight(path_curvature.abs() < CURVATURE_SCALE_MIN_CURVATURE);
+        if needs.observer {
+            // The drift is kept per direction of straight driving (estimate::drift_memory).
+            let path_curvature = curvature_along(local.points(), local.index_local(), 1.0, 1.0);
+            self.estimator
+                .set_straight(path_curvature.abs() < CURVATURE_SCALE_MIN_CURVATURE);
+        }
         // The wheels as they are, in the driving direction, less the sensor's estimated offset.
         let sensor_offset = if needs.observer {
             self.estimator.wheel_offset()

@@ -190,6 +190,15 @@ impl Estimator {
         self.straight = straight;
     }
 
+    /// Move the drift estimate by `step` (world, m/s), within the observer's drift limit.
+    pub(super) fn add_drift(&mut self, step: Vec2) {
+        self.drift += step;
+        let (norm, limit) = (self.drift.norm(), self.params.observer.drift_limit);
+        if norm > limit {
+            self.drift *= limit / norm;
+        }
+    }
+
     /// The drift per direction of straight driving ([the module](self)) at a fix heading
     /// `heading` (rad).
     pub(super) fn drift_by_direction(&mut self, heading: f64) {
@@ -208,11 +217,7 @@ impl Estimator {
                 // keeps its side, and its newest value is the right one).
                 let stored = n.dot(&drift);
                 if stored * carried < 0.0 && stored.abs().min(carried.abs()) > 0.5 * min_drift {
-                    self.drift += n * (stored - carried);
-                    let (norm, limit) = (self.drift.norm(), self.params.observer.drift_limit);
-                    if norm > limit {
-                        self.drift *= limit / norm;
-                    }
+                    self.add_drift(n * (stored - carried));
                 }
             }
             Entered::New => {

@@ -161,6 +161,7 @@ const GATE_SIGMAS: f64 = 3.5;
 /// The noise estimate's time constant, in fixes, and its starting value, m.
 const NOISE_FIXES: f64 = 50.0;
 const NOISE_START: f64 = 0.01;
+
 /// Why the estimator is dead-reckoning instead of taking the fix positions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Coast {
@@ -521,13 +522,9 @@ impl Estimator {
                 },
             );
             let step = self.lateral.update(&h, d_lateral / dt, dt, &o);
-            self.drift += v2(step.x, step.y);
+            self.add_drift(v2(step.x, step.y));
             if drift_on {
                 self.drift_memory.learnt(dt, self.straight);
-            }
-            let norm = self.drift.norm();
-            if norm > o.drift_limit {
-                self.drift *= o.drift_limit / norm;
             }
             self.slip = (self.slip + step.z).clamp(-o.slip_limit, o.slip_limit);
         }

@@ -563,11 +563,11 @@ fn small_angle_sin_cos_and_rotations_match_the_library() {
     assert!((sc.0 - th.sin()).abs() < 1e-13 && (sc.1 - th.cos()).abs() < 1e-13);
 }
 
-/// Four passes north and south (60 s at 3 m/s each, 3 m apart) with a drift of 5 cm/s fixed on
-/// the vehicle (to its right, a side draft's crab) or on the ground (East), driving straight
+/// Four passes north and south (60 s at 3 m/s each, 3 m apart) with the drift (world, m/s)
+/// `drift_of(pass, left)` on each (`left` the vehicle's left normal), driving straight
 /// (`straight`, the memory of the drift per direction on) or not: the error of the estimated
 /// drift across the heading 1 s into each pass, m/s.
-fn crab_passes(of_the_vehicle: bool, straight: bool) -> Vec<f64> {
+fn crab_passes(drift_of: impl Fn(usize, Vec2) -> Vec2, straight: bool) -> Vec<f64> {
     let mut e = Estimator::new(EstimatorParams {
         observer: ObserverParams {
             drift_tau: 20.0,
@@ -581,11 +581,7 @@ fn crab_passes(of_the_vehicle: bool, straight: bool) -> Vec<f64> {
         let north = pass % 2 == 0;
         let th = if north { FRAC_PI_2 } else { -FRAC_PI_2 };
         let left = left_normal(&heading_vec(th));
-        let drift = if of_the_vehicle {
-            left * -0.05
-        } else {
-            v2(0.05, 0.0)
-        };
+        let drift = drift_of(pass, left);
         let t = pass as f64 * 61.0;
         // Re-anchor at the start of each pass (a turn, not simulated, comes between).
         e.fix_pose = None;
@@ -599,15 +595,23 @@ fn crab_passes(of_the_vehicle: bool, straight: bool) -> Vec<f64> {
 
 #[test]
 fn a_drift_of_the_vehicle_is_kept_per_direction_and_one_of_the_ground_is_not_swapped() {
+    // 5 cm/s to the vehicle's right (a side draft's crab), or East on the ground.
+    let vehicle = |_: usize, left: Vec2| left * -0.05;
+    let ground = |_: usize, _: Vec2| v2(0.05, 0.0);
     // The vehicle's drift: from the third pass on each pass starts with its own.
-    let kept = crab_passes(true, true);
+    let kept = crab_passes(vehicle, true);
     assert!(kept[2] < 0.01 && kept[3] < 0.01, "{kept:?}");
     // Without the memory (not straight: a curve) the world vector is exactly wrong there.
-    let world = crab_passes(true, false);
+    let world = crab_passes(vehicle, false);
     assert!(world[2] > 0.08 && world[3] > 0.08, "{world:?}");
     // A drift of the ground keeps its side on every pass, memory or not.
     for straight in [true, false] {
-        let ground = crab_passes(false, straight);
+        let ground = crab_passes(ground, straight);
         assert!(ground[1..].iter().all(|&e| e < 0.01), "{ground:?}");
     }
+    // A ground drift that grows (3 cm/s on the first pass, 6 from the second) keeps its newest
+    // value: the third pass does not go back to what the first learnt (an error of 3 cm/s).
+    let growing = |pass: usize, _: Vec2| v2(if pass == 0 { 0.03 } else { 0.06 }, 0.0);
+    let newest = crab_passes(growing, true);
+    assert!(newest[2] < 0.01 && newest[3] < 0.01, "{newest:?}");
 }
