@@ -55,6 +55,9 @@ pub struct Figures {
     /// Antenna lateral offset, m, positive left (`None`: no two-way pass).
     #[serde(default)]
     pub antenna_left_m: Option<Figure>,
+    /// Antenna forward offset from the rear axle, m (`None`: not measured).
+    #[serde(default)]
+    pub antenna_forward_m: Option<Figure>,
 }
 
 impl Calibration {
@@ -75,6 +78,7 @@ impl Calibration {
             gnss_latency_ms: self.gnss_latency.as_ref().map(|e| Figure::of(e, 1000.0)),
             gnss_interval_ms: self.gnss_interval.map(|i| i * 1000.0),
             antenna_left_m: self.antenna_left.as_ref().map(|e| Figure::of(e, 1.0)),
+            antenna_forward_m: self.antenna_forward.as_ref().map(|e| Figure::of(e, 1.0)),
         }
     }
 }
@@ -101,6 +105,10 @@ impl Figures {
             .map_or("not measured (no two-way pass)".to_string(), |f| {
                 f.show("m (left of the centre line)", 3)
             });
+        let forward = self.antenna_forward_m.map_or(
+            "not measured (no heading receiver, or too little turning)".to_string(),
+            |f| f.show("m (ahead of the rear axle)", 3),
+        );
         format!(
             "dead time      {}\n\
              lag            {}\n\
@@ -113,7 +121,8 @@ impl Figures {
              fit residual   {:.3} ° RMS\n\
              GNSS latency   {latency}\n\
              GNSS interval  {interval}\n\
-             antenna left   {antenna}\n",
+             antenna left   {antenna}\n\
+             antenna ahead  {forward}\n",
             self.dead_time_ms.show("ms", 1),
             self.lag_ms.show("ms", 1),
             self.deadband_deg.show("°", 2),

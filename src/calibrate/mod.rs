@@ -21,6 +21,7 @@
 //! [`crate::demo::calibrate`]).
 
 pub mod antenna;
+pub mod antenna_forward;
 pub mod figures;
 pub mod fit;
 pub mod identify;
@@ -135,12 +136,19 @@ pub struct Calibration {
     pub gnss_interval: Option<f64>,
     /// Antenna lateral offset, m, positive left (`None`: no two-way pass).
     pub antenna_left: Option<Estimate>,
+    /// Antenna forward offset from the rear axle, m (`None`: no heading receiver, or the
+    /// drive's turns did not pin it within [`FORWARD_MAX_SD_M`]).
+    pub antenna_forward: Option<Estimate>,
     /// RMS of the steering fit's residuals, rad.
     pub steering_rms: f64,
     /// The fit in the sensor's terms and the sensor fit, as found.
     pub steering_fit: SteeringFit,
     pub was_fit: WasFit,
 }
+
+/// Largest standard deviation of a measured antenna forward offset written, m: a less certain
+/// one leaves the taped value.
+pub const FORWARD_MAX_SD_M: f64 = 0.05;
 
 /// The GNSS timeout for a receiver that sends a fix every `interval` s: one and a half
 /// intervals and 0.1 s of jitter, at least the default 0.3 s (a 10 Hz receiver keeps it; a
@@ -385,6 +393,13 @@ impl Session {
             latency_note,
             gnss_interval: median_interval(&self.slalom_fixes),
             antenna_left,
+            antenna_forward: antenna_forward::fit_antenna_forward(&self.drive)
+                .ok()
+                .filter(|f| f.sd <= FORWARD_MAX_SD_M)
+                .map(|f| Estimate {
+                    value: f.forward,
+                    sd: Some(f.sd),
+                }),
             steering_rms: fit.rms,
             steering_fit: fit,
             was_fit: was,
@@ -423,7 +438,7 @@ impl Calibration {
             ),
             None => String::new(),
         };
-        let antenna = match &self.antenna_left {
+        let mut antenna = match &self.antenna_left {
             Some(e) => format!(
                 "antenna_left_m = {:.3}  # {} (two-way pass)\n",
                 e.value,
@@ -431,6 +446,13 @@ impl Calibration {
             ),
             None => String::new(),
         };
+        if let Some(e) = &self.antenna_forward {
+            antenna += &format!(
+                "antenna_forward_m = {:.3}  # {} (the drive's turns)\n",
+                e.value,
+                sd(e, 1.0, 3)
+            );
+        }
         format!(
             "# Written by `agsteer calibrate`: copy each key into its table of the configuration.\n\
              [safety]\n\

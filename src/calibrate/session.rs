@@ -23,6 +23,7 @@
 //! wheel (override status, a disengage), the wheels held away from the command, no response.
 
 use super::antenna::MIN_OVERLAP_M;
+use super::antenna_forward::DriveTrack;
 use super::identify::SteeringRecord;
 use super::latency::Slalom;
 use super::was::Hold;
@@ -138,6 +139,9 @@ pub struct Session {
     /// When the slalom's position fixes arrived, s (the receiver's fix interval: what the
     /// supervisor's GNSS timeout times).
     pub(super) slalom_fixes: Vec<f64>,
+    /// The holds' and the slalom's positions, headings and speeds (the antenna's forward
+    /// offset, [`super::antenna_forward`]).
+    pub(super) drive: DriveTrack,
     /// Antenna positions (time s, local ENU m) of the out and the back pass.
     pub(super) pass_out: Vec<(f64, Vec2)>,
     pub(super) pass_back: Vec<(f64, Vec2)>,
@@ -183,6 +187,7 @@ impl Session {
             holds: Vec::new(),
             slalom: Slalom::default(),
             slalom_fixes: Vec::new(),
+            drive: DriveTrack::default(),
             pass_out: Vec::new(),
             pass_back: Vec::new(),
             out_line: None,
@@ -283,6 +288,9 @@ impl Session {
                 if self.phase == Phase::Slalom {
                     self.slalom.heading.push((h.t, h.heading));
                 }
+                if self.driving() {
+                    self.drive.headings.push((h.t, h.heading));
+                }
             }
             Input::CourseSpeed(c) => {
                 if let Some(v) = c.speed_mps.filter(|v| v.is_finite()) {
@@ -292,6 +300,9 @@ impl Session {
                     }
                     if self.phase == Phase::Slalom {
                         self.slalom.speed.push((c.t, v));
+                    }
+                    if self.driving() {
+                        self.drive.speeds.push((c.t, v));
                     }
                 }
                 // Without a heading receiver the course over ground turns at the same rate
@@ -323,6 +334,9 @@ impl Session {
                         Phase::Slalom => self.slalom_fixes.push(p.t),
                         _ => {}
                     }
+                    if self.driving() {
+                        self.drive.positions.push((p.t, pos));
+                    }
                 }
             }
             Input::WheelSpeed(s) => {
@@ -344,6 +358,11 @@ impl Session {
             _ => {}
         }
         Ok(())
+    }
+
+    /// Driving ahead with the wheels steered: the holds and the slalom.
+    fn driving(&self) -> bool {
+        matches!(self.phase, Phase::Holds | Phase::Slalom)
     }
 
     fn active(&self) -> bool {

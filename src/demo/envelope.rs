@@ -283,11 +283,14 @@ pub fn apply_calibration(cfg: &mut Config, calibration: Calibration) {
             cfg.track.lost_motion_initial_deg = (s.actuator_deadband_deg
                 + 0.5 * s.actuator_backlash_deg)
                 .min(cfg.track.lost_motion_limit_deg);
-            // The GNSS latency and the antenna's lateral offset (the slalom and the two-way
-            // pass); the true antenna stays where it is.
+            // The GNSS latency, the antenna's lateral offset and its forward offset (the
+            // slalom, the two-way pass and the drive's turns); the true antenna stays where
+            // it is.
             cfg.track.gnss_latency_s = s.gnss_latency_s.min(0.5);
             cfg.vehicle.antenna_left_m += s.antenna_error_left_m;
             cfg.sim.antenna_error_left_m = 0.0;
+            cfg.vehicle.antenna_forward_m += s.antenna_error_forward_m;
+            cfg.sim.antenna_error_forward_m = 0.0;
         }
     }
 }

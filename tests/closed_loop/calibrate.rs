@@ -31,6 +31,8 @@ struct Plant {
     gnss_latency_s: f64,
     /// The true antenna's lateral offset less the configured one, m.
     antenna_left_error_m: f64,
+    /// The true antenna's forward offset less the configured one, m.
+    antenna_forward_error_m: f64,
     heading_sigma_deg: f64,
     seed: u64,
 }
@@ -58,6 +60,7 @@ impl Plant {
             antenna_left_error_m: rng.gen_range(-0.3..0.3),
             // The default receiver's heading (the envelope does not vary it).
             heading_sigma_deg: 0.1,
+            antenna_forward_error_m: rng.gen_range(-0.3..0.3),
             seed,
         }
     }
@@ -75,6 +78,7 @@ impl Plant {
         p.gnss_sigma = self.gnss_sigma_m;
         p.gnss_latency = self.gnss_latency_s;
         p.antenna_left = cfg.vehicle.antenna_left_m + self.antenna_left_error_m;
+        p.antenna_forward = self.antenna_forward_m(cfg);
         p.heading_sigma = self.heading_sigma_deg.to_radians();
         p.seed = self.seed;
         p
@@ -82,6 +86,10 @@ impl Plant {
 
     fn antenna_left_m(&self, cfg: &Config) -> f64 {
         cfg.vehicle.antenna_left_m + self.antenna_left_error_m
+    }
+
+    fn antenna_forward_m(&self, cfg: &Config) -> f64 {
+        cfg.vehicle.antenna_forward_m + self.antenna_forward_error_m
     }
 }
 
@@ -116,6 +124,8 @@ const LATENCY_TOLERANCE_S: f64 = 0.010;
 /// track both ways (pure pursuit behind the plant's steering) and the position frames'
 /// resolution (1e-7°, ≈ 1 cm).
 const ANTENNA_TOLERANCE_M: f64 = 0.02;
+/// The antenna's forward offset within 5 cm (4 % of the configured 1.2 m).
+const FORWARD_TOLERANCE_M: f64 = 0.05;
 
 /// Every identified parameter within the issue's tolerances: 10 % (deadband and backlash
 /// also within 0.1°, for small ones), offset within 0.1°, dead time within 10 ms, GNSS
@@ -199,6 +209,16 @@ fn misses(p: &Plant, f: &Figures) -> Vec<String> {
         ),
         None => check("antenna left (not measured)", f64::NAN, truth, false),
     }
+    let truth = p.antenna_forward_m(&config());
+    match f.antenna_forward_m {
+        Some(a) => check(
+            "antenna forward m",
+            a.value,
+            truth,
+            (a.value - truth).abs() <= FORWARD_TOLERANCE_M,
+        ),
+        None => check("antenna forward (not measured)", f64::NAN, truth, false),
+    }
     m
 }
 
@@ -231,7 +251,7 @@ fn twenty_random_plants_are_identified_within_the_tolerances() {
     let mut unreached = 0;
     // Worst errors: dead time ms, lag %, rate % (reached), lost motion °, gain %, offset °,
     // GNSS latency ms, antenna left cm.
-    let mut worst = [0.0f64; 8];
+    let mut worst = [0.0f64; 9];
     let cfg = config();
     for (p, r) in &results {
         match r {
@@ -256,10 +276,13 @@ fn twenty_random_plants_are_identified_within_the_tolerances() {
                     c.antenna_left.map_or(f64::INFINITY, |a| {
                         100.0 * (a.value - p.antenna_left_m(&cfg)).abs()
                     }),
+                    c.antenna_forward.map_or(f64::INFINITY, |a| {
+                        100.0 * (a.value - p.antenna_forward_m(&cfg)).abs()
+                    }),
                 ];
                 eprintln!(
                     "plant {}: latency {:.1} ms (truth {:.1}) ± {:.1}, antenna left {:.3} m \
-                     (truth {:.3}) ± {:.3}",
+                     (truth {:.3}) ± {:.3}, ahead {:.3} m (truth {:.3}) ± {:.3}",
                     p.seed,
                     c.gnss_latency.map_or(f64::NAN, |l| 1000.0 * l.value),
                     1000.0 * p.gnss_latency_s,
@@ -269,6 +292,9 @@ fn twenty_random_plants_are_identified_within_the_tolerances() {
                     c.antenna_left.map_or(f64::NAN, |a| a.value),
                     p.antenna_left_m(&cfg),
                     c.antenna_left.and_then(|a| a.sd).unwrap_or(f64::NAN),
+                    c.antenna_forward.map_or(f64::NAN, |a| a.value),
+                    p.antenna_forward_m(&cfg),
+                    c.antenna_forward.and_then(|a| a.sd).unwrap_or(f64::NAN),
                 );
                 for (w, x) in worst.iter_mut().zip(e) {
                     *w = w.max(x);
@@ -284,8 +310,9 @@ fn twenty_random_plants_are_identified_within_the_tolerances() {
     eprintln!("rate limit not reached by the tests on {unreached} of 20 plants");
     eprintln!(
         "worst errors: dead time {:.1} ms, lag {:.1} %, rate {:.1} %, lost motion {:.3}°, \
-         WAS gain {:.2} %, WAS offset {:.3}°, GNSS latency {:.1} ms, antenna left {:.2} cm",
-        worst[0], worst[1], worst[2], worst[3], worst[4], worst[5], worst[6], worst[7]
+         WAS gain {:.2} %, WAS offset {:.3}°, GNSS latency {:.1} ms, antenna left {:.2} cm, \
+         antenna forward {:.2} cm",
+        worst[0], worst[1], worst[2], worst[3], worst[4], worst[5], worst[6], worst[7], worst[8]
     );
     assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
@@ -303,6 +330,7 @@ fn nominal() -> Plant {
         gnss_sigma_m: 0.01,
         gnss_latency_s: 0.08,
         antenna_left_error_m: -0.15,
+        antenna_forward_error_m: 0.2,
         heading_sigma_deg: 0.1,
         seed: 7,
     }
@@ -323,6 +351,7 @@ fn the_fragment_names_the_keys_the_controller_reads() {
         ("vehicle", "was_offset_deg"),
         ("track", "gnss_latency_s"),
         ("vehicle", "antenna_left_m"),
+        ("vehicle", "antenna_forward_m"),
     ] {
         assert!(table[t].get(k).is_some(), "{t}.{k} missing:\n{frag}");
     }
