@@ -199,25 +199,24 @@ fn misses(p: &Plant, f: &Figures) -> Vec<String> {
             false,
         ),
     }
-    let truth = p.antenna_left_m(&config());
-    match f.antenna_left_m {
-        Some(a) => check(
+    let cfg = config();
+    for (name, figure, truth, tolerance) in [
+        (
             "antenna left m",
-            a.value,
-            truth,
-            (a.value - truth).abs() <= ANTENNA_TOLERANCE_M,
+            f.antenna_left_m,
+            p.antenna_left_m(&cfg),
+            ANTENNA_TOLERANCE_M,
         ),
-        None => check("antenna left (not measured)", f64::NAN, truth, false),
-    }
-    let truth = p.antenna_forward_m(&config());
-    match f.antenna_forward_m {
-        Some(a) => check(
+        (
             "antenna forward m",
-            a.value,
-            truth,
-            (a.value - truth).abs() <= FORWARD_TOLERANCE_M,
+            f.antenna_forward_m,
+            p.antenna_forward_m(&cfg),
+            FORWARD_TOLERANCE_M,
         ),
-        None => check("antenna forward (not measured)", f64::NAN, truth, false),
+    ] {
+        // Not measured: a miss.
+        let got = figure.map_or(f64::NAN, |a| a.value);
+        check(name, got, truth, (got - truth).abs() <= tolerance);
     }
     m
 }
