@@ -234,18 +234,18 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
     );
     let working = headland::working_area(&field.boundary, &large, p);
     // Points are checked; the chords between them may cut a little inside the arcs.
-    let clear_map = ClearMap::new(
-        field,
-        half + headland::chord_margin(p) - headland::CHORD_MARGIN,
-    );
+    let strict_half = half + headland::chord_margin(p) - headland::CHORD_MARGIN;
+    let clear_map = ClearMap::new(field, strict_half);
     let clear = |q: &Vec2| clear_map.clear(q);
     // Transits that find no way with the implement clear of the edge keep the tractor inside
     // the field and off the obstacles (the guarantee for paths that do not work).
-    let loose_map = ClearMap::new(
-        field,
-        half.min(TRANSIT_CLEARANCE_M) + headland::chord_margin(p) - headland::CHORD_MARGIN,
-    );
-    let loose = |q: &Vec2| loose_map.clear(q);
+    // With an implement no wider than the tractor's clearance the two tests are one (w ≤ 3 m):
+    // one map then, and the relaxed attempts that would repeat the strict ones are skipped.
+    let loose_half =
+        half.min(TRANSIT_CLEARANCE_M) + headland::chord_margin(p) - headland::CHORD_MARGIN;
+    let one_test = loose_half == strict_half;
+    let loose_map = (!one_test).then(|| ClearMap::new(field, loose_half));
+    let loose = |q: &Vec2| loose_map.as_ref().unwrap_or(&clear_map).clear(q);
     // Waypoints for detours and transits that cannot go direct: grids of clear points over
     // the field, each with the test of its curves. (Built on first need: most plans never
     // need them.)
@@ -259,6 +259,9 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
     };
     let loose_grid = std::cell::OnceCell::new();
     let loose_grid = || {
+        if one_test {
+            return waypoint_grid();
+        }
         loose_grid
             .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, &loose))
     };
@@ -404,6 +407,10 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
         for (t, way, relaxed) in attempts {
             let (cp, cn, f, hf, q, hq) = poses(t);
             if t > 0 && cp == 0 && cn == 0 {
+                continue;
+            }
+            if relaxed && one_test && t == 0 && !matches!(way, Way::Waypoints) {
+                // The strict attempt with the same poses and test found nothing.
                 continue;
             }
             let (r, step) = (p.r_min, p.point_spacing);
