@@ -404,6 +404,10 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
             (0, Way::Waypoints, true),
         ]);
         let mut found = None;
+        // The relaxed headland attempt without shortening, made first (once) where the tests
+        // differ: its test passes every point the strict one passes, on the same rings,
+        // candidates and joins, so when it finds no way the strict attempt finds none either.
+        let mut loose_headland: Option<Option<Vec<Vec2>>> = None;
         for (t, way, relaxed) in attempts {
             let (cp, cn, f, hf, q, hq) = poses(t);
             if t > 0 && cp == 0 && cn == 0 {
@@ -418,6 +422,17 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
             let pts = match way {
                 Way::Direct => transit::transit(f, hf, q, hq, r, step, ok)
                     .and_then(|(pts, ok)| ok.then_some(pts)),
+                Way::Headland if t == 0 && !one_test => {
+                    let loose_way = loose_headland
+                        .get_or_insert_with(|| rings.transit(f, hf, q, hq, r, step, &loose));
+                    if relaxed {
+                        loose_way.take()
+                    } else if loose_way.is_none() {
+                        None
+                    } else {
+                        rings.transit(f, hf, q, hq, r, step, ok)
+                    }
+                }
                 Way::Headland => rings.transit(f, hf, q, hq, r, step, ok),
                 // (Only relaxed: the loose grid's test is `ok`.)
                 Way::Waypoints => {
