@@ -325,6 +325,7 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
 
     let tp = p.turn_params();
     let mut cache = crate::plan::turns::TurnCache::default();
+    let mut block_orders = crate::plan::skip_order::BlockOrders::default();
     let mut segments: Vec<PlanSegment> = Vec::new();
     let push = |segments: &mut Vec<PlanSegment>, kind, direction, cell, points: Vec<Vec2>| {
         if points.len() >= 2 {
@@ -709,6 +710,7 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
                     p,
                     &tp,
                     &mut cache,
+                    &mut block_orders,
                     &clear,
                     &mut segments,
                     &mut at,
