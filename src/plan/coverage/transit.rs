@@ -258,9 +258,16 @@ struct EdgeTable {
     /// Length of each edge's shortest word, m; infinite where the edge arrives against its
     /// direction (see [`arrival_headings`]) or has no word.
     shortest: Vec<f64>,
+    /// Per (di, dj, ha): the heading indices hb (bit hb) of the edges with a word.
+    to_mask: Vec<u8>,
+    /// Per (di, dj, hb): the heading indices ha (bit ha) of the edges with a word.
+    from_mask: Vec<u8>,
+    /// Searches made on the grid: the number of the current one (see `checked`).
+    searches: u32,
     /// Edges between nodes whose points were checked, by every search on the grid (they are
     /// the same curves checked by the same test): (state, state) → the first clear word and
-    /// its length, `None` when none is clear. (Plans of many transits search the same ground
+    /// its length, `None` when none is clear, and the number of the last search that checked
+    /// or used it (one map serves the search's own record and the grid's). (Plans of many transits search the same ground
     /// again: a third to half of the edges a search checks were checked before.)
     checked: CheckedEdges,
 }
@@ -285,6 +292,8 @@ impl EdgeTable {
         self.checked.clear();
         self.slots = vec![None; n];
         self.shortest = vec![f64::INFINITY; n];
+        self.to_mask = vec![0; EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS];
+        self.from_mask = vec![0; EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS];
         for di in -EDGE_REACH..=EDGE_REACH {
             for dj in -EDGE_REACH..=EDGE_REACH {
                 let to = Vec2::new(di as f64 * grid_step, dj as f64 * grid_step);
@@ -293,7 +302,11 @@ impl EdgeTable {
                     for hb in arrival_headings(to, from) {
                         let (h1, h2) = (graph_heading(ha), graph_heading(hb));
                         if let Some(l) = csc_length(Vec2::new(0.0, 0.0), h1, to, h2, r) {
-                            self.shortest[Self::slot((di, dj), ha, hb)] = l;
+                            let slot = Self::slot((di, dj), ha, hb);
+                            self.shortest[slot] = l;
+                            let cell = slot / (GRAPH_HEADINGS * GRAPH_HEADINGS);
+                            self.to_mask[cell * GRAPH_HEADINGS + ha] |= 1 << hb;
+                            self.from_mask[cell * GRAPH_HEADINGS + hb] |= 1 << ha;
                         }
                     }
                 }
@@ -531,8 +544,11 @@ pub fn route_graph(
     // Edges whose points were checked: (parent, state) → (word, length); `None` when no word
     // is clear. When a state's best offer turns out blocked or longer than queued, the offers
     // of its expanded neighbours that were not queued are queued then, at their known lengths.
+    // (The start's edges here; the others in the grid's map, marked with this search.)
     let mut checked = CheckedEdges::default();
     let mut from_start = vec![false; states];
+    // Per node: its expanded headings (bit per heading index).
+    let mut done_at = vec![0u8; grid.usable.len()];
     let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::new();
     // Queue the start's neighbours with their shortest words' lengths.
     for (k, q) in grid.near(&p1, reach) {
@@ -554,51 +570,61 @@ pub fn route_graph(
             }
         }
     }
-    // The shortest word of every edge (a copy: the words are solved on first need meanwhile).
-    let table: Vec<f64> = {
+    // The shortest word of every edge and the masks of those with a word (copies: the words
+    // are solved on first need meanwhile), and this search's number.
+    let (table, to_mask, from_mask, search) = {
         let mut t = grid.edges.borrow_mut();
         t.prepare(r, step, grid.step);
-        t.shortest.clone()
+        t.searches = t.searches.wrapping_add(1);
+        let masks = (t.to_mask.clone(), t.from_mask.clone());
+        (t.shortest.clone(), masks.0, masks.1, t.searches)
     };
+    // The cell of a displacement (di, dj) in the table's layout.
+    let span_cell =
+        |di: i64, dj: i64| (di + EDGE_REACH) as usize * EDGE_SPAN + (dj + EDGE_REACH) as usize;
     let mut expansions = 0;
     while let Some((Reverse(queued), s, from)) = heap.pop() {
         let s = s as usize;
         if done[s] {
             continue;
         }
-        // The edge's first clear word, checked once.
-        let (known, fresh) = match checked.get(&(from, s as u32)) {
-            Some(k) => (*k, false),
-            None => {
-                let earlier = if from == START {
+        // The edge's first clear word, checked once (`fresh`: first in this search).
+        let edge = (from, s as u32);
+        let (known, fresh) = if from == START {
+            match checked.get(&edge) {
+                Some(k) => (k.0, false),
+                None => {
                     // The start's curves, solved here: each word's points made only as far as
                     // its first one that is not clear (the same points and test as its word).
                     let (q, h) = pose(s);
-                    Some(
-                        words_by_length(p1, h1, q, h, r)
-                            .iter()
-                            .enumerate()
-                            .find(|(_, c)| c.points(step, clear).is_some())
-                            .map(|(w, c)| (w as u8, c.length)),
-                    )
-                } else {
-                    grid.edges.borrow().checked.get(&(from, s as u32)).copied()
-                };
-                let k = earlier.unwrap_or_else(|| {
-                    let (base, words) = words_of(from, s);
-                    let k = words
+                    let k = words_by_length(p1, h1, q, h, r)
                         .iter()
                         .enumerate()
-                        .find(|(_, w)| all_clear(&w.pts, base, clear))
-                        .map(|(w, found)| (w as u8, found.length));
-                    if from != START {
-                        grid.edges.borrow_mut().checked.insert((from, s as u32), k);
-                    }
-                    k
-                });
-                checked.insert((from, s as u32), k);
-                (k, true)
+                        .find(|(_, c)| c.points(step, clear).is_some())
+                        .map(|(w, c)| (w as u8, c.length));
+                    checked.insert(edge, (k, search));
+                    (k, true)
+                }
             }
+        } else {
+            let earlier = match grid.edges.borrow_mut().checked.get_mut(&edge) {
+                Some((k, n)) if *n == search => Some((*k, false)),
+                Some((k, n)) => {
+                    *n = search;
+                    Some((*k, true))
+                }
+                None => None,
+            };
+            earlier.unwrap_or_else(|| {
+                let (base, words) = words_of(from, s);
+                let k = words
+                    .iter()
+                    .enumerate()
+                    .find(|(_, w)| all_clear(&w.pts, base, clear))
+                    .map(|(w, found)| (w as u8, found.length));
+                grid.edges.borrow_mut().checked.insert(edge, (k, search));
+                (k, true)
+            })
         };
         let h_s = HEURISTIC_WEIGHT * to_goal[s / H];
         let g_from = if from == START {
@@ -614,6 +640,7 @@ pub fn route_graph(
                 requeue = Some(f);
             } else {
                 done[s] = true;
+                done_at[s / H] |= 1 << (s % H);
                 cost[s] = g_from + length;
                 parent[s] = from;
                 word[s] = w;
@@ -641,8 +668,8 @@ pub fn route_graph(
             };
             if from_start[s] && from != START {
                 match checked.get(&(START, s as u32)) {
-                    Some(Some((_, l))) => offer(START, *l, &mut heap),
-                    Some(None) => {}
+                    Some((Some((_, l)), _)) => offer(START, *l, &mut heap),
+                    Some((None, _)) => {}
                     None => {
                         let (q, h) = pose(s);
                         if let Some(l) = csc_length(p1, h1, q, h, r) {
@@ -652,25 +679,28 @@ pub fn route_graph(
                 }
             }
             let (si, sj) = cell(s);
+            let edges = grid.edges.borrow();
             for di in -EDGE_REACH..=EDGE_REACH {
                 for dj in -EDGE_REACH..=EDGE_REACH {
                     let Some(k) = grid.index(si as i64 - di, sj as i64 - dj) else {
                         continue;
                     };
-                    for ha in 0..H {
+                    // The expanded headings there with an edge (with a word) to this state,
+                    // in heading order. (An edge with no word was never queued, so never
+                    // checked.)
+                    let mut has = done_at[k] & from_mask[span_cell(di, dj) * H + s % H];
+                    while has != 0 {
+                        let ha = has.trailing_zeros() as usize;
+                        has &= has - 1;
                         let q = k * H + ha;
-                        if !done[q] || q as u32 == from {
+                        if q as u32 == from {
                             continue;
                         }
-                        // (An edge with no word was never queued, so never checked.)
                         let shortest = table[EdgeTable::slot((di, dj), ha, s % H)];
-                        if !shortest.is_finite() {
-                            continue;
-                        }
-                        let length = match checked.get(&(q as u32, s as u32)) {
-                            Some(Some((_, l))) => *l,
-                            Some(None) => continue,
-                            None => shortest,
+                        let length = match edges.checked.get(&(q as u32, s as u32)) {
+                            Some((Some((_, l)), n)) if *n == search => *l,
+                            Some((None, n)) if *n == search => continue,
+                            _ => shortest,
                         };
                         if length.is_finite() {
                             offer(q as u32, length, &mut heap);
@@ -725,10 +755,14 @@ pub fn route_graph(
                     continue;
                 }
                 let h_to_go = HEURISTIC_WEIGHT * to_goal[k];
-                for hk in 0..H {
+                // The headings there with an edge (with a word) from this state, in order.
+                let mut has = to_mask[span_cell(di, dj) * H + s % H];
+                while has != 0 {
+                    let hk = has.trailing_zeros() as usize;
+                    has &= has - 1;
                     let next = k * H + hk;
                     let length = table[EdgeTable::slot((di, dj), s % H, hk)];
-                    if length.is_finite() && !done[next] && !is_dead(next) {
+                    if !done[next] && !is_dead(next) {
                         let f = key(g + length + h_to_go);
                         if f < best[next] {
                             best[next] = f;
