@@ -3,13 +3,16 @@
 //! obstacles, so every transit is driveable forward (curvature ≤ 1/r_min).
 
 use super::closed::{CheckedEdges, ClosedSets};
+use super::edges::{
+    arrival_headings, graph_heading, EdgeTable, EdgeWord, EDGE_REACH, EDGE_SPAN, GRAPH_HEADINGS,
+};
 use crate::geo::{heading_vec, left_normal, wrap_angle, Vec2};
 use std::cell::RefCell;
 use std::f64::consts::TAU;
 use std::rc::Rc;
 
 /// One Dubins CSC curve: arc about `c1`, straight from `t1` along `theta`, arc about `c2`.
-struct Csc {
+pub(super) struct Csc {
     c1: Vec2,
     c2: Vec2,
     h1: f64,
@@ -22,7 +25,7 @@ struct Csc {
     /// Lengths of the first arc and of the straight, and the whole length, m.
     l1: f64,
     straight: f64,
-    length: f64,
+    pub(super) length: f64,
     r: f64,
     /// The goal (the last point, exactly).
     p2: Vec2,
@@ -116,7 +119,7 @@ impl Csc {
     /// three-point curvature never reads more than 1/r, even across the joins of the pieces.
     /// `None` when `clear` fails at a point: every [`CHECK_STRIDE`]th point is checked first
     /// (a blocked curve is blocked along a stretch, found after a few checks), then the rest.
-    fn points(&self, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> Option<Vec<Vec2>> {
+    pub(super) fn points(&self, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> Option<Vec<Vec2>> {
         let n = (self.length / step).ceil().max(1.0) as usize;
         let coarse = |k: usize| k % CHECK_STRIDE == CHECK_STRIDE / 2;
         if !(CHECK_STRIDE / 2..=n)
@@ -168,7 +171,7 @@ fn words(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> impl Iterator<Item = C
 
 /// The CSC curves from (`p1`, `h1`) to (`p2`, `h2`) with radius `r` that have a solution,
 /// shortest first.
-fn words_by_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Vec<Csc> {
+pub(super) fn words_by_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Vec<Csc> {
     let mut words: Vec<Csc> = words(p1, h1, p2, h2, r).collect();
     words.sort_by(|a, b| a.length.total_cmp(&b.length));
     words
@@ -221,98 +224,6 @@ pub struct WaypointGrid<'a> {
     edges: RefCell<EdgeTable>,
     /// The states of the searches that failed with nothing left to expand.
     closed: RefCell<ClosedSets>,
-}
-
-/// One CSC word of an edge between grid nodes: its length (m) and its points relative to the
-/// edge's first node.
-#[derive(Debug, Clone)]
-struct EdgeWord {
-    length: f64,
-    pts: Vec<Vec2>,
-}
-
-impl EdgeWord {
-    /// The word of `curve`, points about `step` m apart.
-    fn of(curve: &Csc, step: f64) -> Option<Self> {
-        Some(EdgeWord {
-            length: curve.length,
-            pts: curve.points(step, &|_| true)?,
-        })
-    }
-}
-
-/// Nodes an edge of the waypoint graph may join: up to this many grid steps apart each way.
-const EDGE_REACH: i64 = 2;
-const EDGE_SPAN: usize = (2 * EDGE_REACH + 1) as usize;
-
-/// The CSC words of every edge of the waypoint graph, solved once in the grid's frame: the
-/// curve from a node with heading index `ha` to the node (`di`, `dj`) steps away with heading
-/// index `hb` has the same shape wherever the node lies (Fields2Cover solves its turns once in
-/// a canonical frame the same way), so the search only translates the points and checks them.
-#[derive(Debug, Clone, Default)]
-struct EdgeTable {
-    /// (r_min, point spacing) the table was solved for, as bits.
-    key: (u64, u64),
-    /// Words shortest first per (di, dj, ha, hb); `None` until first needed.
-    slots: Vec<Option<Rc<[EdgeWord]>>>,
-    /// Length of each edge's shortest word, m; infinite where the edge arrives against its
-    /// direction (see [`arrival_headings`]) or has no word.
-    shortest: Vec<f64>,
-    /// Per (di, dj, ha): the heading indices hb (bit hb) of the edges with a word.
-    to_mask: Vec<u8>,
-    /// Per (di, dj, hb): the heading indices ha (bit ha) of the edges with a word.
-    from_mask: Vec<u8>,
-    /// Searches made on the grid: the number of the current one (see `checked`).
-    searches: u32,
-    /// Edges between nodes whose points were checked, by every search on the grid (they are
-    /// the same curves checked by the same test): (state, state) → the first clear word and
-    /// its length, `None` when none is clear, and the number of the last search that checked
-    /// or used it (one map serves the search's own record and the grid's). (Plans of many transits search the same ground
-    /// again: a third to half of the edges a search checks were checked before.)
-    checked: CheckedEdges,
-}
-
-impl EdgeTable {
-    /// The table's slot of the edge from heading index `ha` to the node `d` steps away with
-    /// heading index `hb`.
-    fn slot(d: (i64, i64), ha: usize, hb: usize) -> usize {
-        let cell = (d.0 + EDGE_REACH) as usize * EDGE_SPAN + (d.1 + EDGE_REACH) as usize;
-        (cell * GRAPH_HEADINGS + ha) * GRAPH_HEADINGS + hb
-    }
-
-    /// Ready for radius `r`, point spacing `step` and grid spacing `grid_step`: the shortest
-    /// lengths solved, the words emptied.
-    fn prepare(&mut self, r: f64, step: f64, grid_step: f64) {
-        let key = (r.to_bits(), step.to_bits());
-        if self.key == key && !self.slots.is_empty() {
-            return;
-        }
-        let n = EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS * GRAPH_HEADINGS;
-        self.key = key;
-        self.checked.clear();
-        self.slots = vec![None; n];
-        self.shortest = vec![f64::INFINITY; n];
-        self.to_mask = vec![0; EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS];
-        self.from_mask = vec![0; EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS];
-        for di in -EDGE_REACH..=EDGE_REACH {
-            for dj in -EDGE_REACH..=EDGE_REACH {
-                let to = Vec2::new(di as f64 * grid_step, dj as f64 * grid_step);
-                for ha in 0..GRAPH_HEADINGS {
-                    let from = (di == 0 && dj == 0).then_some(ha);
-                    for hb in arrival_headings(to, from) {
-                        let (h1, h2) = (graph_heading(ha), graph_heading(hb));
-                        if let Some(l) = csc_length(Vec2::new(0.0, 0.0), h1, to, h2, r) {
-                            let slot = Self::slot((di, dj), ha, hb);
-                            self.shortest[slot] = l;
-                            let cell = slot / (GRAPH_HEADINGS * GRAPH_HEADINGS);
-                            self.to_mask[cell * GRAPH_HEADINGS + ha] |= 1 << hb;
-                            self.from_mask[cell * GRAPH_HEADINGS + hb] |= 1 << ha;
-                        }
-                    }
-                }
-            }
-        }
-    }
 }
 
 impl<'a> WaypointGrid<'a> {
@@ -443,26 +354,6 @@ impl<'a> WaypointGrid<'a> {
 /// Weight of the distance to go (through the grid) in the search's priority (> 1: fewer
 /// states expanded, a transit at most about this factor longer than the best).
 const HEURISTIC_WEIGHT: f64 = 1.5;
-
-/// Headings tried at every waypoint.
-const GRAPH_HEADINGS: usize = 8;
-
-/// Heading of heading index `k` of the waypoint graph, rad.
-fn graph_heading(k: usize) -> f64 {
-    k as f64 * TAU / GRAPH_HEADINGS as f64
-}
-
-/// Heading indices an edge along `dir` may arrive with: roughly along the way there (all but
-/// `from` when the edge starts and ends at one node).
-fn arrival_headings(dir: Vec2, from: Option<usize>) -> impl Iterator<Item = usize> {
-    (0..GRAPH_HEADINGS).filter(move |&hk| {
-        if dir.norm() > 1e-9 {
-            wrap_angle(graph_heading(hk) - dir.y.atan2(dir.x)).abs() <= 0.8
-        } else {
-            Some(hk) != from
-        }
-    })
-}
 
 /// A clear transit through several waypoints: A* over (waypoint, heading) states joined by
 /// clear CSC curves to the waypoints within two grid steps, from the start pose to the goal
