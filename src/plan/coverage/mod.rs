@@ -346,6 +346,8 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
     // previous work segment's end and the target's start pulled back together (a swath that
     // ends at an obstacle leaves no room to turn), metre by metre; else through a waypoint.
     // Returns how many points were cut from the start of `target`.
+    // Has a relaxed headland attempt found no way (see `loose_headland` below)?
+    let loose_failed = &mut false;
     let mut go_to = |segments: &mut Vec<PlanSegment>,
                      at: &mut Option<(Vec2, f64)>,
                      target: &[Vec2],
@@ -407,8 +409,11 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
         ]);
         let mut found = None;
         // The relaxed headland attempt without shortening, made first (once) where the tests
-        // differ: its test passes every point the strict one passes, on the same rings,
-        // candidates and joins, so when it finds no way the strict attempt finds none either.
+        // differ and one of this plan's relaxed headland attempts found no way before: its
+        // test passes every point the strict one passes, on the same rings, candidates and
+        // joins, so when it finds no way the strict attempt finds none either. (Made first in
+        // every plan, it cost the plans whose strict attempts succeed as much as it saved the
+        // narrow fields whose attempts all fail.)
         let mut loose_headland: Option<Option<Vec<Vec2>>> = None;
         for (t, way, relaxed) in attempts {
             let (cp, cn, f, hf, q, hq) = poses(t);
@@ -424,9 +429,10 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
             let pts = match way {
                 Way::Direct => transit::transit(f, hf, q, hq, r, step, ok)
                     .and_then(|(pts, ok)| ok.then_some(pts)),
-                Way::Headland if t == 0 && !one_test => {
+                Way::Headland if t == 0 && !one_test && (relaxed || *loose_failed) => {
                     let loose_way = loose_headland
                         .get_or_insert_with(|| rings.transit(f, hf, q, hq, r, step, &loose));
+                    *loose_failed |= loose_way.is_none();
                     if relaxed {
                         loose_way.take()
                     } else if loose_way.is_none() {
