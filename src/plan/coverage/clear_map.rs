@@ -38,9 +38,21 @@ const NEAR: u32 = 3;
 /// Cells per side of a block, whose edges within reach are found once for all its cells.
 const BLOCK: usize = 8;
 
-/// The edges of the rings within reach of one block of cells, in ring order and edge order
-/// within a ring: (ring: 0 the boundary, k obstacle k − 1; a; b).
-type BlockEdges = std::rc::Rc<[(usize, Vec2, Vec2)]>;
+/// What one block of cells knows of the rings, found once for all its cells.
+#[derive(Debug)]
+struct Block {
+    /// The edges of the rings within reach of the block, in ring order and edge order within
+    /// a ring: (ring: 0 the boundary, k obstacle k − 1; a; b).
+    edges: Vec<(usize, Vec2, Vec2)>,
+    /// Per ring with no edge within reach: whether the block's centre is inside it, and so
+    /// every point of the block's cells and of their discs (no edge of the ring comes near
+    /// them, so none lies between them and the centre); `None` for the rings with edges
+    /// within reach. (Asked per cell, the even-odd test ran over every vertex of the field:
+    /// a third of the cost of the points checked.)
+    inside: Vec<Option<bool>>,
+}
+
+type BlockEdges = std::rc::Rc<Block>;
 
 /// [`implement_clear`] of one field and half width through a grid of cells.
 pub(super) struct ClearMap<'a> {
@@ -52,7 +64,8 @@ pub(super) struct ClearMap<'a> {
     ny: usize,
     state: RefCell<Vec<u32>>,
     locals: RefCell<Vec<Local>>,
-    /// Per block (row-major, `nx.div_ceil(BLOCK)` a row): its edges, `None` until first needed.
+    /// Per block (row-major, `nx.div_ceil(BLOCK)` a row): its edges and the rings it lies
+    /// inside, `None` until first needed.
     blocks: RefCell<Vec<Option<BlockEdges>>>,
 }
 
@@ -84,10 +97,13 @@ impl<'a> ClearMap<'a> {
     pub(super) fn clear(&self, q: &Vec2) -> bool {
         let x = (q.x - self.origin.x) / self.cell;
         let y = (q.y - self.origin.y) / self.cell;
-        // Off the grid (or not a number): checked directly. On it, the cast truncates a
-        // non-negative coordinate, as `floor` would (without the libm call per point).
+        // Off the grid (or not a number): outside the boundary's bounding box (the grid covers
+        // it with a cell to spare), so outside the field. (Asked of the boundary's every edge,
+        // the points of curves that swing out past the field's edge cost as much as the rest.)
+        // On it, the cast truncates a non-negative coordinate, as `floor` would (without the
+        // libm call per point).
         if !(x >= 0.0 && y >= 0.0 && (x as usize) < self.nx && (y as usize) < self.ny) {
-            return implement_clear(self.field, self.half, q);
+            return false;
         }
         let (i, j) = (x as usize, y as usize);
         let k = j * self.nx + i;
@@ -129,25 +145,38 @@ impl<'a> ClearMap<'a> {
         let within = self.half + half_block * std::f64::consts::SQRT_2 + 1e-3;
         let rings = std::iter::once(&self.field.boundary).chain(self.field.obstacles.iter());
         let mut edges = Vec::new();
+        let mut inside = Vec::new();
         for (r, ring) in rings.enumerate() {
             let n = ring.len();
+            let before = edges.len();
             for e in 0..n {
                 let (a, b) = (ring[e], ring[(e + 1) % n]);
                 if point_segment_distance(&centre, &a, &b) <= within {
                     edges.push((r, a, b));
                 }
             }
+            inside.push((edges.len() == before).then(|| contains_point(ring, &centre)));
         }
-        let edges: BlockEdges = edges.into();
+        let edges: BlockEdges = std::rc::Rc::new(Block { edges, inside });
         if let Some(slot) = self.blocks.borrow_mut().get_mut(k) {
             *slot = Some(edges.clone());
         }
         edges
     }
 
-    /// The state of the cell about `centre`, whose block's edges are `block`
+    /// The state of the cell about `centre`, whose block is `block`
     /// ([`Self::block_edges`]).
-    fn classify(&self, centre: Vec2, block: &[(usize, Vec2, Vec2)]) -> u32 {
+    fn classify(&self, centre: Vec2, block: &Block) -> u32 {
+        // Is `p` (of the cell's disc) inside ring `r`: the block's answer where it has one.
+        let inside_of = |r: usize, ring: &[Vec2], p: &Vec2| {
+            block
+                .inside
+                .get(r)
+                .copied()
+                .flatten()
+                .unwrap_or_else(|| contains_point(ring, p))
+        };
+        let block = &block.edges;
         // Every point of the cell lies within `reach` of its centre.
         let reach = self.cell * std::f64::consts::FRAC_1_SQRT_2;
         // implement_clear(field, half + reach, centre); the edges off the block's list are
@@ -156,12 +185,13 @@ impl<'a> ClearMap<'a> {
             .iter()
             .all(|(_, a, b)| point_segment_distance(&centre, a, b) >= self.half + reach - 1e-6);
         if clear_of_edges
-            && contains_point(&self.field.boundary, &centre)
+            && inside_of(0, &self.field.boundary, &centre)
             && self
                 .field
                 .obstacles
                 .iter()
-                .all(|o| !contains_point(o, &centre))
+                .enumerate()
+                .all(|(k, o)| !inside_of(k + 1, o, &centre))
         {
             return CLEAR;
         }
@@ -214,7 +244,7 @@ impl<'a> ClearMap<'a> {
             });
         };
         let free_of = |r: usize, ring: &Vec<Vec2>| {
-            let inside = contains_point(ring, &reference);
+            let inside = inside_of(r, ring, &reference);
             if r == 0 {
                 inside
             } else {

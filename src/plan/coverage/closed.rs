@@ -15,9 +15,10 @@ use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
 /// Edges of the waypoint search whose points were checked: (parent, state) → the first clear
-/// word and its length, `None` when none is clear.
+/// word and its length, `None` when none is clear; and the number of the last search on the
+/// grid that checked or used it.
 pub(super) type CheckedEdges =
-    HashMap<(u32, u32), Option<(u8, f64)>, BuildHasherDefault<EdgeHasher>>;
+    HashMap<(u32, u32), (Option<(u8, f64)>, u32), BuildHasherDefault<EdgeHasher>>;
 
 /// Hasher of the search's edge keys (two state indices): one multiply-rotate per word, where
 /// the standard SipHash cost as much as the lookups it served.

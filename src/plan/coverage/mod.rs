@@ -9,6 +9,7 @@ pub mod bypass;
 mod clear_map;
 mod closed;
 pub mod decompose;
+mod edges;
 pub mod geometry;
 pub mod headland;
 pub mod metrics;
@@ -234,18 +235,18 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
     );
     let working = headland::working_area(&field.boundary, &large, p);
     // Points are checked; the chords between them may cut a little inside the arcs.
-    let clear_map = ClearMap::new(
-        field,
-        half + headland::chord_margin(p) - headland::CHORD_MARGIN,
-    );
+    let strict_half = half + headland::chord_margin(p) - headland::CHORD_MARGIN;
+    let clear_map = ClearMap::new(field, strict_half);
     let clear = |q: &Vec2| clear_map.clear(q);
     // Transits that find no way with the implement clear of the edge keep the tractor inside
     // the field and off the obstacles (the guarantee for paths that do not work).
-    let loose_map = ClearMap::new(
-        field,
-        half.min(TRANSIT_CLEARANCE_M) + headland::chord_margin(p) - headland::CHORD_MARGIN,
-    );
-    let loose = |q: &Vec2| loose_map.clear(q);
+    // With an implement no wider than the tractor's clearance the two tests are one (w ≤ 3 m):
+    // one map then, and the relaxed attempts that would repeat the strict ones are skipped.
+    let loose_half =
+        half.min(TRANSIT_CLEARANCE_M) + headland::chord_margin(p) - headland::CHORD_MARGIN;
+    let one_test = loose_half == strict_half;
+    let loose_map = (!one_test).then(|| ClearMap::new(field, loose_half));
+    let loose = |q: &Vec2| loose_map.as_ref().unwrap_or(&clear_map).clear(q);
     // Waypoints for detours and transits that cannot go direct: grids of clear points over
     // the field, each with the test of its curves. (Built on first need: most plans never
     // need them.)
@@ -259,6 +260,9 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
     };
     let loose_grid = std::cell::OnceCell::new();
     let loose_grid = || {
+        if one_test {
+            return waypoint_grid();
+        }
         loose_grid
             .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, &loose))
     };
@@ -322,6 +326,7 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
 
     let tp = p.turn_params();
     let mut cache = crate::plan::turns::TurnCache::default();
+    let mut block_orders = crate::plan::skip_order::BlockOrders::default();
     let mut segments: Vec<PlanSegment> = Vec::new();
     let push = |segments: &mut Vec<PlanSegment>, kind, direction, cell, points: Vec<Vec2>| {
         if points.len() >= 2 {
@@ -341,6 +346,8 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
     // previous work segment's end and the target's start pulled back together (a swath that
     // ends at an obstacle leaves no room to turn), metre by metre; else through a waypoint.
     // Returns how many points were cut from the start of `target`.
+    // Has a relaxed headland attempt found no way (see `loose_headland` below)?
+    let loose_failed = &mut false;
     let mut go_to = |segments: &mut Vec<PlanSegment>,
                      at: &mut Option<(Vec2, f64)>,
                      target: &[Vec2],
@@ -401,9 +408,20 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
             (0, Way::Waypoints, true),
         ]);
         let mut found = None;
+        // The relaxed headland attempt without shortening, made first (once) where the tests
+        // differ and one of this plan's relaxed headland attempts found no way before: its
+        // test passes every point the strict one passes, on the same rings, candidates and
+        // joins, so when it finds no way the strict attempt finds none either. (Made first in
+        // every plan, it cost the plans whose strict attempts succeed as much as it saved the
+        // narrow fields whose attempts all fail.)
+        let mut loose_headland: Option<Option<Vec<Vec2>>> = None;
         for (t, way, relaxed) in attempts {
             let (cp, cn, f, hf, q, hq) = poses(t);
             if t > 0 && cp == 0 && cn == 0 {
+                continue;
+            }
+            if relaxed && one_test && t == 0 && !matches!(way, Way::Waypoints) {
+                // The strict attempt with the same poses and test found nothing.
                 continue;
             }
             let (r, step) = (p.r_min, p.point_spacing);
@@ -411,6 +429,18 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
             let pts = match way {
                 Way::Direct => transit::transit(f, hf, q, hq, r, step, ok)
                     .and_then(|(pts, ok)| ok.then_some(pts)),
+                Way::Headland if t == 0 && !one_test && (relaxed || *loose_failed) => {
+                    let loose_way = loose_headland
+                        .get_or_insert_with(|| rings.transit(f, hf, q, hq, r, step, &loose));
+                    *loose_failed |= loose_way.is_none();
+                    if relaxed {
+                        loose_way.take()
+                    } else if loose_way.is_none() {
+                        None
+                    } else {
+                        rings.transit(f, hf, q, hq, r, step, ok)
+                    }
+                }
                 Way::Headland => rings.transit(f, hf, q, hq, r, step, ok),
                 // (Only relaxed: the loose grid's test is `ok`.)
                 Way::Waypoints => {
@@ -687,6 +717,7 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
                     p,
                     &tp,
                     &mut cache,
+                    &mut block_orders,
                     &clear,
                     &mut segments,
                     &mut at,

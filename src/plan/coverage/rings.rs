@@ -6,7 +6,9 @@
 //! a few Dubins curves where the waypoint search of [`super::transit::route_graph`] costs
 //! thousands.
 
-use super::transit::{csc_length, transit};
+#[cfg(test)]
+use super::transit::transit;
+use super::transit::{words_by_length, Csc};
 use crate::geo::{vec_heading, Vec2};
 
 /// Points of a ring tried as the place to turn onto it (or off it), at most.
@@ -170,18 +172,29 @@ impl Rings {
                 continue;
             }
             for dir in [1, -1] {
-                let ins: Vec<(usize, f64)> = entries
+                // The curves on at each entry and off at each exit, shortest first (solved once:
+                // their lengths bound the joins, then the joins verified check their points).
+                let curves = |a: (Vec2, f64), b: (Vec2, f64)| {
+                    let words = words_by_length(a.0, a.1, b.0, b.1, r);
+                    let length = words.first().map(|c| c.length);
+                    length.map(|l| (l, words))
+                };
+                let on: Vec<(usize, (f64, Vec<Csc>))> = entries
                     .iter()
                     .filter_map(|&i| {
-                        csc_length(p1, h1, ring.pts[i], ring.heading(i, dir), r).map(|l| (i, l))
+                        Some((i, curves((p1, h1), (ring.pts[i], ring.heading(i, dir)))?))
                     })
                     .collect();
-                let outs: Vec<(usize, f64)> = exits
+                let off: Vec<(usize, (f64, Vec<Csc>))> = exits
                     .iter()
                     .filter_map(|&j| {
-                        csc_length(ring.pts[j], ring.heading(j, dir), p2, h2, r).map(|l| (j, l))
+                        Some((j, curves((ring.pts[j], ring.heading(j, dir)), (p2, h2))?))
                     })
                     .collect();
+                let ins: Vec<(usize, f64)> = on.iter().map(|(i, c)| (*i, c.0)).collect();
+                let outs: Vec<(usize, f64)> = off.iter().map(|(j, c)| (*j, c.0)).collect();
+                // The first curve whose points are all clear ([`transit`] of the same poses).
+                let first_clear = |words: &[Csc]| words.iter().find_map(|c| c.points(step, clear));
                 // Every join costs at least the shortest way on plus the shortest way off.
                 let least =
                     |v: &[(usize, f64)]| v.iter().map(|e| e.1).fold(f64::INFINITY, f64::min);
@@ -220,16 +233,17 @@ impl Rings {
                     let a = curve_in
                         .entry(i)
                         .or_insert_with(|| {
-                            transit(p1, h1, ring.pts[i], ring.heading(i, dir), r, step, clear)
-                                .and_then(|(pts, ok)| ok.then_some(pts))
+                            // (The entries and exits are in ring order.)
+                            let k = on.binary_search_by_key(&i, |e| e.0).ok()?;
+                            first_clear(&on[k].1 .1)
                         })
                         .clone();
                     let Some(a) = a else { continue };
                     let b = curve_out
                         .entry(j)
                         .or_insert_with(|| {
-                            transit(ring.pts[j], ring.heading(j, dir), p2, h2, r, step, clear)
-                                .and_then(|(pts, ok)| ok.then_some(pts))
+                            let k = off.binary_search_by_key(&j, |e| e.0).ok()?;
+                            first_clear(&off[k].1 .1)
                         })
                         .clone();
                     let Some(b) = b else { continue };

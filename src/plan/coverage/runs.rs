@@ -5,6 +5,7 @@
 
 use super::{swaths, transit, CoverageParams, PlanSegment, RouteOrder, SegmentKind};
 use crate::geo::{v2, vec_heading, wrap_angle, Direction, Vec2};
+use crate::plan::skip_order::BlockOrders;
 use crate::plan::types::PlanError;
 
 /// Appends a transit from the vehicle's pose to the start of a path: (segments, pose, path,
@@ -107,12 +108,12 @@ fn split_for_detours(
 /// spacing allows a U-turn (or the operator chose sequential lines, with fishtails); otherwise
 /// the seed-000 block skip order ([`crate::plan::skip_order`], blocks of `2·min_gap + 1`), so no
 /// turn is tighter than 2·r_min.
-fn run_order(n: usize, spacing: f64, p: &CoverageParams) -> Vec<usize> {
-    use crate::plan::skip_order::{min_gap_lines, skip_order};
+fn run_order(n: usize, spacing: f64, p: &CoverageParams, orders: &mut BlockOrders) -> Vec<usize> {
+    use crate::plan::skip_order::{min_gap_lines, skip_order_with};
     if p.route == RouteOrder::Sequential {
         return (0..n).collect();
     }
-    skip_order(n, min_gap_lines(p.r_min, spacing), 1)
+    skip_order_with(n, min_gap_lines(p.r_min, spacing), 1, orders)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -124,6 +125,7 @@ pub(super) fn drive_run(
     p: &CoverageParams,
     tp: &crate::plan::turns::TurnParams,
     cache: &mut crate::plan::turns::TurnCache,
+    orders: &mut BlockOrders,
     clear: &dyn Fn(&Vec2) -> bool,
     segments: &mut Vec<PlanSegment>,
     at: &mut Option<(Vec2, f64)>,
@@ -131,7 +133,7 @@ pub(super) fn drive_run(
     detour: &Detour<'_>,
     small_discs: &[(Vec2, f64)],
 ) -> Result<(), PlanError> {
-    let order = run_order(run.len(), lines.spacing, p);
+    let order = run_order(run.len(), lines.spacing, p, orders);
     let here = at.map(|a| a.0);
     // Start from the end of the first swath nearest the vehicle.
     let (l0, (a0, b0)) = run[order[0]];

@@ -3,13 +3,16 @@
 //! obstacles, so every transit is driveable forward (curvature ≤ 1/r_min).
 
 use super::closed::{CheckedEdges, ClosedSets};
+use super::edges::{
+    arrival_headings, graph_heading, EdgeTable, EdgeWord, EDGE_REACH, EDGE_SPAN, GRAPH_HEADINGS,
+};
 use crate::geo::{heading_vec, left_normal, wrap_angle, Vec2};
 use std::cell::RefCell;
 use std::f64::consts::TAU;
 use std::rc::Rc;
 
 /// One Dubins CSC curve: arc about `c1`, straight from `t1` along `theta`, arc about `c2`.
-struct Csc {
+pub(super) struct Csc {
     c1: Vec2,
     c2: Vec2,
     h1: f64,
@@ -22,7 +25,7 @@ struct Csc {
     /// Lengths of the first arc and of the straight, and the whole length, m.
     l1: f64,
     straight: f64,
-    length: f64,
+    pub(super) length: f64,
     r: f64,
     /// The goal (the last point, exactly).
     p2: Vec2,
@@ -116,7 +119,7 @@ impl Csc {
     /// three-point curvature never reads more than 1/r, even across the joins of the pieces.
     /// `None` when `clear` fails at a point: every [`CHECK_STRIDE`]th point is checked first
     /// (a blocked curve is blocked along a stretch, found after a few checks), then the rest.
-    fn points(&self, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> Option<Vec<Vec2>> {
+    pub(super) fn points(&self, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> Option<Vec<Vec2>> {
         let n = (self.length / step).ceil().max(1.0) as usize;
         let coarse = |k: usize| k % CHECK_STRIDE == CHECK_STRIDE / 2;
         if !(CHECK_STRIDE / 2..=n)
@@ -168,7 +171,7 @@ fn words(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> impl Iterator<Item = C
 
 /// The CSC curves from (`p1`, `h1`) to (`p2`, `h2`) with radius `r` that have a solution,
 /// shortest first.
-fn words_by_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Vec<Csc> {
+pub(super) fn words_by_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Vec<Csc> {
     let mut words: Vec<Csc> = words(p1, h1, p2, h2, r).collect();
     words.sort_by(|a, b| a.length.total_cmp(&b.length));
     words
@@ -221,85 +224,6 @@ pub struct WaypointGrid<'a> {
     edges: RefCell<EdgeTable>,
     /// The states of the searches that failed with nothing left to expand.
     closed: RefCell<ClosedSets>,
-}
-
-/// One CSC word of an edge between grid nodes: its length (m) and its points relative to the
-/// edge's first node.
-#[derive(Debug, Clone)]
-struct EdgeWord {
-    length: f64,
-    pts: Vec<Vec2>,
-}
-
-impl EdgeWord {
-    /// The word of `curve`, points about `step` m apart.
-    fn of(curve: &Csc, step: f64) -> Option<Self> {
-        Some(EdgeWord {
-            length: curve.length,
-            pts: curve.points(step, &|_| true)?,
-        })
-    }
-}
-
-/// Nodes an edge of the waypoint graph may join: up to this many grid steps apart each way.
-const EDGE_REACH: i64 = 2;
-const EDGE_SPAN: usize = (2 * EDGE_REACH + 1) as usize;
-
-/// The CSC words of every edge of the waypoint graph, solved once in the grid's frame: the
-/// curve from a node with heading index `ha` to the node (`di`, `dj`) steps away with heading
-/// index `hb` has the same shape wherever the node lies (Fields2Cover solves its turns once in
-/// a canonical frame the same way), so the search only translates the points and checks them.
-#[derive(Debug, Clone, Default)]
-struct EdgeTable {
-    /// (r_min, point spacing) the table was solved for, as bits.
-    key: (u64, u64),
-    /// Words shortest first per (di, dj, ha, hb); `None` until first needed.
-    slots: Vec<Option<Rc<[EdgeWord]>>>,
-    /// Length of each edge's shortest word, m; infinite where the edge arrives against its
-    /// direction (see [`arrival_headings`]) or has no word.
-    shortest: Vec<f64>,
-    /// Edges between nodes whose points were checked, by every search on the grid (they are
-    /// the same curves checked by the same test): (state, state) → the first clear word and
-    /// its length, `None` when none is clear. (Plans of many transits search the same ground
-    /// again: a third to half of the edges a search checks were checked before.)
-    checked: CheckedEdges,
-}
-
-impl EdgeTable {
-    /// The table's slot of the edge from heading index `ha` to the node `d` steps away with
-    /// heading index `hb`.
-    fn slot(d: (i64, i64), ha: usize, hb: usize) -> usize {
-        let cell = (d.0 + EDGE_REACH) as usize * EDGE_SPAN + (d.1 + EDGE_REACH) as usize;
-        (cell * GRAPH_HEADINGS + ha) * GRAPH_HEADINGS + hb
-    }
-
-    /// Ready for radius `r`, point spacing `step` and grid spacing `grid_step`: the shortest
-    /// lengths solved, the words emptied.
-    fn prepare(&mut self, r: f64, step: f64, grid_step: f64) {
-        let key = (r.to_bits(), step.to_bits());
-        if self.key == key && !self.slots.is_empty() {
-            return;
-        }
-        let n = EDGE_SPAN * EDGE_SPAN * GRAPH_HEADINGS * GRAPH_HEADINGS;
-        self.key = key;
-        self.checked.clear();
-        self.slots = vec![None; n];
-        self.shortest = vec![f64::INFINITY; n];
-        for di in -EDGE_REACH..=EDGE_REACH {
-            for dj in -EDGE_REACH..=EDGE_REACH {
-                let to = Vec2::new(di as f64 * grid_step, dj as f64 * grid_step);
-                for ha in 0..GRAPH_HEADINGS {
-                    let from = (di == 0 && dj == 0).then_some(ha);
-                    for hb in arrival_headings(to, from) {
-                        let (h1, h2) = (graph_heading(ha), graph_heading(hb));
-                        if let Some(l) = csc_length(Vec2::new(0.0, 0.0), h1, to, h2, r) {
-                            self.shortest[Self::slot((di, dj), ha, hb)] = l;
-                        }
-                    }
-                }
-            }
-        }
-    }
 }
 
 impl<'a> WaypointGrid<'a> {
@@ -431,26 +355,6 @@ impl<'a> WaypointGrid<'a> {
 /// states expanded, a transit at most about this factor longer than the best).
 const HEURISTIC_WEIGHT: f64 = 1.5;
 
-/// Headings tried at every waypoint.
-const GRAPH_HEADINGS: usize = 8;
-
-/// Heading of heading index `k` of the waypoint graph, rad.
-fn graph_heading(k: usize) -> f64 {
-    k as f64 * TAU / GRAPH_HEADINGS as f64
-}
-
-/// Heading indices an edge along `dir` may arrive with: roughly along the way there (all but
-/// `from` when the edge starts and ends at one node).
-fn arrival_headings(dir: Vec2, from: Option<usize>) -> impl Iterator<Item = usize> {
-    (0..GRAPH_HEADINGS).filter(move |&hk| {
-        if dir.norm() > 1e-9 {
-            wrap_angle(graph_heading(hk) - dir.y.atan2(dir.x)).abs() <= 0.8
-        } else {
-            Some(hk) != from
-        }
-    })
-}
-
 /// A clear transit through several waypoints: A* over (waypoint, heading) states joined by
 /// clear CSC curves to the waypoints within two grid steps, from the start pose to the goal
 /// pose, every point clear by the grid's test; at most `max_expansions` states are expanded.
@@ -531,8 +435,11 @@ pub fn route_graph(
     // Edges whose points were checked: (parent, state) → (word, length); `None` when no word
     // is clear. When a state's best offer turns out blocked or longer than queued, the offers
     // of its expanded neighbours that were not queued are queued then, at their known lengths.
+    // (The start's edges here; the others in the grid's map, marked with this search.)
     let mut checked = CheckedEdges::default();
     let mut from_start = vec![false; states];
+    // Per node: its expanded headings (bit per heading index).
+    let mut done_at = vec![0u8; grid.usable.len()];
     let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::new();
     // Queue the start's neighbours with their shortest words' lengths.
     for (k, q) in grid.near(&p1, reach) {
@@ -554,51 +461,61 @@ pub fn route_graph(
             }
         }
     }
-    // The shortest word of every edge (a copy: the words are solved on first need meanwhile).
-    let table: Vec<f64> = {
+    // The shortest word of every edge and the masks of those with a word (copies: the words
+    // are solved on first need meanwhile), and this search's number.
+    let (table, to_mask, from_mask, search) = {
         let mut t = grid.edges.borrow_mut();
         t.prepare(r, step, grid.step);
-        t.shortest.clone()
+        t.searches = t.searches.wrapping_add(1);
+        let masks = (t.to_mask.clone(), t.from_mask.clone());
+        (t.shortest.clone(), masks.0, masks.1, t.searches)
     };
+    // The cell of a displacement (di, dj) in the table's layout.
+    let span_cell =
+        |di: i64, dj: i64| (di + EDGE_REACH) as usize * EDGE_SPAN + (dj + EDGE_REACH) as usize;
     let mut expansions = 0;
     while let Some((Reverse(queued), s, from)) = heap.pop() {
         let s = s as usize;
         if done[s] {
             continue;
         }
-        // The edge's first clear word, checked once.
-        let (known, fresh) = match checked.get(&(from, s as u32)) {
-            Some(k) => (*k, false),
-            None => {
-                let earlier = if from == START {
+        // The edge's first clear word, checked once (`fresh`: first in this search).
+        let edge = (from, s as u32);
+        let (known, fresh) = if from == START {
+            match checked.get(&edge) {
+                Some(k) => (k.0, false),
+                None => {
                     // The start's curves, solved here: each word's points made only as far as
                     // its first one that is not clear (the same points and test as its word).
                     let (q, h) = pose(s);
-                    Some(
-                        words_by_length(p1, h1, q, h, r)
-                            .iter()
-                            .enumerate()
-                            .find(|(_, c)| c.points(step, clear).is_some())
-                            .map(|(w, c)| (w as u8, c.length)),
-                    )
-                } else {
-                    grid.edges.borrow().checked.get(&(from, s as u32)).copied()
-                };
-                let k = earlier.unwrap_or_else(|| {
-                    let (base, words) = words_of(from, s);
-                    let k = words
+                    let k = words_by_length(p1, h1, q, h, r)
                         .iter()
                         .enumerate()
-                        .find(|(_, w)| all_clear(&w.pts, base, clear))
-                        .map(|(w, found)| (w as u8, found.length));
-                    if from != START {
-                        grid.edges.borrow_mut().checked.insert((from, s as u32), k);
-                    }
-                    k
-                });
-                checked.insert((from, s as u32), k);
-                (k, true)
+                        .find(|(_, c)| c.points(step, clear).is_some())
+                        .map(|(w, c)| (w as u8, c.length));
+                    checked.insert(edge, (k, search));
+                    (k, true)
+                }
             }
+        } else {
+            let earlier = match grid.edges.borrow_mut().checked.get_mut(&edge) {
+                Some((k, n)) if *n == search => Some((*k, false)),
+                Some((k, n)) => {
+                    *n = search;
+                    Some((*k, true))
+                }
+                None => None,
+            };
+            earlier.unwrap_or_else(|| {
+                let (base, words) = words_of(from, s);
+                let k = words
+                    .iter()
+                    .enumerate()
+                    .find(|(_, w)| all_clear(&w.pts, base, clear))
+                    .map(|(w, found)| (w as u8, found.length));
+                grid.edges.borrow_mut().checked.insert(edge, (k, search));
+                (k, true)
+            })
         };
         let h_s = HEURISTIC_WEIGHT * to_goal[s / H];
         let g_from = if from == START {
@@ -614,6 +531,7 @@ pub fn route_graph(
                 requeue = Some(f);
             } else {
                 done[s] = true;
+                done_at[s / H] |= 1 << (s % H);
                 cost[s] = g_from + length;
                 parent[s] = from;
                 word[s] = w;
@@ -641,8 +559,8 @@ pub fn route_graph(
             };
             if from_start[s] && from != START {
                 match checked.get(&(START, s as u32)) {
-                    Some(Some((_, l))) => offer(START, *l, &mut heap),
-                    Some(None) => {}
+                    Some((Some((_, l)), _)) => offer(START, *l, &mut heap),
+                    Some((None, _)) => {}
                     None => {
                         let (q, h) = pose(s);
                         if let Some(l) = csc_length(p1, h1, q, h, r) {
@@ -652,25 +570,28 @@ pub fn route_graph(
                 }
             }
             let (si, sj) = cell(s);
+            let edges = grid.edges.borrow();
             for di in -EDGE_REACH..=EDGE_REACH {
                 for dj in -EDGE_REACH..=EDGE_REACH {
                     let Some(k) = grid.index(si as i64 - di, sj as i64 - dj) else {
                         continue;
                     };
-                    for ha in 0..H {
+                    // The expanded headings there with an edge (with a word) to this state,
+                    // in heading order. (An edge with no word was never queued, so never
+                    // checked.)
+                    let mut has = done_at[k] & from_mask[span_cell(di, dj) * H + s % H];
+                    while has != 0 {
+                        let ha = has.trailing_zeros() as usize;
+                        has &= has - 1;
                         let q = k * H + ha;
-                        if !done[q] || q as u32 == from {
+                        if q as u32 == from {
                             continue;
                         }
-                        // (An edge with no word was never queued, so never checked.)
                         let shortest = table[EdgeTable::slot((di, dj), ha, s % H)];
-                        if !shortest.is_finite() {
-                            continue;
-                        }
-                        let length = match checked.get(&(q as u32, s as u32)) {
-                            Some(Some((_, l))) => *l,
-                            Some(None) => continue,
-                            None => shortest,
+                        let length = match edges.checked.get(&(q as u32, s as u32)) {
+                            Some((Some((_, l)), n)) if *n == search => *l,
+                            Some((None, n)) if *n == search => continue,
+                            _ => shortest,
                         };
                         if length.is_finite() {
                             offer(q as u32, length, &mut heap);
@@ -725,10 +646,14 @@ pub fn route_graph(
                     continue;
                 }
                 let h_to_go = HEURISTIC_WEIGHT * to_goal[k];
-                for hk in 0..H {
+                // The headings there with an edge (with a word) from this state, in order.
+                let mut has = to_mask[span_cell(di, dj) * H + s % H];
+                while has != 0 {
+                    let hk = has.trailing_zeros() as usize;
+                    has &= has - 1;
                     let next = k * H + hk;
                     let length = table[EdgeTable::slot((di, dj), s % H, hk)];
-                    if length.is_finite() && !done[next] && !is_dead(next) {
+                    if !done[next] && !is_dead(next) {
                         let f = key(g + length + h_to_go);
                         if f < best[next] {
                             best[next] = f;
