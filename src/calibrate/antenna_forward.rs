@@ -22,7 +22,9 @@
 //! a few tenths of a radian: the drive's holds at ±12° sweep it through radians. (`l` is
 //! fitted too but not reported: on a circle it moves along n(θ) as the track's scale does; the
 //! two-way pass measures it, [`super::antenna`].) The standard deviation is the least-squares
-//! one from the residual scatter.
+//! one from the residual scatter: it sees the receiver's noise, not the tyres' slip at a crawl
+//! nor a correlated receiver error (1–2 cm on such plants where it says 0.1–0.4 cm; README,
+//! Calibration).
 
 use crate::geo::{heading_vec, left_normal, Vec2};
 use nalgebra::{SMatrix, SVector};
@@ -49,57 +51,47 @@ pub struct ForwardFit {
     /// Forward offset of the antenna from the rear axle, m, and its standard deviation.
     pub forward: f64,
     pub sd: f64,
-    /// Residual RMS of the positions, m.
-    pub rms: f64,
-    /// Heading swept over the record, rad.
-    pub sweep: f64,
 }
 
-/// `ys` at `t` on increasing `ts`, linearly (`None` outside).
-fn at(samples: &[(f64, f64)], t: f64) -> Option<f64> {
-    let i = samples.partition_point(|s| s.0 <= t);
-    if i == 0 || i >= samples.len() {
-        return (samples.last().is_some_and(|s| s.0 == t)).then(|| samples[samples.len() - 1].1);
-    }
-    let (a, b) = (samples[i - 1], samples[i]);
-    let span = b.0 - a.0;
-    if span <= 0.0 {
-        return Some(b.1);
-    }
-    Some(a.1 + (b.1 - a.1) * (t - a.0) / span)
+/// Finite samples (time s, value) as times and values, for [`super::interp`].
+struct Series {
+    ts: Vec<f64>,
+    ys: Vec<f64>,
 }
 
-/// Headings unwrapped into a continuous angle.
-fn unwrapped(headings: &[(f64, f64)]) -> Vec<(f64, f64)> {
-    let mut out: Vec<(f64, f64)> = Vec::with_capacity(headings.len());
-    for &(t, h) in headings
-        .iter()
-        .filter(|s| s.0.is_finite() && s.1.is_finite())
-    {
-        let h = match out.last() {
-            Some(&(_, prev)) => prev + crate::geo::wrap_angle(h - prev),
-            None => h,
-        };
-        out.push((t, h));
+impl Series {
+    fn of(samples: &[(f64, f64)]) -> Series {
+        let (ts, ys) = samples
+            .iter()
+            .filter(|s| s.0.is_finite() && s.1.is_finite())
+            .copied()
+            .unzip();
+        Series { ts, ys }
     }
-    out
+
+    /// The value at `t`, linearly (`None` outside the samples).
+    fn at(&self, t: f64) -> Option<f64> {
+        let (first, last) = (self.ts.first()?, self.ts.last()?);
+        (*first <= t && t <= *last).then(|| super::interp(&self.ts, &self.ys, t))
+    }
 }
 
 /// The antenna's forward offset from a drive with turns. Refused with the reason when there
 /// are too few positions, the heading does not turn enough or the fit is singular.
 pub fn fit_antenna_forward(track: &DriveTrack) -> Result<ForwardFit, String> {
-    let headings = unwrapped(&track.headings);
-    let speeds: Vec<(f64, f64)> = track
-        .speeds
+    let finite: Vec<(f64, f64)> = track
+        .headings
         .iter()
         .copied()
         .filter(|s| s.0.is_finite() && s.1.is_finite())
         .collect();
+    let headings = Series::of(&super::unwrapped(&finite));
+    let speeds = Series::of(&track.speeds);
     // (t, antenna, heading, track so far) at each position the headings and speeds cover.
     let mut rows: Vec<(f64, Vec2, f64, Vec2)> = Vec::with_capacity(track.positions.len());
     let mut travelled = Vec2::zeros();
     for &(t, p) in &track.positions {
-        let (Some(theta), Some(_)) = (at(&headings, t), at(&speeds, t)) else {
+        let (Some(theta), Some(_)) = (headings.at(t), speeds.at(t)) else {
             continue;
         };
         if !(t.is_finite() && p.x.is_finite() && p.y.is_finite()) {
@@ -113,7 +105,7 @@ pub fn fit_antenna_forward(track: &DriveTrack) -> Result<ForwardFit, String> {
                 travelled = Vec2::zeros();
             } else {
                 let mid = t_prev + 0.5 * dt;
-                let (th, v) = (at(&headings, mid), at(&speeds, mid));
+                let (th, v) = (headings.at(mid), speeds.at(mid));
                 if let (Some(th), Some(v)) = (th, v) {
                     travelled += heading_vec(th) * (v * dt);
                 }
@@ -174,12 +166,7 @@ pub fn fit_antenna_forward(track: &DriveTrack) -> Result<ForwardFit, String> {
     if !(x[6].is_finite() && sd.is_finite()) {
         return Err("the drive's positions do not determine the offset".to_string());
     }
-    Ok(ForwardFit {
-        forward: x[6],
-        sd,
-        rms: (rss / (2 * rows.len()) as f64).sqrt(),
-        sweep,
-    })
+    Ok(ForwardFit { forward: x[6], sd })
 }
 
 #[cfg(test)]

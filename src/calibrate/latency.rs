@@ -31,7 +31,7 @@
 //! term (for 2 cm) is added to the standard deviation.
 
 use super::was::Geometry;
-use crate::geo::wrap_angle;
+use super::{interp, unwrapped};
 
 /// Largest latency searched, s.
 pub const MAX_LATENCY: f64 = 0.5;
@@ -68,20 +68,6 @@ pub struct LatencyFit {
     /// too small (rad, sensor terms), and its standard deviation (see [`fit_latency`]).
     pub offset_correction: f64,
     pub offset_correction_sd: f64,
-}
-
-/// Linear interpolation of `ys` at `t` on increasing `ts` (clamped at the ends).
-fn interp(ts: &[f64], ys: &[f64], t: f64) -> f64 {
-    let i = ts.partition_point(|&x| x <= t);
-    if i == 0 {
-        return ys[0];
-    }
-    if i >= ts.len() {
-        return ys[ys.len() - 1];
-    }
-    let (t0, t1) = (ts[i - 1], ts[i]);
-    let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
-    ys[i - 1] + w * (ys[i] - ys[i - 1])
 }
 
 /// Least squares of `y` on the columns `x` (3 of them): coefficients and residual sum of
@@ -167,18 +153,8 @@ pub fn fit_latency(rec: &Slalom, geo: &Geometry, gain: f64, offset: f64) -> Opti
     let pred = Predicted::new(rec, geo, gain, offset, v);
     let (t_first, t_last) = (pred.ts[0], pred.ts[pred.ts.len() - 1]);
     // Unwrapped headings, inside the span every latency searched can reach.
-    let mut prev: Option<f64> = None;
-    let mut hs: Vec<(f64, f64)> = Vec::with_capacity(rec.heading.len());
-    for &(t, h) in &rec.heading {
-        let u = match prev {
-            Some(p) => p + wrap_angle(h - p),
-            None => h,
-        };
-        prev = Some(u);
-        if t - MAX_LATENCY >= t_first && t <= t_last {
-            hs.push((t, u));
-        }
-    }
+    let mut hs = unwrapped(&rec.heading);
+    hs.retain(|&(t, _)| t - MAX_LATENCY >= t_first && t <= t_last);
     if hs.len() < 30 {
         return None;
     }
@@ -274,6 +250,7 @@ pub fn fit_latency(rec: &Slalom, geo: &Geometry, gain: f64, offset: f64) -> Opti
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geo::wrap_angle;
 
     /// A slalom: the sensed angle a sine (period 4 s, ±12°) at 100 Hz, the heading integrated
     /// finely and reported at 10 Hz `latency` late, with a little deterministic noise.

@@ -146,6 +146,34 @@ pub struct Calibration {
     pub was_fit: WasFit,
 }
 
+/// Linear interpolation of `ys` at `t` on increasing `ts` (clamped at the ends; `ts` and `ys`
+/// of the same non-zero length).
+pub(super) fn interp(ts: &[f64], ys: &[f64], t: f64) -> f64 {
+    let i = ts.partition_point(|&x| x <= t);
+    if i == 0 {
+        return ys[0];
+    }
+    if i >= ts.len() {
+        return ys[ys.len() - 1];
+    }
+    let (t0, t1) = (ts[i - 1], ts[i]);
+    let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+    ys[i - 1] + w * (ys[i] - ys[i - 1])
+}
+
+/// Headings (time s, rad) unwrapped into a continuous angle from the first.
+pub(super) fn unwrapped(headings: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut prev: Option<f64> = None;
+    headings
+        .iter()
+        .map(|&(t, h)| {
+            let u = prev.map_or(h, |p| p + crate::geo::wrap_angle(h - p));
+            prev = Some(u);
+            (t, u)
+        })
+        .collect()
+}
+
 /// Largest standard deviation of a measured antenna forward offset written, m: a less certain
 /// one leaves the taped value.
 pub const FORWARD_MAX_SD_M: f64 = 0.05;

@@ -14,8 +14,6 @@
 //! small, which is what the controller needs (it maps a curvature to a sensed angle through
 //! the same wheelbase).
 
-use crate::geo::wrap_angle;
-
 /// One hold of the drive: the sensed angles, the headings (or courses over ground) and the
 /// antenna's speeds over ground it recorded, (time s, value) in time order.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -91,19 +89,7 @@ pub fn hold_result(hold: &Hold, geo: &Geometry) -> Option<HoldResult> {
     if hold.heading.len() < 10 {
         return None;
     }
-    // Unwrap the headings about the first.
-    let h0 = hold.heading[0].1;
-    let mut prev = 0.0;
-    let unwrapped: Vec<(f64, f64)> = hold
-        .heading
-        .iter()
-        .map(|&(t, h)| {
-            let u = prev + wrap_angle(h - h0 - prev);
-            prev = u;
-            (t, u)
-        })
-        .collect();
-    let (_, yaw_rate, _, yaw_rate_sd, _) = line(&unwrapped)?;
+    let (_, yaw_rate, _, yaw_rate_sd, _) = line(&super::unwrapped(&hold.heading))?;
     let v_ant = mean(hold.speed.iter().map(|s| s.1))?;
     let across = yaw_rate * geo.antenna_forward;
     let along = (v_ant * v_ant - across * across).max(0.0).sqrt();
@@ -138,6 +124,7 @@ pub fn fit_was(holds: &[HoldResult]) -> Option<WasFit> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geo::wrap_angle;
 
     /// A hold on a circle: the rear axle at `v` with true angle `delta`, sensed through gain
     /// and offset, the antenna at (f, l).
