@@ -176,7 +176,17 @@ pub fn solve_block_order(n: usize, min_gap: usize, next_block: bool) -> BlockOrd
 /// Exact order: first with short moves forbidden (the usual, feasible case, which also only
 /// visits the allowed moves and so runs about twice as fast), then, if that has no solution,
 /// with short moves allowed at [`SHORT_MOVE_COST`] each.
+/// Blocks of [`super::skip_order_table::TABLE_MIN_LINES`]`..=`[`EXACT_MAX_LINES`] lines are
+/// looked up in the table of this function's answers (`skip_order_table`, made by it and
+/// checked against it by the tests): a block of 20 lines cost ~5 ms, and a plan at w 3 m,
+/// r_min 8 m (blocks of 13 lines, last blocks of 13–25) up to 18 ms for its few sizes.
 fn held_karp(n: usize, min_gap: usize, next_block: bool) -> Vec<usize> {
+    super::skip_order_table::exact_order(n, min_gap, next_block)
+        .unwrap_or_else(|| held_karp_solve(n, min_gap, next_block))
+}
+
+/// [`held_karp`] solved (not looked up).
+fn held_karp_solve(n: usize, min_gap: usize, next_block: bool) -> Vec<usize> {
     if n <= 1 {
         return vec![0; n.max(1)];
     }
@@ -552,6 +562,51 @@ pub(crate) mod tests {
             }
         }
         assert!(fallbacks > 10, "the infeasible cases were exercised");
+    }
+
+    /// The table of exact orders holds the solver's answers: every entry (blocks of up to 16
+    /// lines in a debug build, where the larger ones take seconds), and `min_gap` beyond `n`
+    /// (looked up as `n`: every move is short then, whatever `min_gap`).
+    #[test]
+    fn the_table_of_exact_orders_is_the_solvers() {
+        use crate::plan::skip_order_table::{exact_order, TABLE_MIN_LINES};
+        let largest = if cfg!(debug_assertions) {
+            16
+        } else {
+            EXACT_MAX_LINES
+        };
+        for n in TABLE_MIN_LINES..=largest {
+            for min_gap in (0..=n).chain([n + 1, n + 7]) {
+                for next_block in [false, true] {
+                    assert_eq!(
+                        exact_order(n, min_gap, next_block),
+                        Some(held_karp_solve(n, min_gap, next_block)),
+                        "n={n} gap={min_gap} next={next_block}"
+                    );
+                }
+            }
+        }
+        assert_eq!(exact_order(TABLE_MIN_LINES - 1, 3, true), None);
+        assert_eq!(exact_order(EXACT_MAX_LINES + 1, 3, true), None);
+    }
+
+    /// Writes `src/plan/skip_order_table.rs`'s table (`cargo test --release --lib
+    /// print_the_table_of_exact_orders -- --ignored --nocapture`).
+    #[test]
+    #[ignore]
+    fn print_the_table_of_exact_orders() {
+        use crate::plan::skip_order_table::{DIGITS, TABLE_MIN_LINES};
+        for n in TABLE_MIN_LINES..=EXACT_MAX_LINES {
+            for min_gap in 0..=n {
+                for next_block in [false, true] {
+                    let s: String = held_karp_solve(n, min_gap, next_block)
+                        .iter()
+                        .map(|&l| DIGITS[l] as char)
+                        .collect();
+                    println!("    \"{s}\",");
+                }
+            }
+        }
     }
 
     #[test]
