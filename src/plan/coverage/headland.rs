@@ -408,24 +408,47 @@ pub fn passes_around(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoveragePar
 /// the area is narrow (up to 0.3 s a pass).
 fn eroded_pass_area(boundary: &[Vec2], obstacles: &[Vec<Vec2>], d: f64, rs: f64) -> Vec<Area> {
     let mut area = offset(&[(boundary.to_vec(), vec![])], -(d + rs));
-    let mut discs: Vec<Area> = corner_disc_centres(boundary, d, rs)
+    // The areas taken out, each with its centre when it is a disc.
+    let mut centres: Vec<Option<Vec2>> = corner_disc_centres(boundary, d, rs)
         .into_iter()
-        .map(|c| disc(c, 2.0 * rs))
+        .map(Some)
+        .collect();
+    if !obstacles.is_empty() {
+        // An obstacle's convex corners turn right for the field around it: walk each
+        // obstacle clockwise so they are the right-hand turns.
+        centres.extend(obstacles.iter().flat_map(|o| {
+            let cw: Vec<Vec2> = o.iter().rev().copied().collect();
+            corner_disc_centres(&cw, d, rs).into_iter().map(Some)
+        }));
+    }
+    let mut discs: Vec<Area> = centres
+        .iter()
+        .flatten()
+        .map(|&c| disc(c, 2.0 * rs))
         .collect();
     if !obstacles.is_empty() {
         let rings: Vec<Area> = obstacles.iter().map(|o| (o.clone(), vec![])).collect();
-        discs.extend(offset(&rings, d + rs));
-        // An obstacle's convex corners turn right for the field around it: walk each
-        // obstacle clockwise so they are the right-hand turns.
-        discs.extend(obstacles.iter().flat_map(|o| {
-            let cw: Vec<Vec2> = o.iter().rev().copied().collect();
-            corner_disc_centres(&cw, d, rs)
-                .into_iter()
-                .map(|c| disc(c, 2.0 * rs))
-        }));
+        let grown = offset(&rings, d + rs);
+        centres.extend(grown.iter().map(|_| None));
+        discs.extend(grown);
     }
     if !discs.is_empty() && !area.is_empty() {
-        area = difference_of_union(&area, &discs);
+        // Each corner disc cut to its cap that can meet the area (the rest of it lies
+        // outside the area; see [`super::disc_caps`]).
+        let capped: Vec<Area> = discs
+            .into_iter()
+            .zip(centres)
+            .filter_map(|(d, c)| match c {
+                Some(c) => {
+                    let rr = d.0.first().map_or(0.0, |q| (q - c).norm());
+                    super::disc_caps::cap(d.0, c, rr, &area).map(|cap| (cap, vec![]))
+                }
+                None => Some(d),
+            })
+            .collect();
+        if !capped.is_empty() {
+            area = difference_of_union(&area, &capped);
+        }
     }
     area
 }

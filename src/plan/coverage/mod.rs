@@ -9,6 +9,7 @@ pub mod bypass;
 mod clear_map;
 mod closed;
 pub mod decompose;
+mod disc_caps;
 mod edges;
 pub mod geometry;
 pub mod headland;
