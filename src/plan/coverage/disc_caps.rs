@@ -13,7 +13,7 @@ use crate::geo::{v2, Vec2};
 /// cap keeps the disc's boundary wherever it could meet the area, with this to spare.
 const CUT_MARGIN: f64 = 0.01;
 
-/// Is `p` inside `area` (its outer ring and none of its holes)?
+/// Is `p` inside `area` (its outer ring and none of its holes; the holes may overlap)?
 fn inside(area: &[Area], p: &Vec2) -> bool {
     area.iter().any(|(outer, holes)| {
         contains_point(outer, p) && !holes.iter().any(|h| contains_point(h, p))
@@ -23,7 +23,8 @@ fn inside(area: &[Area], p: &Vec2) -> bool {
 /// The part of `disc` (a convex counter-clockwise polygon whose vertices lie on the circle of
 /// radius `rr` about `c`) that can meet `area`: the disc cut by a line beyond which no point of
 /// `area` lies inside the circle; the disc whole when no cut removes anything; `None` when no
-/// point of `area` lies inside the circle.
+/// point of `area` lies inside the circle. (Holes of `area` may overlap each other and its
+/// outer ring: every edge bounds the cut, and a point in any hole is out of the area.)
 pub(super) fn cap(disc: Vec<Vec2>, c: Vec2, rr: f64, area: &[Area]) -> Option<Vec<Vec2>> {
     // The points of the area's edges inside the circle: each edge clipped to it.
     let mut ends: Vec<Vec2> = Vec::new();

@@ -433,15 +433,30 @@ fn eroded_pass_area(boundary: &[Vec2], obstacles: &[Vec<Vec2>], d: f64, rs: f64)
         discs.extend(grown);
     }
     if !discs.is_empty() && !area.is_empty() {
-        // Each corner disc cut to its cap that can meet the area (the rest of it lies
-        // outside the area; see [`super::disc_caps`]).
+        // Each corner disc cut to its cap that can meet what is left of the area (the rest of
+        // it lies outside the area or in a grown obstacle; see [`super::disc_caps`]). The
+        // grown obstacles (those without holes) count as holes of the area there.
+        let grown_holes: Vec<Vec<Vec2>> = discs
+            .iter()
+            .zip(&centres)
+            .filter(|(d, c)| c.is_none() && d.1.is_empty())
+            .map(|(d, _)| d.0.clone())
+            .collect();
+        let left: Vec<Area> = area
+            .iter()
+            .map(|(outer, holes)| {
+                let mut holes = holes.clone();
+                holes.extend(grown_holes.iter().cloned());
+                (outer.clone(), holes)
+            })
+            .collect();
         let capped: Vec<Area> = discs
             .into_iter()
             .zip(centres)
             .filter_map(|(d, c)| match c {
                 Some(c) => {
                     let rr = d.0.first().map_or(0.0, |q| (q - c).norm());
-                    super::disc_caps::cap(d.0, c, rr, &area).map(|cap| (cap, vec![]))
+                    super::disc_caps::cap(d.0, c, rr, &left).map(|cap| (cap, vec![]))
                 }
                 None => Some(d),
             })
