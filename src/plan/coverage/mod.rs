@@ -428,8 +428,7 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
             let (r, step) = (p.r_min, p.point_spacing);
             let ok: &dyn Fn(&Vec2) -> bool = if relaxed { &loose } else { &clear };
             let pts = match way {
-                Way::Direct => transit::transit(f, hf, q, hq, r, step, ok)
-                    .and_then(|(pts, ok)| ok.then_some(pts)),
+                Way::Direct => transit::clear_transit(f, hf, q, hq, r, step, ok),
                 Way::Headland if t == 0 && !one_test && (relaxed || *loose_failed) => {
                     let loose_way = loose_headland
                         .get_or_insert_with(|| rings.transit(f, hf, q, hq, r, step, &loose));
@@ -522,9 +521,10 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
                 if !clear(&via) {
                     continue;
                 }
-                let a = transit::transit(from, h0, via, h0, p.r_min, p.point_spacing, &clear);
-                let b = transit::transit(via, h0, to, h1, p.r_min, p.point_spacing, &clear);
-                if let (Some((mut a, true)), Some((b, true))) = (a, b) {
+                let a = transit::clear_transit(from, h0, via, h0, p.r_min, p.point_spacing, &clear);
+                let b =
+                    || transit::clear_transit(via, h0, to, h1, p.r_min, p.point_spacing, &clear);
+                if let Some((mut a, b)) = a.and_then(|a| Some((a, b()?))) {
                     a.extend(b.into_iter().skip(1));
                     return Some(a);
                 }
@@ -673,8 +673,16 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
                     for k in (0..m).step_by((m / 48).max(1)) {
                         let i = (nearest + k) % m;
                         let hi = vec_heading(&(open[(i + 1) % m] - open[i]));
-                        if let Some((_, true)) =
-                            transit::transit(q, h, open[i], hi, p.r_min, p.point_spacing, &clear)
+                        if transit::clear_transit(
+                            q,
+                            h,
+                            open[i],
+                            hi,
+                            p.r_min,
+                            p.point_spacing,
+                            &clear,
+                        )
+                        .is_some()
                         {
                             start = i;
                             break;

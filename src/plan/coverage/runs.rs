@@ -183,8 +183,8 @@ pub(super) fn drive_run(
                 }
                 let (h1, h2) = (vec_heading(&d), vec_heading(&(-d)));
                 let (q1, q2) = (world(e_t, y), world(s2, y2));
-                match transit::transit(q1, h1, q2, h2, p.r_min, p.point_spacing, clear) {
-                    Some((pts, true))
+                match transit::clear_transit(q1, h1, q2, h2, p.r_min, p.point_spacing, clear) {
+                    Some(pts)
                         if crate::geo::polygon::polyline_length(&pts)
                             <= ASYMMETRIC_TURN_MAX_LENGTH
                                 * (std::f64::consts::PI * p.r_min

@@ -184,6 +184,23 @@ pub fn csc_length(p1: Vec2, h1: f64, p2: Vec2, h2: f64, r: f64) -> Option<f64> {
         .min_by(f64::total_cmp)
 }
 
+/// The shortest CSC transit for which `clear` holds at every point; `None` when none does.
+/// ([`transit`] without the points of the shortest curve when no curve is clear, which its
+/// callers that want a clear one only threw away.)
+pub fn clear_transit(
+    p1: Vec2,
+    h1: f64,
+    p2: Vec2,
+    h2: f64,
+    r: f64,
+    step: f64,
+    clear: &dyn Fn(&Vec2) -> bool,
+) -> Option<Vec<Vec2>> {
+    words_by_length(p1, h1, p2, h2, r)
+        .iter()
+        .find_map(|curve| curve.points(step, clear))
+}
+
 /// The shortest CSC transit for which `clear` holds at every point, else the shortest one
 /// (`false` second element).
 pub fn transit(
@@ -401,7 +418,7 @@ pub fn route_graph(
         .collect();
     let finishes = |s: usize| {
         let (q, h) = pose(s);
-        matches!(transit(q, h, p2, h2, r, step, clear), Some((_, true)))
+        clear_transit(q, h, p2, h2, r, step, clear).is_some()
     };
     let dead = grid
         .closed
@@ -608,7 +625,7 @@ pub fn route_graph(
         }
         let at = pose(s);
         if (p2 - at.0).norm() <= 3.0 * grid.step {
-            if let Some((last, true)) = transit(at.0, at.1, p2, h2, r, step, clear) {
+            if let Some(last) = clear_transit(at.0, at.1, p2, h2, r, step, clear) {
                 // The chain of states back to the start, then its curves.
                 let mut chain = vec![s];
                 while let Some(&c) = chain.last() {
