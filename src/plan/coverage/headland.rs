@@ -483,11 +483,16 @@ fn open_without_kinks(eroded: &[Area], rs: f64, p: &CoverageParams) -> Vec<Area>
         if kinks.is_empty() {
             break;
         }
-        kink_discs.extend(
-            kinks
-                .iter()
-                .map(|(q, out)| disc(q + out * (rs - KINK_DISC_DEPTH), 2.0 * rs)),
-        );
+        // (Each cut to its cap that can meet `eroded`, as the corner discs are.)
+        kink_discs.extend(kinks.iter().filter_map(|(q, out)| {
+            let c = q + out * (rs - KINK_DISC_DEPTH);
+            let (ring, _) = disc(c, 2.0 * rs);
+            let rr = ring.first().map_or(0.0, |v| (v - c).norm());
+            super::disc_caps::cap(ring, c, rr, eroded).map(|cap| (cap, vec![]))
+        }));
+        if kink_discs.is_empty() {
+            break;
+        }
         opened = offset(&difference_of_union(eroded, &kink_discs), rs);
     }
     opened
