@@ -194,11 +194,45 @@ const BYPASS_SLACK_M: f64 = 0.05;
 /// ([`narrow`]); each says so in [`FieldPlan::warnings`]. A plan with no working pass at all is
 /// the caller's to refuse ([`headland::no_swath_fits`] gives the numbers).
 pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> {
-    narrow::plan_field(field, p, plan_once)
+    p.validate()?;
+    // The clearance tests and waypoint grids depend on the field, the width, r_min and the
+    // point spacing, not on the headland passes: one set for the plans of every pass count
+    // tried (their checks, and the edges the searches checked, kept from one to the next).
+    let half = p.line_width / 2.0;
+    let strict_half = half + headland::chord_margin(p) - headland::CHORD_MARGIN;
+    let loose_half =
+        half.min(TRANSIT_CLEARANCE_M) + headland::chord_margin(p) - headland::CHORD_MARGIN;
+    let clear_map = ClearMap::new(field, strict_half);
+    let one_test = loose_half == strict_half;
+    let loose_map = (!one_test).then(|| ClearMap::new(field, loose_half));
+    let clear = |q: &Vec2| clear_map.clear(q);
+    let loose = |q: &Vec2| loose_map.as_ref().unwrap_or(&clear_map).clear(q);
+    let (grid, loose_grid) = (std::cell::OnceCell::new(), std::cell::OnceCell::new());
+    let tests = Tests {
+        clear: &clear,
+        loose: &loose,
+        one_test,
+        grid: &grid,
+        loose_grid: &loose_grid,
+    };
+    narrow::plan_field(field, p, |f, q| plan_once(f, q, &tests))
 }
 
-/// [`plan_field`] with the configured headland passes as they are.
-fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> {
+/// The clearance tests of one field, width, r_min and point spacing, and their waypoint grids
+/// (built on first need: most plans never need them).
+struct Tests<'a> {
+    /// The implement clear of the edge and the obstacles.
+    clear: &'a dyn Fn(&Vec2) -> bool,
+    /// The tractor inside the field and off the obstacles ([`TRANSIT_CLEARANCE_M`]).
+    loose: &'a dyn Fn(&Vec2) -> bool,
+    /// The two tests are one (w ≤ 3 m).
+    one_test: bool,
+    grid: &'a std::cell::OnceCell<transit::WaypointGrid<'a>>,
+    loose_grid: &'a std::cell::OnceCell<transit::WaypointGrid<'a>>,
+}
+
+/// [`plan_field`] with the configured headland passes as they are, with the field's `tests`.
+fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPlan, PlanError> {
     p.validate()?;
     if field.boundary.len() < 3 || crate::geo::polygon::signed_area(&field.boundary) <= 0.0 {
         return Err(PlanError::Invalid {
@@ -235,37 +269,30 @@ fn plan_once(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> 
         margin,
     );
     let working = headland::working_area(&field.boundary, &large, p);
-    // Points are checked; the chords between them may cut a little inside the arcs.
-    let strict_half = half + headland::chord_margin(p) - headland::CHORD_MARGIN;
-    let clear_map = ClearMap::new(field, strict_half);
-    let clear = |q: &Vec2| clear_map.clear(q);
-    // Transits that find no way with the implement clear of the edge keep the tractor inside
-    // the field and off the obstacles (the guarantee for paths that do not work).
-    // With an implement no wider than the tractor's clearance the two tests are one (w ≤ 3 m):
-    // one map then, and the relaxed attempts that would repeat the strict ones are skipped.
-    let loose_half =
-        half.min(TRANSIT_CLEARANCE_M) + headland::chord_margin(p) - headland::CHORD_MARGIN;
-    let one_test = loose_half == strict_half;
-    let loose_map = (!one_test).then(|| ClearMap::new(field, loose_half));
-    let loose = |q: &Vec2| loose_map.as_ref().unwrap_or(&clear_map).clear(q);
+    // Points are checked; the chords between them may cut a little inside the arcs
+    // (`tests.clear`). Transits that find no way with the implement clear of the edge keep the
+    // tractor inside the field and off the obstacles (`tests.loose`; the guarantee for
+    // paths that do not work). With an implement no wider than the tractor's clearance the two
+    // tests are one (w ≤ 3 m): one map then, and the relaxed attempts that would repeat the
+    // strict ones are skipped.
+    let (clear, loose, one_test) = (tests.clear, tests.loose, tests.one_test);
     // Waypoints for detours and transits that cannot go direct: grids of clear points over
-    // the field, each with the test of its curves. (Built on first need: most plans never
-    // need them.)
+    // the field, each with the test of its curves.
     let (grid_lo, grid_hi) =
         crate::geo::polygon::bbox(field.boundary.iter()).unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
     let grid_step = 2.0 * p.r_min;
-    let waypoint_grid = std::cell::OnceCell::new();
     let waypoint_grid = || {
-        waypoint_grid
-            .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, &clear))
+        tests
+            .grid
+            .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, clear))
     };
-    let loose_grid = std::cell::OnceCell::new();
     let loose_grid = || {
         if one_test {
             return waypoint_grid();
         }
-        loose_grid
-            .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, &loose))
+        tests
+            .loose_grid
+            .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, loose))
     };
     let warnings = std::cell::RefCell::new(Vec::<String>::new());
 

@@ -241,6 +241,9 @@ pub struct WaypointGrid<'a> {
     edges: RefCell<EdgeTable>,
     /// The states of the searches that failed with nothing left to expand.
     closed: RefCell<ClosedSets>,
+    /// The answers of the searches made, by their poses, radius, spacing and budget (the
+    /// plans of a field with several headland pass counts ask the same ones).
+    answers: RefCell<std::collections::HashMap<[u64; 9], Option<Vec<Vec2>>>>,
 }
 
 impl<'a> WaypointGrid<'a> {
@@ -267,6 +270,7 @@ impl<'a> WaypointGrid<'a> {
             clear,
             edges: RefCell::default(),
             closed: RefCell::default(),
+            answers: RefCell::default(),
         };
         for j in 0..ny {
             for i in 0..nx {
@@ -384,6 +388,38 @@ const HEURISTIC_WEIGHT: f64 = 1.5;
 /// [`EdgeTable`], their checks kept there for the grid's later searches.
 #[allow(clippy::too_many_arguments)]
 pub fn route_graph(
+    p1: Vec2,
+    h1: f64,
+    p2: Vec2,
+    h2: f64,
+    r: f64,
+    step: f64,
+    grid: &WaypointGrid,
+    max_expansions: usize,
+) -> Option<Vec<Vec2>> {
+    let key = [p1.x, p1.y, h1, p2.x, p2.y, h2, r, step].map(f64::to_bits);
+    let key = [
+        key[0],
+        key[1],
+        key[2],
+        key[3],
+        key[4],
+        key[5],
+        key[6],
+        key[7],
+        max_expansions as u64,
+    ];
+    if let Some(answer) = grid.answers.borrow().get(&key) {
+        return answer.clone();
+    }
+    let answer = search(p1, h1, p2, h2, r, step, grid, max_expansions);
+    grid.answers.borrow_mut().insert(key, answer.clone());
+    answer
+}
+
+/// [`route_graph`]'s search.
+#[allow(clippy::too_many_arguments)]
+fn search(
     p1: Vec2,
     h1: f64,
     p2: Vec2,
