@@ -67,7 +67,14 @@ pub(super) struct ClearMap<'a> {
     /// Per block (row-major, `nx.div_ceil(BLOCK)` a row): its edges and the rings it lies
     /// inside, `None` until first needed.
     blocks: RefCell<Vec<Option<BlockEdges>>>,
+    /// The same per super-block of [`SUPER`] × [`SUPER`] blocks (row-major,
+    /// `nx.div_ceil(BLOCK * SUPER)` a row): a block's edges are found among its super-block's,
+    /// not among every edge of the field (a waypoint grid asks a new block at each node).
+    supers: RefCell<Vec<Option<BlockEdges>>>,
 }
+
+/// Blocks per side of a super-block.
+const SUPER: usize = 8;
 
 impl<'a> ClearMap<'a> {
     /// At most this many grid cells (a few MB).
@@ -89,6 +96,10 @@ impl<'a> ClearMap<'a> {
             state: RefCell::new(vec![UNKNOWN; nx * ny]),
             locals: RefCell::new(Vec::new()),
             blocks: RefCell::new(vec![None; nx.div_ceil(BLOCK) * ny.div_ceil(BLOCK)]),
+            supers: RefCell::new(vec![
+                None;
+                nx.div_ceil(BLOCK * SUPER) * ny.div_ceil(BLOCK * SUPER)
+            ]),
         }
     }
 
@@ -143,6 +154,49 @@ impl<'a> ClearMap<'a> {
             + v2(half_block, half_block);
         // The block's half diagonal, a millimetre wider for rounding.
         let within = self.half + half_block * std::f64::consts::SQRT_2 + 1e-3;
+        // Every edge within `within` of the block's centre is on its super-block's list (the
+        // block's centre lies within the super-block's half diagonal less the block's of the
+        // super-block's centre), in the same order; a ring with no edge on that list has none
+        // between the two centres, so the block's centre is inside it when the super-block's is.
+        let sup = self.super_edges(bi / SUPER, bj / SUPER);
+        let rings = std::iter::once(&self.field.boundary).chain(self.field.obstacles.iter());
+        let mut edges = Vec::new();
+        let mut inside = Vec::new();
+        let mut next = 0;
+        for (r, ring) in rings.enumerate() {
+            if let Some(known) = sup.inside.get(r).copied().flatten() {
+                inside.push(Some(known));
+                continue;
+            }
+            let before = edges.len();
+            while let Some(&(_, a, b)) = sup.edges.get(next).filter(|e| e.0 == r) {
+                next += 1;
+                if point_segment_distance(&centre, &a, &b) <= within {
+                    edges.push((r, a, b));
+                }
+            }
+            inside.push((edges.len() == before).then(|| contains_point(ring, &centre)));
+        }
+        let edges: BlockEdges = std::rc::Rc::new(Block { edges, inside });
+        if let Some(slot) = self.blocks.borrow_mut().get_mut(k) {
+            *slot = Some(edges.clone());
+        }
+        edges
+    }
+
+    /// The edges within reach of super-block (`si`, `sj`) (every edge within `half` plus its
+    /// half diagonal of its centre, a millimetre wider) and the rings with none of them that
+    /// its centre is inside, as [`Self::block_edges`] for a block.
+    fn super_edges(&self, si: usize, sj: usize) -> BlockEdges {
+        let k = sj * self.nx.div_ceil(BLOCK * SUPER) + si;
+        if let Some(Some(edges)) = self.supers.borrow().get(k) {
+            return edges.clone();
+        }
+        let half_super = (BLOCK * SUPER) as f64 * 0.5 * self.cell;
+        let centre = self.origin
+            + v2(si as f64, sj as f64) * ((BLOCK * SUPER) as f64 * self.cell)
+            + v2(half_super, half_super);
+        let within = self.half + half_super * std::f64::consts::SQRT_2 + 2e-3;
         let rings = std::iter::once(&self.field.boundary).chain(self.field.obstacles.iter());
         let mut edges = Vec::new();
         let mut inside = Vec::new();
@@ -158,7 +212,7 @@ impl<'a> ClearMap<'a> {
             inside.push((edges.len() == before).then(|| contains_point(ring, &centre)));
         }
         let edges: BlockEdges = std::rc::Rc::new(Block { edges, inside });
-        if let Some(slot) = self.blocks.borrow_mut().get_mut(k) {
+        if let Some(slot) = self.supers.borrow_mut().get_mut(k) {
             *slot = Some(edges.clone());
         }
         edges
