@@ -298,6 +298,9 @@ impl Controller {
         if needs.observer {
             // The drift is kept per direction of straight driving (estimate::drift_memory).
             let path_curvature = curvature_along(local.points(), local.index_local(), 1.0, 1.0);
+            self.estimator.set_work(
+                direction == Direction::Forward && self.guidance.tag() == crate::geo::Tag::Work,
+            );
             self.estimator
                 .set_straight(path_curvature.abs() < CURVATURE_SCALE_MIN_CURVATURE);
         }

@@ -28,10 +28,28 @@
 //! worse (the envelope's antenna-position and GNSS-latency rows). Sectors are [`SECTORS`] of
 //! 45°; an active one is kept until the heading is [`HYSTERESIS`] past its edge, so a line along
 //! an edge does not swap the drift on noise. Fixed arrays; nothing allocates.
+//!
+//! **Curves.** A curve sweeps the heading round, so a vehicle drift turns with it while the
+//! world vector stays put (on an arc of R 15 m at 10 km/h a 5 kN side draft's 8 cm/s crab turns
+//! a radian in 5 s, the drift's time constant is a minute). Where the drift is known to be the
+//! vehicle's it turns with the heading ([`CurveDrift`], [`Estimator::set_work`]):
+//! - on a curved work path, once the drift has been learnt on its curves for
+//!   [`MIN_LEARNT_S`] (or was carried in, below), when it is one the memory acts on (above
+//!   [`MIN_DRIFT`], [`MIN_CRAB`] times the speed);
+//! - through a headland turn, when the work line that ends had such a drift and it is known to
+//!   be the vehicle's: the line was curved (above), or the way back in the opposite sector kept
+//!   the drift on the other side of the field. The turn then keeps it and does not learn (a
+//!   turn's transient slip of dynamic tyres is not the line's drift), and the straight after it
+//!   takes its sector's drift across the heading, if learnt, as the way back does above (the
+//!   carried one is right only in its vehicle part; a slope adds a ground part).
+//!
+//! A ground drift, or one not yet known (the first turn), goes through a turn as a world
+//! vector, as before. The understeering tyres' crab on an arc flips with the arc's direction
+//! and is carried into the next arc wrong: tractor_b's R 15 m 3.27 → 3.96 cm (docs/envelope.md,
+//! Session 16).
 
-use super::{Estimator, LateralFilter};
-use crate::geo::{heading_vec, left_normal, wrap_angle, Vec2};
-use nalgebra::Vector3;
+use super::Estimator;
+use crate::geo::{heading_vec, left_normal, v2, wrap_angle, Vec2};
 use std::f64::consts::TAU;
 
 /// Sectors of heading.
@@ -133,6 +151,13 @@ impl DriftMemory {
         }
     }
 
+    /// The drift kept driving straight the other way (the sector of `heading` + π, rad), if
+    /// learnt there for [`MIN_LEARNT_S`].
+    pub fn opposite(&self, heading: f64) -> Option<Vec2> {
+        let slot = &self.slots[sector_of(heading + std::f64::consts::PI)];
+        (slot.learnt >= MIN_LEARNT_S).then_some(slot.drift)
+    }
+
     /// The vehicle now heads `heading` (rad), driving straight or not (`straight`), with the
     /// observer's drift `drift` (world, m/s): what to go on with.
     /// Only straight driving takes a sector's drift: a curve sweeps through the sectors and
@@ -183,11 +208,101 @@ impl DriftMemory {
     }
 }
 
+/// The drift on curves ([the module](self)).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(super) struct CurveDrift {
+    /// The path is a work path driven forward.
+    work: bool,
+    /// The current headland turn carries the last work line's drift as the vehicle's.
+    turn_carries_crab: bool,
+    /// The current work path started with a drift a turn carried as the vehicle's.
+    carried_in: bool,
+    /// Time the drift has been learnt on curves of this work path, s.
+    line_learnt: f64,
+}
+
+impl CurveDrift {
+    /// The drift was learnt for `dt` (s) on a straight path or not (`straight`).
+    pub(super) fn learnt(&mut self, dt: f64, straight: bool) {
+        if !straight && self.work && dt.is_finite() && dt > 0.0 {
+            self.line_learnt += dt;
+        }
+    }
+}
+
 impl Estimator {
     /// Whether the vehicle follows a straight path (the guidance's; the drift is kept per
     /// direction of straight driving, [the module](self)).
     pub fn set_straight(&mut self, straight: bool) {
         self.straight = straight;
+    }
+
+    /// Whether the vehicle follows a work path forward (the guidance's). Leaving one decides
+    /// whether the headland turn carries its drift as the vehicle's ([the module](self)).
+    pub fn set_work(&mut self, work: bool) {
+        if self.curve.work && !work {
+            // A curved line whose drift already turned with the vehicle, or a straight one
+            // whose way back kept the drift on the other side.
+            let curved = self.curve.line_learnt >= MIN_LEARNT_S;
+            self.curve.turn_carries_crab = self.fix_pose.is_some_and(|pose| {
+                self.drift_is_vehicles(pose.heading) && (curved || self.crab_known(pose.heading))
+            });
+        } else if work && !self.curve.work {
+            self.curve.carried_in = self.curve.turn_carries_crab;
+            self.curve.line_learnt = 0.0;
+        }
+        self.curve.work = work;
+    }
+
+    /// Whether the last headland turn carried the drift as the vehicle's.
+    #[cfg(test)]
+    pub(super) fn curve_carried(&self) -> bool {
+        self.curve.turn_carries_crab
+    }
+
+    /// Whether the drift across `heading` (rad) is one the memory acts on: above
+    /// [`MIN_DRIFT`], and above 10 km/h above [`MIN_CRAB`] times the speed.
+    fn drift_is_vehicles(&self, heading: f64) -> bool {
+        let across = left_normal(&heading_vec(heading)).dot(&self.drift).abs();
+        across > (MIN_CRAB * self.fix_speed.abs()).max(MIN_DRIFT)
+    }
+
+    /// Whether the drift across `heading` (rad) is known to be the vehicle's: the way back
+    /// (the opposite direction, learnt) kept it on the other side of the field.
+    fn crab_known(&self, heading: f64) -> bool {
+        let n = left_normal(&heading_vec(heading));
+        let (here, there) = (n.dot(&self.drift), self.drift_memory.opposite(heading));
+        there.is_some_and(|d| n.dot(&d) * here < 0.0)
+    }
+
+    /// In a headland turn that carries the last line's drift as the vehicle's: the drift is
+    /// kept as it is, turning with the vehicle, and not learnt (the turn's transient slip is
+    /// not the line's drift).
+    pub(super) fn turn_keeps_drift(&self) -> bool {
+        !self.straight && !self.curve.work && self.curve.turn_carries_crab
+    }
+
+    /// On a curve from the fix heading `previous` to `heading` (rad): the drift turns with the
+    /// vehicle where it is the vehicle's (on a work path, a drift the memory acts on, carried
+    /// in as the vehicle's or learnt on its curves for [`MIN_LEARNT_S`]; in a headland turn
+    /// that carries one).
+    pub(super) fn drift_through_curve(&mut self, previous: f64, heading: f64) {
+        let c = self.curve;
+        let turns = !self.straight
+            && if c.work {
+                // A drift carried through the turn as the vehicle's is known from the start.
+                (c.carried_in || c.line_learnt >= MIN_LEARNT_S) && self.drift_is_vehicles(previous)
+            } else {
+                c.turn_carries_crab
+            };
+        if turns {
+            let (sin, cos) = wrap_angle(heading - previous).sin_cos();
+            self.drift = v2(
+                cos * self.drift.x - sin * self.drift.y,
+                sin * self.drift.x + cos * self.drift.y,
+            );
+            self.lateral.rotate_drift(cos, sin);
+        }
     }
 
     /// Move the drift estimate by `step` (world, m/s), within the observer's drift limit.
@@ -214,9 +329,13 @@ impl Estimator {
             Entered::Learnt(drift) => {
                 // The sector's own drift where the carried one points the other way across the
                 // heading: a drift of the vehicle, not of the ground (a ground drift that grows
-                // keeps its side, and its newest value is the right one).
+                // keeps its side, and its newest value is the right one). After a turn that
+                // carried the drift as the vehicle's, the sector's own: the carried one is
+                // right only in its vehicle part.
                 let stored = n.dot(&drift);
-                if stored * carried < 0.0 && stored.abs().min(carried.abs()) > 0.5 * min_drift {
+                let swapped =
+                    stored * carried < 0.0 && stored.abs().min(carried.abs()) > 0.5 * min_drift;
+                if swapped || self.curve.turn_carries_crab {
                     self.add_drift(n * (stored - carried));
                 }
             }
@@ -225,18 +344,6 @@ impl Estimator {
                     self.lateral.relearn_across(&n);
                 }
             }
-        }
-    }
-}
-
-impl LateralFilter {
-    /// Learn the drift across `n` (a unit vector) afresh: its variance along `n` back to the
-    /// initial one, the rest as it is.
-    pub(super) fn relearn_across(&mut self, n: &Vec2) {
-        let n3 = Vector3::new(n.x, n.y, 0.0);
-        let add = Self::P0[0] - n3.dot(&(self.p * n3));
-        if add > 0.0 && add.is_finite() {
-            self.p += n3 * n3.transpose() * add;
         }
     }
 }

@@ -12,10 +12,12 @@
 use crate::geo::{
     heading_vec, left_normal, rotate, small_sin_cos, v2, vec_heading, wrap_angle, Pose, Vec2,
 };
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 mod drift_memory;
+mod lateral_filter;
 use drift_memory::DriftMemory;
+use lateral_filter::LateralFilter;
 
 /// GNSS antenna position relative to the rear-axle centre, m.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -195,74 +197,6 @@ const MIN_TAU: f64 = 1.0;
 /// it is left alone.
 const SLIP_REFERENCE_ROLL: f64 = 0.035;
 
-/// The Kalman filter of the lateral disturbances θ = (world drift x, y in m/s; slip
-/// coefficient in m/s per rad of roll), each a random walk. The measurement is the lateral
-/// rate error of one fix interval, e = Δl/Δt = h·(θ − θ̂) + noise, h = (n, −sin roll).
-///
-/// Estimating them jointly matters on a side slope: the downhill drift and the slope slip push
-/// the same way on every pass, so only the slope's variation along a pass tells them apart, and
-/// two filters fed the same error would share it arbitrarily (then dead reckoning through RTK
-/// float drifts wherever the slope differs from its mean). The noise densities are set so
-/// that, alone, each state is a first-order filter with its configured time constant (the
-/// slip at [`SLIP_REFERENCE_ROLL`]): process noise q = r/τ² against a measurement noise
-/// density r (the scale cancels, r = 1). The covariance starts at the value of a 1 s time
-/// constant ([`MIN_TAU`]) and is never let above it, so that a state that is not observed
-/// (the drift along the pass, the slip on flat ground) does not gather an unbounded gain.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct LateralFilter {
-    p: Matrix3<f64>,
-}
-
-impl LateralFilter {
-    /// The initial and largest variances: a time constant τ for a state seen through a
-    /// regressor of size h has variance 1/(τ·h²); here τ = [`MIN_TAU`], h = 1 for the drift and
-    /// the reference roll for the slip.
-    const P0: [f64; 3] = [
-        1.0 / MIN_TAU,
-        1.0 / MIN_TAU,
-        1.0 / (MIN_TAU * SLIP_REFERENCE_ROLL * SLIP_REFERENCE_ROLL),
-    ];
-
-    fn new() -> Self {
-        LateralFilter {
-            p: Matrix3::from_diagonal(&Vector3::from(Self::P0)),
-        }
-    }
-
-    /// One fix interval `dt` (s) with regressor `h` and lateral rate error `e` (m/s): the
-    /// correction of θ̂.
-    fn update(&mut self, h: &Vector3<f64>, e: f64, dt: f64, o: &ObserverParams) -> Vector3<f64> {
-        // Process noise q = r/τ² (r = 1) for the slip in units of the reference roll.
-        let q = |tau: f64, scale: f64| {
-            if tau > 0.0 {
-                1.0 / (tau * tau * scale * scale)
-            } else {
-                0.0
-            }
-        };
-        let q_drift = q(o.drift_tau, 1.0);
-        let q_slip = q(o.slip_tau, SLIP_REFERENCE_ROLL);
-        self.p += Matrix3::from_diagonal(&Vector3::new(q_drift, q_drift, q_slip)) * dt;
-        let ph = self.p * h;
-        let s = h.dot(&ph) + 1.0 / dt;
-        let k = ph / s;
-        self.p -= k * ph.transpose();
-        // Keep the covariance symmetric and each variance within its initial value (scaling
-        // the row and column keeps it positive semi-definite).
-        self.p = 0.5 * (self.p + self.p.transpose());
-        for (i, cap) in Self::P0.into_iter().enumerate() {
-            if self.p[(i, i)] > cap {
-                let f = (cap / self.p[(i, i)]).sqrt();
-                for j in 0..3 {
-                    self.p[(i, j)] *= f;
-                    self.p[(j, i)] *= f;
-                }
-            }
-        }
-        k * e
-    }
-}
-
 /// The estimate handed to guidance and tracking.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VehicleEstimate {
@@ -303,6 +237,8 @@ pub struct Estimator {
     /// The drift per direction of straight driving, and whether the path is straight.
     drift_memory: DriftMemory,
     straight: bool,
+    /// The drift on curves: work path or not, and what a headland turn carries.
+    curve: drift_memory::CurveDrift,
     /// The joint filter of the drift and the slip.
     lateral: LateralFilter,
     /// Roll of the latest fix, rad (0 without a roll signal).
@@ -348,6 +284,7 @@ impl Estimator {
             slip: 0.0,
             drift_memory: DriftMemory::default(),
             straight: false,
+            curve: Default::default(),
             lateral: LateralFilter::new(),
             roll: 0.0,
             roll_prev: 0.0,
@@ -509,7 +446,7 @@ impl Estimator {
         }
         // The lateral rate error e = Δl/Δt measures h·(θ − θ̂) with θ = (drift, slip) and
         // h = (n, −sin roll): one Kalman update of the three together.
-        let drift_on = o.drift_tau > 0.0;
+        let drift_on = o.drift_tau > 0.0 && !self.turn_keeps_drift();
         let slip_on = o.slip_tau > 0.0;
         if drift_on || slip_on {
             let h = Vector3::new(
@@ -522,9 +459,10 @@ impl Estimator {
                 },
             );
             let step = self.lateral.update(&h, d_lateral / dt, dt, &o);
-            self.add_drift(v2(step.x, step.y));
             if drift_on {
+                self.add_drift(v2(step.x, step.y));
                 self.drift_memory.learnt(dt, self.straight);
+                self.curve.learnt(dt, self.straight);
             }
             self.slip = (self.slip + step.z).clamp(-o.slip_limit, o.slip_limit);
         }
@@ -654,6 +592,9 @@ impl Estimator {
             _ => self.smooth = Vec2::zeros(),
         }
         if o.drift_tau > 0.0 {
+            if let Some(previous) = self.fix_pose {
+                self.drift_through_curve(previous.heading, heading);
+            }
             self.drift_by_direction(heading);
         }
         self.fix_pose = Some(pose);

@@ -3,7 +3,7 @@
 use super::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::f64::consts::FRAC_PI_2;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 fn params(predict: bool) -> EstimatorParams {
     EstimatorParams {
@@ -614,4 +614,109 @@ fn a_drift_of_the_vehicle_is_kept_per_direction_and_one_of_the_ground_is_not_swa
     let growing = |pass: usize, _: Vec2| v2(if pass == 0 { 0.03 } else { 0.06 }, 0.0);
     let newest = crab_passes(growing, true);
     assert!(newest[2] < 0.01 && newest[3] < 0.01, "{newest:?}");
+}
+
+/// Drives `seconds` from `start` at 3 m/s turning at `rate` (rad/s, the wheels at the angle the
+/// kinematic model needs) with a drift of `crab` m/s to the vehicle's left plus `ground` (world,
+/// m/s), a work path or not (`work`), straight when `rate` is 0: the end pose.
+fn drive_curve(
+    e: &mut Estimator,
+    t0: f64,
+    seconds: f64,
+    start: Pose,
+    rate: f64,
+    (crab, ground): (f64, Vec2),
+    work: bool,
+) -> Pose {
+    let v = 3.0;
+    let wheel = (rate * e.params().wheelbase / v).atan();
+    let (mut pos, mut th) = (start.pos, start.heading);
+    e.set_work(work);
+    e.set_straight(rate == 0.0);
+    let steps = (seconds / 0.02).round() as usize;
+    for k in 1..=steps {
+        let t = t0 + k as f64 * 0.02;
+        let h = heading_vec(th);
+        pos += (h * v + left_normal(&h) * crab + ground) * 0.02;
+        th = wrap_angle(th + rate * 0.02);
+        e.on_wheel_angle(t, wheel);
+        if k % 5 == 0 {
+            e.on_fix(&GnssFix {
+                t_received: t + e.params().gnss_latency,
+                antenna: antenna_of(e, &Pose::new(pos.x, pos.y, th)),
+                heading: Some(th),
+                speed: v,
+                roll: None,
+                latency: None,
+            });
+        }
+    }
+    Pose::new(pos.x, pos.y, th)
+}
+
+/// The estimated drift's error across the heading `heading` against the truth, m/s.
+fn drift_error_across(e: &Estimator, heading: f64, (crab, ground): (f64, Vec2)) -> f64 {
+    let n = left_normal(&heading_vec(heading));
+    (n.dot(&e.drift()) - (crab + n.dot(&ground))).abs()
+}
+
+#[test]
+fn on_a_curved_work_path_a_crab_turns_with_the_vehicle() {
+    let observer = EstimatorParams {
+        observer: ObserverParams {
+            drift_tau: 20.0,
+            ..ObserverParams::default()
+        },
+        ..params(true)
+    };
+    // An arc of R 20 m (0.15 rad/s) for 90 s, 6 cm/s to the vehicle's right (a side draft).
+    let crab = (-0.06, Vec2::zeros());
+    let start = Pose::new(0.0, 0.0, 0.0);
+    let mut errors = Vec::new();
+    for work in [true, false] {
+        let mut e = Estimator::new(observer.clone());
+        let end = drive_curve(&mut e, 0.0, 90.0, start, 0.15, crab, work);
+        errors.push(drift_error_across(&e, end.heading, crab));
+    }
+    // On a work path the drift turns with the heading once learnt; a world vector learnt over
+    // 20 s trails a heading that turns a radian in 7 s.
+    assert!(errors[0] < 0.01 && errors[1] > 0.03, "{errors:?}");
+}
+
+#[test]
+fn a_headland_turn_carries_a_crab_known_from_both_directions_but_not_a_ground_drift() {
+    let observer = EstimatorParams {
+        observer: ObserverParams {
+            drift_tau: 20.0,
+            ..ObserverParams::default()
+        },
+        ..params(true)
+    };
+    // Passes north, south and north again (40 s each), a half circle of R 3 m (1 rad/s)
+    // between: the error across the heading 1 s into the third pass's start, and a second
+    // later, with a crab and with a ground drift.
+    for (drift, carried) in [
+        ((-0.06, Vec2::zeros()), true),
+        ((0.0, v2(0.06, 0.0)), false),
+    ] {
+        let mut e = Estimator::new(observer.clone());
+        let mut at = Pose::new(0.0, 0.0, FRAC_PI_2);
+        let mut t = 0.0;
+        for pass in 0..2 {
+            at = drive_curve(&mut e, t, 40.0, at, 0.0, drift, true);
+            let rate = if pass == 0 { 1.0 } else { -1.0 };
+            at = drive_curve(&mut e, t + 40.0, PI, at, rate, drift, false);
+            t += 40.0 + PI;
+        }
+        // The turn has just ended, heading north again: a crab turned with the vehicle (a
+        // world vector kept through the turn would be 12 cm/s off), a ground drift stayed.
+        assert_eq!(e.curve_carried(), carried, "{drift:?}");
+        let turned = drift_error_across(&e, at.heading, drift);
+        at = drive_curve(&mut e, t, 1.0, at, 0.0, drift, true);
+        let error = drift_error_across(&e, at.heading, drift);
+        assert!(
+            turned < 0.01 && error < 0.01,
+            "{drift:?}: {turned}, {error}"
+        );
+    }
 }

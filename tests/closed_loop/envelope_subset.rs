@@ -43,6 +43,9 @@ const CELLS: &[(&str, &str, f64)] = &[
     // Session 14: the drift kept per direction of straight driving (a 5 kN side draft's crab
     // flipped with every pass: 12.08 cm RMS before).
     ("side_draft_5kN", "straight_10kmh", 0.63),
+    // Session 16: on curves a drift known to be the vehicle's turns with the heading (the side
+    // draft's crab on R 15 m arcs: 14.1 cm RMS before).
+    ("side_draft_5kN", "curve_r15", 2.49),
 ];
 
 #[test]
