@@ -43,8 +43,11 @@
 //!   takes its sector's drift across the heading, if learnt, as the way back does above (the
 //!   carried one is right only in its vehicle part; a slope adds a ground part).
 //!
-//! A ground drift, or one not yet known (the first turn), goes through a turn as a world
-//! vector, as before. The understeering tyres' crab on an arc flips with the arc's direction
+//! A ground drift goes through a turn as a world vector, as before. One not yet known (the first
+//! turn: no way back learnt) is as likely the vehicle's as the ground's, so the next line starts
+//! its drift across the heading from zero and learns it afresh (the expected value; half the
+//! error either way: the side draft's first line at 15 km/h 15.9 → 12.7 cm max, a slope's
+//! first line start a few millimetres worse). The understeering tyres' crab on an arc flips with the arc's direction
 //! and is carried into the next arc wrong: tractor_b's R 15 m 3.27 → 3.96 cm (docs/envelope.md,
 //! Session 16).
 
@@ -217,6 +220,9 @@ pub(super) struct CurveDrift {
     turn_carries_crab: bool,
     /// The current work path started with a drift a turn carried as the vehicle's.
     carried_in: bool,
+    /// The current headland turn came from a line whose drift was not known to be the
+    /// vehicle's or the ground's.
+    turn_unknown: bool,
     /// Time the drift has been learnt on curves of this work path, s.
     line_learnt: f64,
 }
@@ -247,7 +253,20 @@ impl Estimator {
             self.curve.turn_carries_crab = self.fix_pose.is_some_and(|pose| {
                 self.drift_is_vehicles(pose.heading) && (curved || self.crab_known(pose.heading))
             });
+            self.curve.turn_unknown = !curved
+                && self.fix_pose.is_some_and(|pose| {
+                    self.drift_is_vehicles(pose.heading)
+                        && self.drift_memory.opposite(pose.heading).is_none()
+                });
         } else if work && !self.curve.work {
+            // After a turn from a line whose drift was neither known to be the vehicle's nor
+            // the ground's, the drift across the new line is as likely the carried one as its
+            // opposite: start it from zero and learn it afresh.
+            if let (true, Some(pose)) = (self.curve.turn_unknown, self.fix_pose) {
+                let n = left_normal(&heading_vec(pose.heading));
+                self.drift -= n * n.dot(&self.drift);
+                self.lateral.relearn_across(&n);
+            }
             self.curve.carried_in = self.curve.turn_carries_crab;
             self.curve.line_learnt = 0.0;
         }
