@@ -47,9 +47,9 @@
 //! turn: no way back learnt) is as likely the vehicle's as the ground's, so the next line starts
 //! its drift across the heading from zero and learns it afresh (the expected value; half the
 //! error either way: the side draft's first line at 15 km/h 15.9 → 12.7 cm max, a slope's
-//! first line start a few millimetres worse). The understeering tyres' crab on an arc flips with the arc's direction
-//! and is carried into the next arc wrong: tractor_b's R 15 m 3.27 → 3.96 cm (docs/envelope.md,
-//! Session 16).
+//! first line start a few millimetres worse). The understeering tyres' crab on an arc flips
+//! with the arc's direction and is carried into the next arc wrong: tractor_b's R 15 m 3.27 →
+//! 3.96 cm (Session 16 of docs/envelope.md).
 
 use super::Estimator;
 use crate::geo::{heading_vec, left_normal, v2, wrap_angle, Vec2};

@@ -77,7 +77,8 @@ pub struct EstimatorParams {
 ///   the lateral innovation Δl ≈ (d − d̂)·n·Δt, n the vehicle's left normal. Only the component
 ///   along n is observable on a straight pass; kept as a world vector, a drift that is fixed on
 ///   the ground (downhill) keeps its sign when the direction of travel flips, and per direction
-///   of straight driving where a large one flips with it (a side draft's crab, [`drift_memory`]);
+///   of straight driving where a large one flips with it (a side draft's crab, [`drift_memory`]),
+///   turning with the heading on curves where it is known to be the vehicle's;
 /// * a side-slope slip coefficient `c` (vehicle frame, m/s per rad of roll), see
 ///   [`ObserverParams::slip_tau`], from the same lateral innovation.
 ///

@@ -20,7 +20,6 @@ pub mod coverage;
 pub mod job;
 pub mod maneuver;
 pub mod skip_order;
-mod skip_order_table;
 pub mod turns;
 pub mod types;
 

@@ -18,6 +18,8 @@
 //! block size and so drives a last block of `N` lines (when `line_num` is a multiple of `N`)
 //! in the first block's order, whose end keeps the gap a next block would need.
 
+mod table;
+
 pub use crate::plan::turns::GAP_TOLERANCE;
 
 /// Largest block solved exactly (Held–Karp over subsets); larger blocks use a bounded search.
@@ -176,12 +178,12 @@ pub fn solve_block_order(n: usize, min_gap: usize, next_block: bool) -> BlockOrd
 /// Exact order: first with short moves forbidden (the usual, feasible case, which also only
 /// visits the allowed moves and so runs about twice as fast), then, if that has no solution,
 /// with short moves allowed at [`SHORT_MOVE_COST`] each.
-/// Blocks of [`super::skip_order_table::TABLE_MIN_LINES`]`..=`[`EXACT_MAX_LINES`] lines are
-/// looked up in the table of this function's answers (`skip_order_table`, made by it and
+/// Blocks of [`table::TABLE_MIN_LINES`]`..=`[`EXACT_MAX_LINES`] lines are
+/// looked up in the table of this function's answers (`skip_order/table.rs`, made by it and
 /// checked against it by the tests): a block of 20 lines cost ~5 ms, and a plan at w 3 m,
 /// r_min 8 m (blocks of 13 lines, last blocks of 13–25) up to 18 ms for its few sizes.
 fn held_karp(n: usize, min_gap: usize, next_block: bool) -> Vec<usize> {
-    super::skip_order_table::exact_order(n, min_gap, next_block)
+    table::exact_order(n, min_gap, next_block)
         .unwrap_or_else(|| held_karp_solve(n, min_gap, next_block))
 }
 
@@ -569,7 +571,7 @@ pub(crate) mod tests {
     /// (looked up as `n`: every move is short then, whatever `min_gap`).
     #[test]
     fn the_table_of_exact_orders_is_the_solvers() {
-        use crate::plan::skip_order_table::{exact_order, TABLE_MIN_LINES};
+        use table::{exact_order, TABLE_MIN_LINES};
         let largest = if cfg!(debug_assertions) {
             16
         } else {
@@ -590,12 +592,12 @@ pub(crate) mod tests {
         assert_eq!(exact_order(EXACT_MAX_LINES + 1, 3, true), None);
     }
 
-    /// Writes `src/plan/skip_order_table.rs`'s table (`cargo test --release --lib
+    /// Writes `src/plan/skip_order/table.rs`'s table (`cargo test --release --lib
     /// print_the_table_of_exact_orders -- --ignored --nocapture`).
     #[test]
     #[ignore]
     fn print_the_table_of_exact_orders() {
-        use crate::plan::skip_order_table::{DIGITS, TABLE_MIN_LINES};
+        use table::{DIGITS, TABLE_MIN_LINES};
         for n in TABLE_MIN_LINES..=EXACT_MAX_LINES {
             for min_gap in 0..=n {
                 for next_block in [false, true] {

@@ -1,11 +1,11 @@
-//! The exact block orders of [`super::skip_order`] for blocks of [`TABLE_MIN_LINES`] to
-//! [`super::skip_order::EXACT_MAX_LINES`] lines, as its Held–Karp solver gives them: a pure
+//! The exact block orders of [`super`] for blocks of [`TABLE_MIN_LINES`] to
+//! [`super::EXACT_MAX_LINES`] lines, as its Held–Karp solver gives them: a pure
 //! function of three small integers (lines, `min_gap`, a next block or not), looked up instead
 //! of solved (a block of 20 lines took ~5 ms to solve). Written by the ignored test
 //! `print_the_table_of_exact_orders` and checked entry by entry against the solver by
 //! `the_table_of_exact_orders_is_the_solvers` (plan::skip_order::tests).
 
-use super::skip_order::EXACT_MAX_LINES;
+use super::EXACT_MAX_LINES;
 
 /// Smallest block in the table, lines (smaller ones solve in well under a millisecond).
 pub(crate) const TABLE_MIN_LINES: usize = 12;
