@@ -563,18 +563,23 @@ fn small_angle_sin_cos_and_rotations_match_the_library() {
     assert!((sc.0 - th.sin()).abs() < 1e-13 && (sc.1 - th.cos()).abs() < 1e-13);
 }
 
-/// Four passes north and south (60 s at 3 m/s each, 3 m apart) with the drift (world, m/s)
-/// `drift_of(pass, left)` on each (`left` the vehicle's left normal), driving straight
-/// (`straight`, the memory of the drift per direction on) or not: the error of the estimated
-/// drift across the heading 1 s into each pass, m/s.
-fn crab_passes(drift_of: impl Fn(usize, Vec2) -> Vec2, straight: bool) -> Vec<f64> {
-    let mut e = Estimator::new(EstimatorParams {
+/// An estimator with the drift observer alone (time constant 20 s).
+fn drift_observer() -> Estimator {
+    Estimator::new(EstimatorParams {
         observer: ObserverParams {
             drift_tau: 20.0,
             ..ObserverParams::default()
         },
         ..params(true)
-    });
+    })
+}
+
+/// Four passes north and south (60 s at 3 m/s each, 3 m apart) with the drift (world, m/s)
+/// `drift_of(pass, left)` on each (`left` the vehicle's left normal), driving straight
+/// (`straight`, the memory of the drift per direction on) or not: the error of the estimated
+/// drift across the heading 1 s into each pass, m/s.
+fn crab_passes(drift_of: impl Fn(usize, Vec2) -> Vec2, straight: bool) -> Vec<f64> {
+    let mut e = drift_observer();
     e.set_straight(straight);
     let mut errors = Vec::new();
     for pass in 0..4 {
@@ -662,19 +667,12 @@ fn drift_error_across(e: &Estimator, heading: f64, (crab, ground): (f64, Vec2)) 
 
 #[test]
 fn on_a_curved_work_path_a_crab_turns_with_the_vehicle() {
-    let observer = EstimatorParams {
-        observer: ObserverParams {
-            drift_tau: 20.0,
-            ..ObserverParams::default()
-        },
-        ..params(true)
-    };
     // An arc of R 20 m (0.15 rad/s) for 90 s, 6 cm/s to the vehicle's right (a side draft).
     let crab = (-0.06, Vec2::zeros());
     let start = Pose::new(0.0, 0.0, 0.0);
     let mut errors = Vec::new();
     for work in [true, false] {
-        let mut e = Estimator::new(observer.clone());
+        let mut e = drift_observer();
         let end = drive_curve(&mut e, 0.0, 90.0, start, 0.15, crab, work);
         errors.push(drift_error_across(&e, end.heading, crab));
     }
@@ -685,13 +683,6 @@ fn on_a_curved_work_path_a_crab_turns_with_the_vehicle() {
 
 #[test]
 fn a_headland_turn_carries_a_crab_known_from_both_directions_but_not_a_ground_drift() {
-    let observer = EstimatorParams {
-        observer: ObserverParams {
-            drift_tau: 20.0,
-            ..ObserverParams::default()
-        },
-        ..params(true)
-    };
     // Passes north, south and north again (40 s each), a half circle of R 3 m (1 rad/s)
     // between: the error across the heading 1 s into the third pass's start, and a second
     // later, with a crab and with a ground drift.
@@ -699,7 +690,7 @@ fn a_headland_turn_carries_a_crab_known_from_both_directions_but_not_a_ground_dr
         ((-0.06, Vec2::zeros()), true),
         ((0.0, v2(0.06, 0.0)), false),
     ] {
-        let mut e = Estimator::new(observer.clone());
+        let mut e = drift_observer();
         let mut at = Pose::new(0.0, 0.0, FRAC_PI_2);
         let mut t = 0.0;
         for pass in 0..2 {
