@@ -247,17 +247,19 @@ impl Estimator {
     /// whether the headland turn carries its drift as the vehicle's ([the module](self)).
     pub fn set_work(&mut self, work: bool) {
         if self.curve.work && !work {
-            // A curved line whose drift already turned with the vehicle, or a straight one
-            // whose way back kept the drift on the other side.
+            // Carried: a curved line whose drift already turned with the vehicle, or a
+            // straight one whose way back kept the drift on the other side. Unknown: a
+            // straight one with no way back learnt yet.
             let curved = self.curve.line_learnt >= MIN_LEARNT_S;
-            self.curve.turn_carries_crab = self.fix_pose.is_some_and(|pose| {
-                self.drift_is_vehicles(pose.heading) && (curved || self.crab_known(pose.heading))
-            });
-            self.curve.turn_unknown = !curved
-                && self.fix_pose.is_some_and(|pose| {
-                    self.drift_is_vehicles(pose.heading)
-                        && self.drift_memory.opposite(pose.heading).is_none()
-                });
+            let (carries, unknown) = match self.fix_pose {
+                Some(pose) if self.drift_is_vehicles(pose.heading) => (
+                    curved || self.crab_known(pose.heading),
+                    !curved && self.drift_memory.opposite(pose.heading).is_none(),
+                ),
+                _ => (false, false),
+            };
+            self.curve.turn_carries_crab = carries;
+            self.curve.turn_unknown = unknown;
         } else if work && !self.curve.work {
             // After a turn from a line whose drift was neither known to be the vehicle's nor
             // the ground's, the drift across the new line is as likely the carried one as its

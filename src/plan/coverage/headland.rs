@@ -187,6 +187,15 @@ fn disc(centre: Vec2, r: f64) -> Area {
     )
 }
 
+/// The disc of radius `r` about `centre` cut to its cap that can meet `area`
+/// ([`super::disc_caps::cap`]); `None` when it cannot meet it.
+fn capped_disc(centre: Vec2, r: f64, area: &[Area]) -> Option<Area> {
+    let (ring, _) = disc(centre, r);
+    // The polygon's vertices lie outside the circle of radius r (`disc`): the cut takes theirs.
+    let rr = ring.first().map_or(0.0, |v| (v - centre).norm());
+    super::disc_caps::cap(ring, centre, rr, area).map(|cap| (cap, vec![]))
+}
+
 /// Unit bisector of the corner at `ring[i]` pointing to the ring's left (the inside of a
 /// counter-clockwise ring); `None` for a spike that folds back on itself.
 fn left_bisector(ring: &[Vec2], i: usize) -> Option<Vec2> {
@@ -408,62 +417,40 @@ pub fn passes_around(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoveragePar
 /// the area is narrow (up to 0.3 s a pass).
 fn eroded_pass_area(boundary: &[Vec2], obstacles: &[Vec<Vec2>], d: f64, rs: f64) -> Vec<Area> {
     let mut area = offset(&[(boundary.to_vec(), vec![])], -(d + rs));
-    // The areas taken out, each with its centre when it is a disc.
-    let mut centres: Vec<Option<Vec2>> = corner_disc_centres(boundary, d, rs)
-        .into_iter()
-        .map(Some)
-        .collect();
-    if !obstacles.is_empty() {
-        // An obstacle's convex corners turn right for the field around it: walk each
-        // obstacle clockwise so they are the right-hand turns.
-        centres.extend(obstacles.iter().flat_map(|o| {
-            let cw: Vec<Vec2> = o.iter().rev().copied().collect();
-            corner_disc_centres(&cw, d, rs).into_iter().map(Some)
-        }));
-    }
-    let mut discs: Vec<Area> = centres
-        .iter()
-        .flatten()
-        .map(|&c| disc(c, 2.0 * rs))
-        .collect();
-    if !obstacles.is_empty() {
+    let mut centres = corner_disc_centres(boundary, d, rs);
+    // An obstacle's convex corners turn right for the field around it: walk each obstacle
+    // clockwise so they are the right-hand turns.
+    centres.extend(obstacles.iter().flat_map(|o| {
+        let cw: Vec<Vec2> = o.iter().rev().copied().collect();
+        corner_disc_centres(&cw, d, rs)
+    }));
+    let grown = if obstacles.is_empty() {
+        Vec::new()
+    } else {
         let rings: Vec<Area> = obstacles.iter().map(|o| (o.clone(), vec![])).collect();
-        let grown = offset(&rings, d + rs);
-        centres.extend(grown.iter().map(|_| None));
-        discs.extend(grown);
+        offset(&rings, d + rs)
+    };
+    if area.is_empty() || (centres.is_empty() && grown.is_empty()) {
+        return area;
     }
-    if !discs.is_empty() && !area.is_empty() {
-        // Each corner disc cut to its cap that can meet what is left of the area (the rest of
-        // it lies outside the area or in a grown obstacle; see [`super::disc_caps`]). The
-        // grown obstacles (those without holes) count as holes of the area there.
-        let grown_holes: Vec<Vec<Vec2>> = discs
-            .iter()
-            .zip(&centres)
-            .filter(|(d, c)| c.is_none() && d.1.is_empty())
-            .map(|(d, _)| d.0.clone())
-            .collect();
-        let left: Vec<Area> = area
-            .iter()
-            .map(|(outer, holes)| {
-                let mut holes = holes.clone();
-                holes.extend(grown_holes.iter().cloned());
-                (outer.clone(), holes)
-            })
-            .collect();
-        let capped: Vec<Area> = discs
-            .into_iter()
-            .zip(centres)
-            .filter_map(|(d, c)| match c {
-                Some(c) => {
-                    let rr = d.0.first().map_or(0.0, |q| (q - c).norm());
-                    super::disc_caps::cap(d.0, c, rr, &left).map(|cap| (cap, vec![]))
-                }
-                None => Some(d),
-            })
-            .collect();
-        if !capped.is_empty() {
-            area = difference_of_union(&area, &capped);
-        }
+    // Each corner disc cut to its cap that can meet what is left of the area (the rest of it
+    // lies outside the area or in a grown obstacle; see [`super::disc_caps`]). The grown
+    // obstacles (those without holes) count as holes of the area there.
+    let left: Vec<Area> = area
+        .iter()
+        .map(|(outer, holes)| {
+            let mut holes = holes.clone();
+            holes.extend(grown.iter().filter(|g| g.1.is_empty()).map(|g| g.0.clone()));
+            (outer.clone(), holes)
+        })
+        .collect();
+    let mut taken: Vec<Area> = centres
+        .into_iter()
+        .filter_map(|c| capped_disc(c, 2.0 * rs, &left))
+        .collect();
+    taken.extend(grown);
+    if !taken.is_empty() {
+        area = difference_of_union(&area, &taken);
     }
     area
 }
@@ -485,10 +472,7 @@ fn open_without_kinks(eroded: &[Area], rs: f64, p: &CoverageParams) -> Vec<Area>
         }
         // (Each cut to its cap that can meet `eroded`, as the corner discs are.)
         kink_discs.extend(kinks.iter().filter_map(|(q, out)| {
-            let c = q + out * (rs - KINK_DISC_DEPTH);
-            let (ring, _) = disc(c, 2.0 * rs);
-            let rr = ring.first().map_or(0.0, |v| (v - c).norm());
-            super::disc_caps::cap(ring, c, rr, eroded).map(|cap| (cap, vec![]))
+            capped_disc(q + out * (rs - KINK_DISC_DEPTH), 2.0 * rs, eroded)
         }));
         if kink_discs.is_empty() {
             break;

@@ -196,6 +196,8 @@ pub fn clear_transit(
     step: f64,
     clear: &dyn Fn(&Vec2) -> bool,
 ) -> Option<Vec<Vec2>> {
+    // Lengths first; points only for the words tried, shortest first, each given up at its
+    // first point that is not clear.
     words_by_length(p1, h1, p2, h2, r)
         .iter()
         .find_map(|curve| curve.points(step, clear))
@@ -212,15 +214,11 @@ pub fn transit(
     step: f64,
     clear: &dyn Fn(&Vec2) -> bool,
 ) -> Option<(Vec<Vec2>, bool)> {
-    // Lengths first; points only for the words tried, shortest first, each given up at its
-    // first point that is not clear.
-    let words = words_by_length(p1, h1, p2, h2, r);
-    for curve in &words {
-        if let Some(pts) = curve.points(step, clear) {
-            return Some((pts, true));
-        }
+    if let Some(pts) = clear_transit(p1, h1, p2, h2, r, step, clear) {
+        return Some((pts, true));
     }
-    Some((words.first()?.points(step, &|_| true)?, false))
+    let shortest = words_by_length(p1, h1, p2, h2, r).into_iter().next()?;
+    Some((shortest.points(step, &|_| true)?, false))
 }
 
 /// Clear waypoints on a square grid: the nodes of [`route_graph`], with the test of the points
@@ -397,16 +395,16 @@ pub fn route_graph(
     grid: &WaypointGrid,
     max_expansions: usize,
 ) -> Option<Vec<Vec2>> {
-    let key = [p1.x, p1.y, h1, p2.x, p2.y, h2, r, step].map(f64::to_bits);
+    let bits = f64::to_bits;
     let key = [
-        key[0],
-        key[1],
-        key[2],
-        key[3],
-        key[4],
-        key[5],
-        key[6],
-        key[7],
+        bits(p1.x),
+        bits(p1.y),
+        bits(h1),
+        bits(p2.x),
+        bits(p2.y),
+        bits(h2),
+        bits(r),
+        bits(step),
         max_expansions as u64,
     ];
     if let Some(answer) = grid.answers.borrow().get(&key) {
