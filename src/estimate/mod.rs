@@ -83,7 +83,7 @@ pub struct EstimatorParams {
 ///   [`ObserverParams::slip_tau`], from the same lateral innovation.
 ///
 /// The offset's estimate moves by Δt/τ of the innovation's measurement of its error, a
-/// first-order filter with time constant τ; τ starts at 1 s and grows with the time learnt up
+/// first-order filter with time constant τ; τ starts at 3 s and grows with the time learnt up
 /// to the configured value, as a Kalman filter's gain falls from its initial covariance to the
 /// steady state. The drift and the slip share one measurement and are estimated together by a
 /// three-state Kalman filter ([`LateralFilter`]) tuned to the same time constants. Innovations
@@ -191,8 +191,22 @@ struct Innovation {
 /// The offset is learnt only below this wheel angle, rad (the linearisation holds and the
 /// actuator is not slewing through a turn).
 const BIAS_MAX_WHEEL: f64 = 0.2;
-/// Shortest effective time constant at the start of learning, s.
+/// Shortest effective time constant at the start of learning, s: the slip coefficient's.
 const MIN_TAU: f64 = 1.0;
+/// The priors of the offset and the drift at the start of a job: their first estimates weigh a
+/// disturbance of zero as this many seconds of fixes, s. The innovations of consecutive fixes
+/// telescope, so an estimate learnt over t s carries the noise of two fixes over t (position
+/// noise σ: σ·√2/t on the drift; heading noise σθ: σθ·√2·L/(v·t) on the offset), and with a
+/// 1 s prior a job's first seconds steered by a drift and an offset that were not there: 2 cm
+/// off the line 10–20 m into the first pass at 15 km/h (1 cm fixes, 0.1° heading), where the
+/// references, which learn nothing, stayed within 0.7 cm. Swept over the envelope (offset
+/// 1–5 s × drift 1–3 s; docs/envelope.md, Session 17: the observer's priors): every offset
+/// prior of 2–4 s with a 2 s drift prior gained 6–7 cells and lost none; a longer drift prior
+/// delays a side draft's crab and a slope's drift at the start. A drift learnt afresh across a line after a turn
+/// ([`LateralFilter::relearn_across`]) starts from the 1 s prior: the slope's drift is then
+/// known to be there and a 2 s one put the nominal slope 14 % over its suite figure.
+const BIAS_PRIOR_S: f64 = 3.0;
+const DRIFT_PRIOR_S: f64 = 2.0;
 /// The roll at which the slip coefficient's estimate has the time constant
 /// [`ObserverParams::slip_tau`], rad (2°): at a steeper slope it learns faster, on flat ground
 /// it is left alone.
@@ -437,7 +451,7 @@ impl Estimator {
         let (dt, t_prev, d_heading, d_lateral, n) =
             (i.dt, i.t_prev, i.heading, i.lateral, i.normal);
         self.learnt += dt;
-        let tau = |configured: f64| configured.min(self.learnt.max(MIN_TAU));
+        let tau = |configured: f64| configured.min(self.learnt.max(BIAS_PRIOR_S));
         // The wheel angle over the interval, less the offset.
         let delta = self.wheel_angle_at(t_prev + 0.5 * dt) - self.bias;
         if o.bias_tau > 0.0 && delta.abs() < BIAS_MAX_WHEEL {

@@ -117,9 +117,13 @@ fn within_the_rate(
         return out;
     }
     let v = speed.abs();
-    // The wheel-angle rate the correction of `o` asks for, rad/s.
+    // The wheel-angle rate the correction of `o` asks for, rad/s. What the path itself needs
+    // is its mean curvature over the look-ahead: the circle through the nearest point, the
+    // point half-way and the preview point ([`span_curvature`]).
+    let points = local.points();
     let asks = |o: &TrackOutput| {
-        let needed = (params.wheelbase * o.path_curvature).atan();
+        let needed =
+            (params.wheelbase * span_curvature(points, local.index_local(), o.lookahead)).atan();
         (o.wheel_angle - needed).abs() * std::f64::consts::SQRT_2 * v / o.lookahead
     };
     let allowed = RATE_SHARE * rate;
@@ -146,6 +150,16 @@ fn within_the_rate(
         }
     }
     best
+}
+
+/// The path's mean curvature over the look-ahead `ld` from sample `start`, 1/m: the circle
+/// through the points 0, `ld`/2 and `ld` along it. A correction is the command less this: the
+/// curvature at the preview point alone counts the path's own way into or out of an arc as a
+/// correction (an arc's exit, the preview on the straight, would be "corrected" towards the
+/// straight and the arc left early), and a 2 m chord on a turn whose nodes are metres apart
+/// reads 0 between two nodes.
+fn span_curvature(points: &[crate::geo::Vec2], start: usize, ld: f64) -> f64 {
+    curvature_along(points, start, 0.5 * ld, 0.5 * ld)
 }
 
 /// Half the chord over which the path's curvature at the preview point is measured, m.
@@ -252,5 +266,59 @@ mod tests {
         assert!((scheduled.lookahead - 1.2 * speed).abs() < 1e-9);
         assert!(asked(&scheduled, speed) > rate);
         assert!(scheduled.lookahead <= fast.lookahead && fast.lookahead < slow.lookahead);
+    }
+
+    /// The local path of an arc of radius `r` m (left, centre (0, r), from the origin, nodes
+    /// `spacing` m apart) of length `arc` m, then the straight on from its end, near `at`.
+    fn arc_then_straight(r: f64, arc: f64, spacing: f64, at: &crate::geo::Vec2) -> LocalPath {
+        use crate::geo::{v2, PathPoint};
+        use crate::track::local_path::LocalPathParams;
+        let end = arc / r;
+        let mut g: Vec<PathPoint> = (0..=(arc / spacing) as usize)
+            .map(|i| {
+                let a = i as f64 * spacing / r;
+                PathPoint::work(v2(r * a.sin(), r * (1.0 - a.cos())))
+            })
+            .collect();
+        let (p, t) = (
+            v2(r * end.sin(), r * (1.0 - end.cos())),
+            v2(end.cos(), end.sin()),
+        );
+        g.extend((1..30).map(|i| PathPoint::work(p + t * (i as f64 * spacing))));
+        let mut lp = LocalPath::new(&LocalPathParams {
+            nodes_before: 1,
+            nodes_after: 10,
+            ..Default::default()
+        });
+        let nearest = crate::track::local_path::nearest_global(&g, at, 0, g.len());
+        lp.rebuild(&g, nearest);
+        lp.nearest(at);
+        lp
+    }
+
+    #[test]
+    fn an_arc_followed_to_its_end_is_not_slowed_as_a_correction() {
+        // On an R 10 m arc 3 m before it ends in a straight, on the path and along it, at
+        // 15 km/h with a 10°/s steering: the command is the arc's own and no correction, so
+        // the rate bound leaves the look-ahead as scheduled. (Measured against the curvature
+        // at the preview point alone, on the straight, the arc's wheel angle counted as a
+        // correction, the look-ahead grew and the vehicle left the arc early: a turn's exit
+        // 30 cm off the next line.) Likewise in the middle of an arc of nodes 1.5 m apart,
+        // where a 2 m chord between two nodes reads a straight.
+        let law = PurePursuit::predictive(4.5);
+        let speed = 15.0 / 3.6;
+        let (r, arc) = (10.0, 12.0);
+        for (along, spacing) in [(arc - 3.0, 1.0), (4.0, 1.5), (4.7, 1.5), (5.3, 1.5)] {
+            let a: f64 = along / r;
+            let pose = Pose::new(r * a.sin(), r * (1.0 - a.cos()), a);
+            let local = arc_then_straight(r, arc, spacing, &pose.pos);
+            let slow = law.steer(&local, &pose, speed, None, &params(10.0));
+            let unbounded = law.steer(&local, &pose, speed, None, &params(0.0));
+            assert!(slow.valid && unbounded.valid);
+            assert_eq!(
+                slow.lookahead, unbounded.lookahead,
+                "{along} m along the arc, nodes {spacing} m apart"
+            );
+        }
     }
 }
