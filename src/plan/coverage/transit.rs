@@ -234,7 +234,12 @@ pub struct WaypointGrid<'a> {
     /// Node (i, j) at `j * nx + i` is usable.
     pub usable: Vec<bool>,
     /// Is a point of a curve clear?
-    clear: &'a dyn Fn(&Vec2) -> bool,
+    pub(super) clear: &'a dyn Fn(&Vec2) -> bool,
+    /// Spacing of the points checked on the straights between neighbouring nodes, m: the
+    /// clearance, half the thickness of the thinnest ground that is not clear.
+    pub(super) probe: f64,
+    /// The ways between neighbouring nodes by clear straights (see [`super::to_goal`]).
+    pub(super) links: RefCell<super::to_goal::Links>,
     /// The curves between nodes, solved once (see [`EdgeTable`]).
     edges: RefCell<EdgeTable>,
     /// The states of the searches that failed with nothing left to expand.
@@ -247,13 +252,15 @@ pub struct WaypointGrid<'a> {
 impl<'a> WaypointGrid<'a> {
     /// Nodes every `step` m over the box `lo`–`hi` where `clear` holds; at most `max_nodes`
     /// (the step grows to fit). The curves of every search on the grid keep `clear` at every
-    /// point.
+    /// point. `clearance`: the distance from the field's edges and obstacles `clear` keeps, m
+    /// (the ground that is not clear is at least twice that thick).
     pub fn new(
         lo: Vec2,
         hi: Vec2,
         step: f64,
         max_nodes: usize,
         clear: &'a dyn Fn(&Vec2) -> bool,
+        clearance: f64,
     ) -> Self {
         let span = hi - lo;
         let step = step.max((span.x.max(0.0) * span.y.max(0.0) / max_nodes.max(1) as f64).sqrt());
@@ -266,6 +273,8 @@ impl<'a> WaypointGrid<'a> {
             ny,
             usable: vec![false; nx * ny],
             clear,
+            probe: clearance.max(0.05),
+            links: RefCell::new(vec![[f32::NAN; 16]; nx * ny]),
             edges: RefCell::default(),
             closed: RefCell::default(),
             answers: RefCell::default(),
@@ -298,61 +307,18 @@ impl<'a> WaypointGrid<'a> {
         words
     }
 
-    /// Distance from every node to `goal` through usable nodes (8-neighbour moves), m;
-    /// infinite where the goal cannot be reached. Nodes within `radius` of the goal start at
-    /// their straight distance.
-    fn distances_to(&self, goal: &Vec2, radius: f64) -> Vec<f64> {
-        use std::cmp::Reverse;
-        let mut dist = vec![f64::INFINITY; self.usable.len()];
-        let mut heap = std::collections::BinaryHeap::new();
-        let key = |d: f64| Reverse((d * 1000.0) as u64);
-        for (k, q) in self.near(goal, radius) {
-            dist[k] = (q - goal).norm();
-            heap.push((key(dist[k]), k));
-        }
-        while let Some((Reverse(d), k)) = heap.pop() {
-            if (d as f64) > dist[k] * 1000.0 + 1.0 {
-                continue;
-            }
-            let (i, j) = ((k % self.nx) as i64, (k / self.nx) as i64);
-            for (di, dj) in [
-                (-1, -1),
-                (-1, 0),
-                (-1, 1),
-                (0, -1),
-                (0, 1),
-                (1, -1),
-                (1, 0),
-                (1, 1),
-            ] {
-                let Some(n) = self.index(i + di, j + dj) else {
-                    continue;
-                };
-                if !self.usable[n] {
-                    continue;
-                }
-                let nd = dist[k] + self.step * ((di * di + dj * dj) as f64).sqrt();
-                if nd < dist[n] {
-                    dist[n] = nd;
-                    heap.push((key(nd), n));
-                }
-            }
-        }
-        dist
-    }
-
-    fn node(&self, i: usize, j: usize) -> Vec2 {
+    pub(super) fn node(&self, i: usize, j: usize) -> Vec2 {
         self.origin + Vec2::new(i as f64 * self.step, j as f64 * self.step)
     }
 
     /// Index of node (`i`, `j`), if on the grid.
-    fn index(&self, i: i64, j: i64) -> Option<usize> {
+    pub(super) fn index(&self, i: i64, j: i64) -> Option<usize> {
         (i >= 0 && j >= 0 && (i as usize) < self.nx && (j as usize) < self.ny)
             .then(|| j as usize * self.nx + i as usize)
     }
 
     /// Usable nodes within `radius` m of `p`: (index, position).
-    fn near(&self, p: &Vec2, radius: f64) -> Vec<(usize, Vec2)> {
+    pub(super) fn near(&self, p: &Vec2, radius: f64) -> Vec<(usize, Vec2)> {
         let rel = (p - self.origin) / self.step;
         let reach = (radius / self.step).ceil() as i64;
         let (ci, cj) = (rel.x.round() as i64, rel.y.round() as i64);
@@ -434,8 +400,9 @@ fn search(
     /// The parent of the states joined to the start pose.
     const START: u32 = u32::MAX;
     let reach = 2.0 * grid.step * std::f64::consts::SQRT_2 + 1e-6;
-    // The heuristic: the distance to go through the grid (it knows the way around bays).
-    let to_goal = grid.distances_to(&p2, 3.0 * grid.step);
+    // Which nodes can reach the goal (`to_goal`), and the heuristic: the distance to go
+    // through the grid by clear straights (it knows the way around bays and slots).
+    let (to_goal, steer) = grid.distances_to(&p2, 3.0 * grid.step);
     let states = grid.usable.len() * H;
     let cell = |s: usize| (s / H % grid.nx, s / H / grid.nx);
     let pose = |s: usize| {
@@ -504,7 +471,7 @@ fn search(
                     continue;
                 }
                 from_start[s] = true;
-                let f = key(len + HEURISTIC_WEIGHT * to_goal[k]);
+                let f = key(len + HEURISTIC_WEIGHT * steer[k]);
                 if f < best[s] {
                     best[s] = f;
                     heap.push((Reverse(f), s as u32, START));
@@ -568,7 +535,7 @@ fn search(
                 (k, true)
             })
         };
-        let h_s = HEURISTIC_WEIGHT * to_goal[s / H];
+        let h_s = HEURISTIC_WEIGHT * steer[s / H];
         let g_from = if from == START {
             0.0
         } else {
@@ -696,7 +663,7 @@ fn search(
                 if !grid.usable[k] || !to_goal[k].is_finite() {
                     continue;
                 }
-                let h_to_go = HEURISTIC_WEIGHT * to_goal[k];
+                let h_to_go = HEURISTIC_WEIGHT * steer[k];
                 // The headings there with an edge (with a word) from this state, in order.
                 let mut has = to_mask[span_cell(di, dj) * H + s % H];
                 while has != 0 {

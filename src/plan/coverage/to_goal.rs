@@ -1,0 +1,165 @@
+//! The distance to go of the waypoint search of [`super::transit::route_graph`]: the shortest
+//! way from each grid node to the goal through the usable nodes, as the crow flies between
+//! neighbours.
+//!
+//! Two such distances are kept. The open one joins every two neighbouring usable nodes: it
+//! tells which nodes can reach the goal at all (a node it cannot is never used, and the
+//! failed searches' closed sets are built on it, see [`super::closed`]). The one the search
+//! steers by joins two neighbours only when the straight between them is clear: the open one
+//! steps across a boundary notch or a strip narrower than the grid's step as if it were not
+//! there, so a goal 20 m away across a slot looked 20 m away from every state on the near side,
+//! and the search expanded every state cheaper than the 800 m way round the slot's end
+//! (de_bb_concave, dk_marker_strip) before it went that way.
+
+use super::transit::WaypointGrid;
+use crate::geo::Vec2;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// The neighbour steps (di, dj) of the distance to steer by: the eight neighbours and the
+/// eight a knight's move away; step `d` and step `15 - d` are opposite.
+const STEPS: [(i64, i64); 16] = [
+    (-2, -1),
+    (-2, 1),
+    (-1, -2),
+    (-1, -1),
+    (-1, 0),
+    (-1, 1),
+    (-1, 2),
+    (0, -1),
+    (0, 1),
+    (1, -2),
+    (1, -1),
+    (1, 0),
+    (1, 1),
+    (1, 2),
+    (2, -1),
+    (2, 1),
+];
+
+/// The eight neighbours of the open distance (indices into [`STEPS`]).
+const EIGHT: [usize; 8] = [3, 4, 5, 7, 8, 10, 11, 12];
+const ALL: [usize; 16] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15];
+
+/// Per node and step ([`STEPS`]): the length of the way to the neighbour the distance to
+/// steer by takes (see [`WaypointGrid::link`]); NaN until asked, infinite when there is none.
+pub(super) type Links = Vec<[f32; 16]>;
+
+/// Where a link whose straight is not clear may bend: at these fractions of its length off
+/// its midpoint, to either side.
+const BENDS: [f64; 3] = [0.15, 0.3, 0.5];
+
+impl WaypointGrid<'_> {
+    /// The way from node `k` to its neighbour `n` (step `d`) by clear straights: the straight
+    /// when it is clear, else the shortest of two straights through a point off its midpoint
+    /// (a neck the straight clips, round a corner the curves bend round); `None` when neither
+    /// is. Found once per grid (both ways).
+    fn link(&self, k: usize, n: usize, d: usize) -> Option<f64> {
+        let known = self.links.borrow().get(k).map_or(f32::NAN, |l| l[d]);
+        if !known.is_nan() {
+            return known.is_finite().then_some(f64::from(known));
+        }
+        let (a, b) = (self.node_at(k), self.node_at(n));
+        let length = if self.segment_clear(a, b) {
+            Some((b - a).norm())
+        } else {
+            let mid = (a + b) * 0.5;
+            let across = crate::geo::left_normal(&(b - a));
+            BENDS
+                .iter()
+                .flat_map(|&f| [f, -f])
+                .map(|f| mid + across * f)
+                .find(|m| (self.clear)(m) && self.segment_clear(a, *m) && self.segment_clear(*m, b))
+                .map(|m| (m - a).norm() + (b - m).norm())
+        };
+        let value = length.map_or(f32::INFINITY, |l| l as f32);
+        let mut links = self.links.borrow_mut();
+        if let Some(l) = links.get_mut(k) {
+            l[d] = value;
+        }
+        if let Some(l) = links.get_mut(n) {
+            l[15 - d] = value;
+        }
+        length
+    }
+
+    /// Is the straight from `a` to `b` clear at points at most the probe spacing apart (the
+    /// ends not checked)?
+    fn segment_clear(&self, a: Vec2, b: Vec2) -> bool {
+        let m = ((b - a).norm() / self.probe).ceil().max(1.0) as usize;
+        (1..m).all(|t| (self.clear)(&(a + (b - a) * (t as f64 / m as f64))))
+    }
+
+    fn node_at(&self, k: usize) -> Vec2 {
+        self.node(k % self.nx, k / self.nx)
+    }
+
+    /// The distances to `goal` through usable nodes (8-neighbour moves), m; infinite where the
+    /// goal cannot be reached: first every two neighbours joined (the open distance), then only
+    /// those whose straight is clear (the distance to steer by; where it finds no way, the
+    /// open one). Nodes within `radius` of the goal start at their straight distance (for the
+    /// second, those whose straight to the goal is clear, or all of them when none is).
+    pub(super) fn distances_to(&self, goal: &Vec2, radius: f64) -> (Vec<f64>, Vec<f64>) {
+        let near = self.near(goal, radius);
+        let open = self.dijkstra(&near, goal, false);
+        let seen: Vec<(usize, Vec2)> = near
+            .iter()
+            .copied()
+            .filter(|(_, q)| self.segment_clear(*q, *goal))
+            .collect();
+        let seeds = if seen.is_empty() { &near } else { &seen };
+        let mut steer = self.dijkstra(seeds, goal, true);
+        for (s, o) in steer.iter_mut().zip(&open) {
+            if !s.is_finite() {
+                *s = *o;
+            }
+        }
+        (open, steer)
+    }
+
+    /// Dijkstra from `seeds` (at their straight distances to `goal`) over the usable nodes,
+    /// through the neighbours whose straight is clear when `straight`, else every neighbour.
+    fn dijkstra(&self, seeds: &[(usize, Vec2)], goal: &Vec2, straight: bool) -> Vec<f64> {
+        let mut dist = vec![f64::INFINITY; self.usable.len()];
+        let mut heap = BinaryHeap::new();
+        let key = |d: f64| Reverse((d * 1000.0) as u64);
+        for &(k, q) in seeds {
+            dist[k] = (q - goal).norm();
+            heap.push((key(dist[k]), k));
+        }
+        while let Some((Reverse(d), k)) = heap.pop() {
+            if (d as f64) > dist[k] * 1000.0 + 1.0 {
+                continue;
+            }
+            let (i, j) = ((k % self.nx) as i64, (k / self.nx) as i64);
+            let dirs: &[usize] = if straight { &ALL } else { &EIGHT };
+            for &dir in dirs {
+                let (di, dj) = STEPS[dir];
+                let Some(n) = self.index(i + di, j + dj) else {
+                    continue;
+                };
+                if !self.usable[n] {
+                    continue;
+                }
+                let step = self.step * ((di * di + dj * dj) as f64).sqrt();
+                if dist[k] + step >= dist[n] {
+                    continue;
+                }
+                let length = if straight {
+                    match self.link(k, n, dir) {
+                        Some(l) => l,
+                        None => continue,
+                    }
+                } else {
+                    step
+                };
+                let nd = dist[k] + length;
+                if nd < dist[n] {
+                    dist[n] = nd;
+                    heap.push((key(nd), n));
+                }
+            }
+        }
+        dist
+    }
+}
