@@ -94,14 +94,19 @@ impl WaypointGrid<'_> {
         self.node(k % self.nx, k / self.nx)
     }
 
-    /// The distances to `goal` through usable nodes (8-neighbour moves), m; infinite where the
-    /// goal cannot be reached: first every two neighbours joined (the open distance), then only
-    /// those whose straight is clear (the distance to steer by; where it finds no way, the
-    /// open one). Nodes within `radius` of the goal start at their straight distance (for the
-    /// second, those whose straight to the goal is clear, or all of them when none is).
-    pub(super) fn distances_to(&self, goal: &Vec2, radius: f64) -> (Vec<f64>, Vec<f64>) {
+    /// The open distances to `goal` through usable nodes (every two neighbours joined), m;
+    /// infinite where the goal cannot be reached. Nodes within `radius` of the goal start at
+    /// their straight distance.
+    pub(super) fn open_distances(&self, goal: &Vec2, radius: f64) -> Vec<f64> {
+        self.dijkstra(&self.near(goal, radius), goal, false)
+    }
+
+    /// The distances to steer by ([`Self::open_distances`] through clear straights only, m):
+    /// the nodes within `radius` of the goal whose straight to it is clear start at their
+    /// straight distance (all of them when none is clear); where this finds no way, the open
+    /// distance (`open`).
+    pub(super) fn steer_distances(&self, goal: &Vec2, radius: f64, open: &[f64]) -> Vec<f64> {
         let near = self.near(goal, radius);
-        let open = self.dijkstra(&near, goal, false);
         let seen: Vec<(usize, Vec2)> = near
             .iter()
             .copied()
@@ -109,12 +114,12 @@ impl WaypointGrid<'_> {
             .collect();
         let seeds = if seen.is_empty() { &near } else { &seen };
         let mut steer = self.dijkstra(seeds, goal, true);
-        for (s, o) in steer.iter_mut().zip(&open) {
+        for (s, o) in steer.iter_mut().zip(open) {
             if !s.is_finite() {
                 *s = *o;
             }
         }
-        (open, steer)
+        steer
     }
 
     /// Dijkstra from `seeds` (at their straight distances to `goal`) over the usable nodes,

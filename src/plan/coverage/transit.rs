@@ -400,9 +400,15 @@ fn search(
     /// The parent of the states joined to the start pose.
     const START: u32 = u32::MAX;
     let reach = 2.0 * grid.step * std::f64::consts::SQRT_2 + 1e-6;
-    // Which nodes can reach the goal (`to_goal`), and the heuristic: the distance to go
-    // through the grid by clear straights (it knows the way around bays and slots).
-    let (to_goal, steer) = grid.distances_to(&p2, 3.0 * grid.step);
+    // Which nodes can reach the goal (`to_goal`): none near the start, no way.
+    let to_goal = grid.open_distances(&p2, 3.0 * grid.step);
+    let start_nodes = grid.near(&p1, reach);
+    if start_nodes.iter().all(|(k, _)| !to_goal[*k].is_finite()) {
+        return None;
+    }
+    // The heuristic: the distance to go through the grid by clear straights (it knows the
+    // way round bays and slots).
+    let steer = grid.steer_distances(&p2, 3.0 * grid.step, &to_goal);
     let states = grid.usable.len() * H;
     let cell = |s: usize| (s / H % grid.nx, s / H / grid.nx);
     let pose = |s: usize| {
@@ -460,7 +466,7 @@ fn search(
     let mut done_at = vec![0u8; grid.usable.len()];
     let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::new();
     // Queue the start's neighbours with their shortest words' lengths.
-    for (k, q) in grid.near(&p1, reach) {
+    for (k, q) in start_nodes {
         if !to_goal[k].is_finite() {
             continue;
         }
