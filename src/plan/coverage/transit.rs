@@ -118,13 +118,18 @@ impl Csc {
     /// the last one the goal: every point lies on the curve and the chords are all alike, so
     /// three-point curvature never reads more than 1/r, even across the joins of the pieces.
     /// `None` when `clear` fails at a point: every [`CHECK_STRIDE`]th point is checked first
-    /// (a blocked curve is blocked along a stretch, found after a few checks), then the rest.
+    /// (a blocked curve is blocked along a stretch, found after a few checks), in halving
+    /// order ([`halving`]: a long curve through a blocked stretch in its middle is found out
+    /// after a few checks too), then the rest.
     pub(super) fn points(&self, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> Option<Vec<Vec2>> {
         let n = (self.length / step).ceil().max(1.0) as usize;
         let coarse = |k: usize| k % CHECK_STRIDE == CHECK_STRIDE / 2;
-        if !(CHECK_STRIDE / 2..=n)
-            .step_by(CHECK_STRIDE)
-            .all(|k| clear(&self.point_at(k, n)))
+        let strides = if n >= CHECK_STRIDE / 2 {
+            (n - CHECK_STRIDE / 2) / CHECK_STRIDE + 1
+        } else {
+            0
+        };
+        if !halving(strides).all(|m| clear(&self.point_at(CHECK_STRIDE / 2 + m * CHECK_STRIDE, n)))
         {
             return None;
         }
@@ -143,6 +148,19 @@ impl Csc {
 /// Points of a curve checked first (every this many, then the rest): the same answer as
 /// checking them in order, with fewer checks of a curve that is not clear.
 const CHECK_STRIDE: usize = 8;
+
+/// `0..n` in halving order: 0, then the multiples of the largest power of two below `n` not
+/// yet given, then of the next smaller one, and so on (0, 8, 4, 12, 2, 6, 10, 14, 1, … for
+/// n = 16): each index once, the points checked spread along the curve from the start.
+fn halving(n: usize) -> impl Iterator<Item = usize> {
+    let top = usize::BITS - n.max(1).leading_zeros();
+    (0..top).rev().flat_map(move |level| {
+        let s = 1usize << level;
+        (0..n)
+            .step_by(s)
+            .filter(move |&m| level + 1 == top || m % (2 * s) != 0)
+    })
+}
 
 /// Is `clear` true at every point of `pts` (each moved by `base`)? Every
 /// [`CHECK_STRIDE`]th point first, then the rest.
@@ -708,6 +726,21 @@ pub fn straight(a: Vec2, b: Vec2, step: f64) -> Vec<Vec2> {
 mod tests {
     use super::*;
     use crate::geo::v2;
+
+    /// The halving order gives every index once.
+    #[test]
+    fn halving_gives_every_index_once() {
+        for n in 0..70 {
+            let mut all: Vec<usize> = halving(n).collect();
+            assert_eq!(all.first().copied(), (n > 0).then_some(0));
+            all.sort_unstable();
+            assert_eq!(all, (0..n).collect::<Vec<_>>(), "n {n}");
+        }
+        assert_eq!(
+            halving(16).collect::<Vec<_>>(),
+            [0, 8, 4, 12, 2, 6, 10, 14, 1, 3, 5, 7, 9, 11, 13, 15]
+        );
+    }
 
     #[test]
     fn csc_ends_at_the_goal_with_bounded_curvature() {
