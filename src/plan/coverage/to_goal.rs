@@ -168,3 +168,49 @@ impl WaypointGrid<'_> {
         dist
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::geo::polygon::{contains_point, point_segment_distance};
+    use crate::geo::{v2, Vec2};
+    use crate::plan::coverage::transit::WaypointGrid;
+
+    /// A 200 × 100 m field with a slot 2 m wide cut 80 m up from its bottom edge between the
+    /// grid's columns at x 90 and 100 m, clear 1.5 m from the edges: from the node left of the
+    /// slot the goal just right of it is 7 m away for the open distance and round the slot's
+    /// end for the one to steer by.
+    #[test]
+    fn the_distance_to_steer_by_goes_round_a_slot() {
+        let boundary = [
+            v2(0.0, 0.0),
+            v2(92.0, 0.0),
+            v2(92.0, 80.0),
+            v2(94.0, 80.0),
+            v2(94.0, 0.0),
+            v2(200.0, 0.0),
+            v2(200.0, 100.0),
+            v2(0.0, 100.0),
+        ];
+        let half = 1.5;
+        let clear = |q: &Vec2| {
+            let n = boundary.len();
+            contains_point(&boundary, q)
+                && (0..n).all(|i| {
+                    point_segment_distance(q, &boundary[i], &boundary[(i + 1) % n]) >= half
+                })
+        };
+        let grid = WaypointGrid::new(v2(0.0, 0.0), v2(200.0, 100.0), 10.0, 20_000, &clear, half);
+        // Goal just right of the slot, 20 m up; the node left of it at (90, 20).
+        let goal = v2(97.0, 20.0);
+        let open = grid.open_distances(&goal, 30.0);
+        let steer = grid.steer_distances(&goal, 30.0, &open);
+        let k = 2 * grid.nx + 9;
+        assert!((grid.node(9, 2) - v2(90.0, 20.0)).norm() < 1e-9);
+        assert!((open[k] - 7.0).abs() < 1e-9, "open {}", open[k]);
+        // Round the slot's end (y ≥ 81.5): about 2 × 62 m up and down.
+        assert!(steer[k] > 120.0 && steer[k] < 170.0, "steer {}", steer[k]);
+        // Nodes on the goal's side see it straight.
+        let right = 2 * grid.nx + 10;
+        assert!((steer[right] - open[right]).abs() < 1e-9);
+    }
+}
