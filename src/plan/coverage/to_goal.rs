@@ -125,7 +125,7 @@ impl WaypointGrid<'_> {
     /// Dijkstra from `seeds` (at their straight distances to `goal`) over the usable nodes,
     /// through the neighbours whose straight is clear when `straight`, else every neighbour.
     fn dijkstra(&self, seeds: &[(usize, Vec2)], goal: &Vec2, straight: bool) -> Vec<f64> {
-        let mut dist = vec![f64::INFINITY; self.usable.len()];
+        let mut dist = vec![f64::INFINITY; self.node_count()];
         let mut heap = BinaryHeap::new();
         let key = |d: f64| Reverse((d * 1000.0) as u64);
         for &(k, q) in seeds {
@@ -143,7 +143,7 @@ impl WaypointGrid<'_> {
                 let Some(n) = self.index(i + di, j + dj) else {
                     continue;
                 };
-                if !self.usable[n] {
+                if !self.usable(n) {
                     continue;
                 }
                 let step = self.step * ((di * di + dj * dj) as f64).sqrt();

@@ -249,8 +249,11 @@ pub struct WaypointGrid<'a> {
     pub step: f64,
     pub nx: usize,
     pub ny: usize,
-    /// Node (i, j) at `j * nx + i` is usable.
-    pub usable: Vec<bool>,
+    /// Node (i, j) at `j * nx + i` is usable: 1, not: 2, not yet asked: 0 (a search's
+    /// distances reach only the nodes of its goal's part of the field: asking every node
+    /// cost a plan whose searches fail at once, as between parts joined by a neck too narrow
+    /// to turn through, more than its searches).
+    usable: RefCell<Vec<u8>>,
     /// Is a point of a curve clear?
     pub(super) clear: &'a dyn Fn(&Vec2) -> bool,
     /// Spacing of the points checked on the straights between neighbouring nodes, m: the
@@ -284,25 +287,37 @@ impl<'a> WaypointGrid<'a> {
         let step = step.max((span.x.max(0.0) * span.y.max(0.0) / max_nodes.max(1) as f64).sqrt());
         let nx = (span.x / step).floor().max(0.0) as usize + 1;
         let ny = (span.y / step).floor().max(0.0) as usize + 1;
-        let mut grid = WaypointGrid {
+        WaypointGrid {
             origin: lo,
             step,
             nx,
             ny,
-            usable: vec![false; nx * ny],
+            usable: RefCell::new(vec![0; nx * ny]),
             clear,
             probe: clearance.max(0.05),
             links: RefCell::new(vec![[f32::NAN; 16]; nx * ny]),
             edges: RefCell::default(),
             closed: RefCell::default(),
             answers: RefCell::default(),
-        };
-        for j in 0..ny {
-            for i in 0..nx {
-                grid.usable[j * nx + i] = clear(&grid.node(i, j));
-            }
         }
-        grid
+    }
+
+    /// The number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Is node `k` (at `j * nx + i`) usable: `clear` at it? Asked once.
+    pub fn usable(&self, k: usize) -> bool {
+        let known = self.usable.borrow().get(k).copied().unwrap_or(2);
+        if known != 0 {
+            return known == 1;
+        }
+        let ok = (self.clear)(&self.node(k % self.nx, k / self.nx));
+        if let Some(x) = self.usable.borrow_mut().get_mut(k) {
+            *x = if ok { 1 } else { 2 };
+        }
+        ok
     }
 
     /// The words of the edge from a node with heading index `ha` to the node (`di`, `dj`)
@@ -345,7 +360,7 @@ impl<'a> WaypointGrid<'a> {
             for i in (ci - reach).max(0)..=(ci + reach).min(self.nx as i64 - 1) {
                 let k = j as usize * self.nx + i as usize;
                 let q = self.node(i as usize, j as usize);
-                if self.usable[k] && (q - p).norm() <= radius {
+                if (q - p).norm() <= radius && self.usable(k) {
                     out.push((k, q));
                 }
             }
@@ -427,7 +442,7 @@ fn search(
     // The heuristic: the distance to go through the grid by clear straights (it knows the
     // way round bays and slots).
     let steer = grid.steer_distances(&p2, 3.0 * grid.step, &to_goal);
-    let states = grid.usable.len() * H;
+    let states = grid.node_count() * H;
     let cell = |s: usize| (s / H % grid.nx, s / H / grid.nx);
     let pose = |s: usize| {
         let (i, j) = cell(s);
@@ -481,7 +496,7 @@ fn search(
     let mut checked = CheckedEdges::default();
     let mut from_start = vec![false; states];
     // Per node: its expanded headings (bit per heading index).
-    let mut done_at = vec![0u8; grid.usable.len()];
+    let mut done_at = vec![0u8; grid.node_count()];
     let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::new();
     // Queue the start's neighbours with their shortest words' lengths.
     for (k, q) in start_nodes {
@@ -684,7 +699,7 @@ fn search(
                 let Some(k) = grid.index(i as i64 + di, j as i64 + dj) else {
                     continue;
                 };
-                if !grid.usable[k] || !to_goal[k].is_finite() {
+                if !to_goal[k].is_finite() || !grid.usable(k) {
                     continue;
                 }
                 let h_to_go = HEURISTIC_WEIGHT * steer[k];
