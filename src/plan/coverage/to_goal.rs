@@ -98,14 +98,16 @@ impl WaypointGrid<'_> {
     /// infinite where the goal cannot be reached. Nodes within `radius` of the goal start at
     /// their straight distance.
     pub(super) fn open_distances(&self, goal: &Vec2, radius: f64) -> Vec<f64> {
-        self.dijkstra(&self.near(goal, radius), goal, false)
+        let mut open = Dijkstra::new(self, &self.near(goal, radius), goal, false);
+        while open.step(self) {}
+        open.dist
     }
 
-    /// The distances to steer by ([`Self::open_distances`] through clear straights only, m):
+    /// The distances to steer by ([`Self::open_distances`] through clear straights only):
     /// the nodes within `radius` of the goal whose straight to it is clear start at their
-    /// straight distance (all of them when none is clear); where this finds no way, the open
-    /// distance (`open`).
-    pub(super) fn steer_distances(&self, goal: &Vec2, radius: f64, open: &[f64]) -> Vec<f64> {
+    /// straight distance (all of them when none is clear). Found as far as asked
+    /// ([`Steer::at`]): a short detour's search asks only the nodes near it.
+    pub(super) fn steer_distances(&self, goal: &Vec2, radius: f64) -> Steer {
         let near = self.near(goal, radius);
         let seen: Vec<(usize, Vec2)> = near
             .iter()
@@ -113,59 +115,108 @@ impl WaypointGrid<'_> {
             .filter(|(_, q)| self.segment_clear(*q, *goal))
             .collect();
         let seeds = if seen.is_empty() { &near } else { &seen };
-        let mut steer = self.dijkstra(seeds, goal, true);
-        for (s, o) in steer.iter_mut().zip(open) {
-            if !s.is_finite() {
-                *s = *o;
-            }
-        }
-        steer
+        Steer(Dijkstra::new(self, seeds, goal, true))
     }
+}
 
-    /// Dijkstra from `seeds` (at their straight distances to `goal`) over the usable nodes,
-    /// through the neighbours whose straight is clear when `straight`, else every neighbour.
-    fn dijkstra(&self, seeds: &[(usize, Vec2)], goal: &Vec2, straight: bool) -> Vec<f64> {
-        let mut dist = vec![f64::INFINITY; self.node_count()];
+/// The distances to steer by of one search ([`WaypointGrid::steer_distances`]).
+pub(super) struct Steer(Dijkstra);
+
+impl Steer {
+    /// The distance to steer by from node `k`, m; where it finds no way, `open` (the node's
+    /// open distance).
+    pub(super) fn at(&mut self, grid: &WaypointGrid, k: usize, open: f64) -> f64 {
+        let d = self.0.settled(grid, k);
+        if d.is_finite() {
+            d
+        } else {
+            open
+        }
+    }
+}
+
+/// A Dijkstra search from the goal's nodes over the usable nodes, run as far as asked.
+struct Dijkstra {
+    dist: Vec<f64>,
+    heap: BinaryHeap<(Reverse<u64>, usize)>,
+    /// Through the neighbours whose straight is clear (else through every neighbour).
+    straight: bool,
+}
+
+/// The queue's key of a distance (mm).
+fn key(d: f64) -> Reverse<u64> {
+    Reverse((d * 1000.0) as u64)
+}
+
+impl Dijkstra {
+    /// From `seeds` at their straight distances to `goal`.
+    fn new(grid: &WaypointGrid, seeds: &[(usize, Vec2)], goal: &Vec2, straight: bool) -> Self {
+        let mut dist = vec![f64::INFINITY; grid.node_count()];
         let mut heap = BinaryHeap::new();
-        let key = |d: f64| Reverse((d * 1000.0) as u64);
         for &(k, q) in seeds {
             dist[k] = (q - goal).norm();
             heap.push((key(dist[k]), k));
         }
-        while let Some((Reverse(d), k)) = heap.pop() {
-            if (d as f64) > dist[k] * 1000.0 + 1.0 {
-                continue;
-            }
-            let (i, j) = ((k % self.nx) as i64, (k / self.nx) as i64);
-            let dirs: &[usize] = if straight { &ALL } else { &EIGHT };
-            for &dir in dirs {
-                let (di, dj) = STEPS[dir];
-                let Some(n) = self.index(i + di, j + dj) else {
-                    continue;
-                };
-                if !self.usable(n) {
-                    continue;
+        Dijkstra {
+            dist,
+            heap,
+            straight,
+        }
+    }
+
+    /// The distance of node `k`, the search run until no node left in its queue can shorten
+    /// it (every move is at least a grid step); infinite when none reaches it.
+    fn settled(&mut self, grid: &WaypointGrid, k: usize) -> f64 {
+        loop {
+            let d = self.dist.get(k).copied().unwrap_or(f64::INFINITY);
+            let next = self.heap.peek().map(|e| e.0 .0);
+            match next {
+                Some(q) if d.is_infinite() || (q as f64) < (d - grid.step) * 1000.0 + 1.0 => {
+                    self.step(grid);
                 }
-                let step = self.step * ((di * di + dj * dj) as f64).sqrt();
-                if dist[k] + step >= dist[n] {
-                    continue;
-                }
-                let length = if straight {
-                    match self.link(k, n, dir) {
-                        Some(l) => l,
-                        None => continue,
-                    }
-                } else {
-                    step
-                };
-                let nd = dist[k] + length;
-                if nd < dist[n] {
-                    dist[n] = nd;
-                    heap.push((key(nd), n));
-                }
+                _ => return d,
             }
         }
-        dist
+    }
+
+    /// Settle the next node of the queue; `false` when the queue is empty.
+    fn step(&mut self, grid: &WaypointGrid) -> bool {
+        let Some((Reverse(d), k)) = self.heap.pop() else {
+            return false;
+        };
+        let dist = &mut self.dist;
+        if (d as f64) > dist[k] * 1000.0 + 1.0 {
+            return true;
+        }
+        let (i, j) = ((k % grid.nx) as i64, (k / grid.nx) as i64);
+        let dirs: &[usize] = if self.straight { &ALL } else { &EIGHT };
+        for &dir in dirs {
+            let (di, dj) = STEPS[dir];
+            let Some(n) = grid.index(i + di, j + dj) else {
+                continue;
+            };
+            if !grid.usable(n) {
+                continue;
+            }
+            let step = grid.step * ((di * di + dj * dj) as f64).sqrt();
+            if dist[k] + step >= dist[n] {
+                continue;
+            }
+            let length = if self.straight {
+                match grid.link(k, n, dir) {
+                    Some(l) => l,
+                    None => continue,
+                }
+            } else {
+                step
+            };
+            let nd = dist[k] + length;
+            if nd < dist[n] {
+                dist[n] = nd;
+                self.heap.push((key(nd), n));
+            }
+        }
+        true
     }
 }
 
@@ -203,14 +254,15 @@ mod tests {
         // Goal just right of the slot, 20 m up; the node left of it at (90, 20).
         let goal = v2(97.0, 20.0);
         let open = grid.open_distances(&goal, 30.0);
-        let steer = grid.steer_distances(&goal, 30.0, &open);
+        let mut steer = grid.steer_distances(&goal, 30.0);
         let k = 2 * grid.nx + 9;
         assert!((grid.node(9, 2) - v2(90.0, 20.0)).norm() < 1e-9);
         assert!((open[k] - 7.0).abs() < 1e-9, "open {}", open[k]);
         // Round the slot's end (y ≥ 81.5): about 2 × 62 m up and down.
-        assert!(steer[k] > 120.0 && steer[k] < 170.0, "steer {}", steer[k]);
+        let round = steer.at(&grid, k, open[k]);
+        assert!(round > 120.0 && round < 170.0, "steer {round}");
         // Nodes on the goal's side see it straight.
         let right = 2 * grid.nx + 10;
-        assert!((steer[right] - open[right]).abs() < 1e-9);
+        assert!((steer.at(&grid, right, open[right]) - open[right]).abs() < 1e-9);
     }
 }

@@ -441,7 +441,7 @@ fn search(
     }
     // The heuristic: the distance to go through the grid by clear straights (it knows the
     // way round bays and slots).
-    let steer = grid.steer_distances(&p2, 3.0 * grid.step, &to_goal);
+    let mut steer = grid.steer_distances(&p2, 3.0 * grid.step);
     let states = grid.node_count() * H;
     let cell = |s: usize| (s / H % grid.nx, s / H / grid.nx);
     let pose = |s: usize| {
@@ -510,7 +510,7 @@ fn search(
                     continue;
                 }
                 from_start[s] = true;
-                let f = key(len + HEURISTIC_WEIGHT * steer[k]);
+                let f = key(len + HEURISTIC_WEIGHT * steer.at(grid, k, to_goal[k]));
                 if f < best[s] {
                     best[s] = f;
                     heap.push((Reverse(f), s as u32, START));
@@ -574,7 +574,7 @@ fn search(
                 (k, true)
             })
         };
-        let h_s = HEURISTIC_WEIGHT * steer[s / H];
+        let h_s = HEURISTIC_WEIGHT * steer.at(grid, s / H, to_goal[s / H]);
         let g_from = if from == START {
             0.0
         } else {
@@ -702,7 +702,7 @@ fn search(
                 if !to_goal[k].is_finite() || !grid.usable(k) {
                     continue;
                 }
-                let h_to_go = HEURISTIC_WEIGHT * steer[k];
+                let h_to_go = HEURISTIC_WEIGHT * steer.at(grid, k, to_goal[k]);
                 // The headings there with an edge (with a word) from this state, in order.
                 let mut has = to_mask[span_cell(di, dj) * H + s % H];
                 while has != 0 {
