@@ -19,6 +19,7 @@ pub mod rings;
 mod runs;
 pub mod swath_angle;
 pub mod swaths;
+mod to_goal;
 pub mod transit;
 
 pub use crate::plan::types::{Field, PlanSegment, SegmentKind};
@@ -211,6 +212,7 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     let tests = Tests {
         clear: &clear,
         loose: &loose,
+        clearance: (strict_half, loose_half),
         one_test,
         grid: &grid,
         loose_grid: &loose_grid,
@@ -225,6 +227,8 @@ struct Tests<'a> {
     clear: &'a dyn Fn(&Vec2) -> bool,
     /// The tractor inside the field and off the obstacles ([`TRANSIT_CLEARANCE_M`]).
     loose: &'a dyn Fn(&Vec2) -> bool,
+    /// The distances from the edges and obstacles the two tests keep, m.
+    clearance: (f64, f64),
     /// The two tests are one (w ≤ 3 m).
     one_test: bool,
     grid: &'a std::cell::OnceCell<transit::WaypointGrid<'a>>,
@@ -282,17 +286,19 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         crate::geo::polygon::bbox(field.boundary.iter()).unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
     let grid_step = 2.0 * p.r_min;
     let waypoint_grid = || {
-        tests
-            .grid
-            .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, clear))
+        tests.grid.get_or_init(|| {
+            let c = tests.clearance.0;
+            transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, clear, c)
+        })
     };
     let loose_grid = || {
         if one_test {
             return waypoint_grid();
         }
-        tests
-            .loose_grid
-            .get_or_init(|| transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, loose))
+        tests.loose_grid.get_or_init(|| {
+            let c = tests.clearance.1;
+            transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, loose, c)
+        })
     };
     let warnings = std::cell::RefCell::new(Vec::<String>::new());
 

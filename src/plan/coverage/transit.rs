@@ -118,13 +118,18 @@ impl Csc {
     /// the last one the goal: every point lies on the curve and the chords are all alike, so
     /// three-point curvature never reads more than 1/r, even across the joins of the pieces.
     /// `None` when `clear` fails at a point: every [`CHECK_STRIDE`]th point is checked first
-    /// (a blocked curve is blocked along a stretch, found after a few checks), then the rest.
+    /// (a blocked curve is blocked along a stretch, found after a few checks), in halving
+    /// order ([`halving`]: a long curve through a blocked stretch in its middle is found out
+    /// after a few checks too), then the rest.
     pub(super) fn points(&self, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> Option<Vec<Vec2>> {
         let n = (self.length / step).ceil().max(1.0) as usize;
         let coarse = |k: usize| k % CHECK_STRIDE == CHECK_STRIDE / 2;
-        if !(CHECK_STRIDE / 2..=n)
-            .step_by(CHECK_STRIDE)
-            .all(|k| clear(&self.point_at(k, n)))
+        let strides = if n >= CHECK_STRIDE / 2 {
+            (n - CHECK_STRIDE / 2) / CHECK_STRIDE + 1
+        } else {
+            0
+        };
+        if !halving(strides).all(|m| clear(&self.point_at(CHECK_STRIDE / 2 + m * CHECK_STRIDE, n)))
         {
             return None;
         }
@@ -143,6 +148,19 @@ impl Csc {
 /// Points of a curve checked first (every this many, then the rest): the same answer as
 /// checking them in order, with fewer checks of a curve that is not clear.
 const CHECK_STRIDE: usize = 8;
+
+/// `0..n` in halving order: 0, then the multiples of the largest power of two below `n` not
+/// yet given, then of the next smaller one, and so on (0, 8, 4, 12, 2, 6, 10, 14, 1, … for
+/// n = 16): each index once, the points checked spread along the curve from the start.
+fn halving(n: usize) -> impl Iterator<Item = usize> {
+    let top = usize::BITS - n.max(1).leading_zeros();
+    (0..top).rev().flat_map(move |level| {
+        let s = 1usize << level;
+        (0..n)
+            .step_by(s)
+            .filter(move |&m| level + 1 == top || m % (2 * s) != 0)
+    })
+}
 
 /// Is `clear` true at every point of `pts` (each moved by `base`)? Every
 /// [`CHECK_STRIDE`]th point first, then the rest.
@@ -231,10 +249,18 @@ pub struct WaypointGrid<'a> {
     pub step: f64,
     pub nx: usize,
     pub ny: usize,
-    /// Node (i, j) at `j * nx + i` is usable.
-    pub usable: Vec<bool>,
+    /// Node (i, j) at `j * nx + i` is usable: 1, not: 2, not yet asked: 0 (a search's
+    /// distances reach only the nodes of its goal's part of the field: asking every node
+    /// cost a plan whose searches fail at once, as between parts joined by a neck too narrow
+    /// to turn through, more than its searches).
+    usable: RefCell<Vec<u8>>,
     /// Is a point of a curve clear?
-    clear: &'a dyn Fn(&Vec2) -> bool,
+    pub(super) clear: &'a dyn Fn(&Vec2) -> bool,
+    /// Spacing of the points checked on the straights between neighbouring nodes, m: the
+    /// clearance, half the thickness of the thinnest ground that is not clear.
+    pub(super) probe: f64,
+    /// The ways between neighbouring nodes by clear straights (see [`super::to_goal`]).
+    pub(super) links: RefCell<super::to_goal::Links>,
     /// The curves between nodes, solved once (see [`EdgeTable`]).
     edges: RefCell<EdgeTable>,
     /// The states of the searches that failed with nothing left to expand.
@@ -247,35 +273,51 @@ pub struct WaypointGrid<'a> {
 impl<'a> WaypointGrid<'a> {
     /// Nodes every `step` m over the box `lo`–`hi` where `clear` holds; at most `max_nodes`
     /// (the step grows to fit). The curves of every search on the grid keep `clear` at every
-    /// point.
+    /// point. `clearance`: the distance from the field's edges and obstacles `clear` keeps, m
+    /// (the ground that is not clear is at least twice that thick).
     pub fn new(
         lo: Vec2,
         hi: Vec2,
         step: f64,
         max_nodes: usize,
         clear: &'a dyn Fn(&Vec2) -> bool,
+        clearance: f64,
     ) -> Self {
         let span = hi - lo;
         let step = step.max((span.x.max(0.0) * span.y.max(0.0) / max_nodes.max(1) as f64).sqrt());
         let nx = (span.x / step).floor().max(0.0) as usize + 1;
         let ny = (span.y / step).floor().max(0.0) as usize + 1;
-        let mut grid = WaypointGrid {
+        WaypointGrid {
             origin: lo,
             step,
             nx,
             ny,
-            usable: vec![false; nx * ny],
+            usable: RefCell::new(vec![0; nx * ny]),
             clear,
+            probe: clearance.max(0.05),
+            links: RefCell::new(vec![[f32::NAN; 16]; nx * ny]),
             edges: RefCell::default(),
             closed: RefCell::default(),
             answers: RefCell::default(),
-        };
-        for j in 0..ny {
-            for i in 0..nx {
-                grid.usable[j * nx + i] = clear(&grid.node(i, j));
-            }
         }
-        grid
+    }
+
+    /// The number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Is node `k` (at `j * nx + i`) usable: `clear` at it? Asked once.
+    pub fn usable(&self, k: usize) -> bool {
+        let known = self.usable.borrow().get(k).copied().unwrap_or(2);
+        if known != 0 {
+            return known == 1;
+        }
+        let ok = (self.clear)(&self.node(k % self.nx, k / self.nx));
+        if let Some(x) = self.usable.borrow_mut().get_mut(k) {
+            *x = if ok { 1 } else { 2 };
+        }
+        ok
     }
 
     /// The words of the edge from a node with heading index `ha` to the node (`di`, `dj`)
@@ -298,61 +340,18 @@ impl<'a> WaypointGrid<'a> {
         words
     }
 
-    /// Distance from every node to `goal` through usable nodes (8-neighbour moves), m;
-    /// infinite where the goal cannot be reached. Nodes within `radius` of the goal start at
-    /// their straight distance.
-    fn distances_to(&self, goal: &Vec2, radius: f64) -> Vec<f64> {
-        use std::cmp::Reverse;
-        let mut dist = vec![f64::INFINITY; self.usable.len()];
-        let mut heap = std::collections::BinaryHeap::new();
-        let key = |d: f64| Reverse((d * 1000.0) as u64);
-        for (k, q) in self.near(goal, radius) {
-            dist[k] = (q - goal).norm();
-            heap.push((key(dist[k]), k));
-        }
-        while let Some((Reverse(d), k)) = heap.pop() {
-            if (d as f64) > dist[k] * 1000.0 + 1.0 {
-                continue;
-            }
-            let (i, j) = ((k % self.nx) as i64, (k / self.nx) as i64);
-            for (di, dj) in [
-                (-1, -1),
-                (-1, 0),
-                (-1, 1),
-                (0, -1),
-                (0, 1),
-                (1, -1),
-                (1, 0),
-                (1, 1),
-            ] {
-                let Some(n) = self.index(i + di, j + dj) else {
-                    continue;
-                };
-                if !self.usable[n] {
-                    continue;
-                }
-                let nd = dist[k] + self.step * ((di * di + dj * dj) as f64).sqrt();
-                if nd < dist[n] {
-                    dist[n] = nd;
-                    heap.push((key(nd), n));
-                }
-            }
-        }
-        dist
-    }
-
-    fn node(&self, i: usize, j: usize) -> Vec2 {
+    pub(super) fn node(&self, i: usize, j: usize) -> Vec2 {
         self.origin + Vec2::new(i as f64 * self.step, j as f64 * self.step)
     }
 
     /// Index of node (`i`, `j`), if on the grid.
-    fn index(&self, i: i64, j: i64) -> Option<usize> {
+    pub(super) fn index(&self, i: i64, j: i64) -> Option<usize> {
         (i >= 0 && j >= 0 && (i as usize) < self.nx && (j as usize) < self.ny)
             .then(|| j as usize * self.nx + i as usize)
     }
 
     /// Usable nodes within `radius` m of `p`: (index, position).
-    fn near(&self, p: &Vec2, radius: f64) -> Vec<(usize, Vec2)> {
+    pub(super) fn near(&self, p: &Vec2, radius: f64) -> Vec<(usize, Vec2)> {
         let rel = (p - self.origin) / self.step;
         let reach = (radius / self.step).ceil() as i64;
         let (ci, cj) = (rel.x.round() as i64, rel.y.round() as i64);
@@ -361,7 +360,7 @@ impl<'a> WaypointGrid<'a> {
             for i in (ci - reach).max(0)..=(ci + reach).min(self.nx as i64 - 1) {
                 let k = j as usize * self.nx + i as usize;
                 let q = self.node(i as usize, j as usize);
-                if self.usable[k] && (q - p).norm() <= radius {
+                if (q - p).norm() <= radius && self.usable(k) {
                     out.push((k, q));
                 }
             }
@@ -434,9 +433,16 @@ fn search(
     /// The parent of the states joined to the start pose.
     const START: u32 = u32::MAX;
     let reach = 2.0 * grid.step * std::f64::consts::SQRT_2 + 1e-6;
-    // The heuristic: the distance to go through the grid (it knows the way around bays).
-    let to_goal = grid.distances_to(&p2, 3.0 * grid.step);
-    let states = grid.usable.len() * H;
+    // Which nodes can reach the goal (`to_goal`): none near the start, no way.
+    let to_goal = grid.open_distances(&p2, 3.0 * grid.step);
+    let start_nodes = grid.near(&p1, reach);
+    if start_nodes.iter().all(|(k, _)| !to_goal[*k].is_finite()) {
+        return None;
+    }
+    // The heuristic: the distance to go through the grid by clear straights (it knows the
+    // way round bays and slots).
+    let mut steer = grid.steer_distances(&p2, 3.0 * grid.step);
+    let states = grid.node_count() * H;
     let cell = |s: usize| (s / H % grid.nx, s / H / grid.nx);
     let pose = |s: usize| {
         let (i, j) = cell(s);
@@ -490,10 +496,10 @@ fn search(
     let mut checked = CheckedEdges::default();
     let mut from_start = vec![false; states];
     // Per node: its expanded headings (bit per heading index).
-    let mut done_at = vec![0u8; grid.usable.len()];
+    let mut done_at = vec![0u8; grid.node_count()];
     let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::new();
     // Queue the start's neighbours with their shortest words' lengths.
-    for (k, q) in grid.near(&p1, reach) {
+    for (k, q) in start_nodes {
         if !to_goal[k].is_finite() {
             continue;
         }
@@ -504,7 +510,7 @@ fn search(
                     continue;
                 }
                 from_start[s] = true;
-                let f = key(len + HEURISTIC_WEIGHT * to_goal[k]);
+                let f = key(len + HEURISTIC_WEIGHT * steer.at(grid, k, to_goal[k]));
                 if f < best[s] {
                     best[s] = f;
                     heap.push((Reverse(f), s as u32, START));
@@ -568,7 +574,7 @@ fn search(
                 (k, true)
             })
         };
-        let h_s = HEURISTIC_WEIGHT * to_goal[s / H];
+        let h_s = HEURISTIC_WEIGHT * steer.at(grid, s / H, to_goal[s / H]);
         let g_from = if from == START {
             0.0
         } else {
@@ -693,10 +699,10 @@ fn search(
                 let Some(k) = grid.index(i as i64 + di, j as i64 + dj) else {
                     continue;
                 };
-                if !grid.usable[k] || !to_goal[k].is_finite() {
+                if !to_goal[k].is_finite() || !grid.usable(k) {
                     continue;
                 }
-                let h_to_go = HEURISTIC_WEIGHT * to_goal[k];
+                let h_to_go = HEURISTIC_WEIGHT * steer.at(grid, k, to_goal[k]);
                 // The headings there with an edge (with a word) from this state, in order.
                 let mut has = to_mask[span_cell(di, dj) * H + s % H];
                 while has != 0 {
@@ -735,6 +741,21 @@ pub fn straight(a: Vec2, b: Vec2, step: f64) -> Vec<Vec2> {
 mod tests {
     use super::*;
     use crate::geo::v2;
+
+    /// The halving order gives every index once.
+    #[test]
+    fn halving_gives_every_index_once() {
+        for n in 0..70 {
+            let mut all: Vec<usize> = halving(n).collect();
+            assert_eq!(all.first().copied(), (n > 0).then_some(0));
+            all.sort_unstable();
+            assert_eq!(all, (0..n).collect::<Vec<_>>(), "n {n}");
+        }
+        assert_eq!(
+            halving(16).collect::<Vec<_>>(),
+            [0, 8, 4, 12, 2, 6, 10, 14, 1, 3, 5, 7, 9, 11, 13, 15]
+        );
+    }
 
     #[test]
     fn csc_ends_at_the_goal_with_bounded_curvature() {
