@@ -1,6 +1,6 @@
 //! The Kalman filter of the observer's lateral disturbances (world drift and slope slip).
 
-use super::{ObserverParams, DRIFT_PRIOR_S, MIN_TAU, SLIP_REFERENCE_ROLL};
+use super::{ObserverParams, MIN_TAU, SLIP_REFERENCE_ROLL};
 use crate::geo::Vec2;
 use nalgebra::{Matrix3, Vector3};
 
@@ -14,9 +14,8 @@ use nalgebra::{Matrix3, Vector3};
 /// float drifts wherever the slope differs from its mean). The noise densities are set so
 /// that, alone, each state is a first-order filter with its configured time constant (the
 /// slip at [`SLIP_REFERENCE_ROLL`]): process noise q = r/τ² against a measurement noise
-/// density r (the scale cancels, r = 1). The covariance starts at the value of a 2 s time
-/// constant for the drift ([`DRIFT_PRIOR_S`]) and 1 s for the slip, and is never let above
-/// that of 1 s ([`MIN_TAU`]), so that a state that is not observed
+/// density r (the scale cancels, r = 1). The covariance starts at the value of a 1 s time
+/// constant ([`MIN_TAU`]) and is never let above it, so that a state that is not observed
 /// (the drift along the pass, the slip on flat ground) does not gather an unbounded gain.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct LateralFilter {
@@ -24,10 +23,9 @@ pub(super) struct LateralFilter {
 }
 
 impl LateralFilter {
-    /// The largest variances, and the one a drift learnt afresh starts from: a time constant
-    /// τ for a state seen through a regressor of size h has variance 1/(τ·h²); here
-    /// τ = [`MIN_TAU`], h = 1 for the drift and the reference roll for the slip. A job starts
-    /// the drift at [`DRIFT_PRIOR_S`].
+    /// The initial and largest variances: a time constant τ for a state seen through a
+    /// regressor of size h has variance 1/(τ·h²); here τ = [`MIN_TAU`], h = 1 for the drift and
+    /// the reference roll for the slip.
     const P0: [f64; 3] = [
         1.0 / MIN_TAU,
         1.0 / MIN_TAU,
@@ -36,11 +34,7 @@ impl LateralFilter {
 
     pub(super) fn new() -> Self {
         LateralFilter {
-            p: Matrix3::from_diagonal(&Vector3::new(
-                1.0 / DRIFT_PRIOR_S,
-                1.0 / DRIFT_PRIOR_S,
-                Self::P0[2],
-            )),
+            p: Matrix3::from_diagonal(&Vector3::from(Self::P0)),
         }
     }
 

@@ -193,20 +193,14 @@ struct Innovation {
 const BIAS_MAX_WHEEL: f64 = 0.2;
 /// Shortest effective time constant at the start of learning, s: the slip coefficient's.
 const MIN_TAU: f64 = 1.0;
-/// The priors of the offset and the drift at the start of a job: their first estimates weigh a
-/// disturbance of zero as this many seconds of fixes, s. The innovations of consecutive fixes
-/// telescope, so an estimate learnt over t s carries the noise of two fixes over t (position
-/// noise σ: σ·√2/t on the drift; heading noise σθ: σθ·√2·L/(v·t) on the offset), and with a
-/// 1 s prior a job's first seconds steered by a drift and an offset that were not there: 2 cm
-/// off the line 10–20 m into the first pass at 15 km/h (1 cm fixes, 0.1° heading), where the
-/// references, which learn nothing, stayed within 0.7 cm. Swept over the envelope (offset
-/// 1–5 s × drift 1–3 s; docs/envelope.md, Session 17: the observer's priors): every offset
-/// prior of 2–4 s with a 2 s drift prior gained 6–7 cells and lost none; a longer drift prior
-/// delays a side draft's crab and a slope's drift at the start. A drift learnt afresh across a line after a turn
-/// ([`LateralFilter::relearn_across`]) starts from the 1 s prior: the slope's drift is then
-/// known to be there and a 2 s one put the nominal slope 14 % over its suite figure.
+/// The offset's prior: its first estimate weighs an offset of zero as this many seconds of
+/// fixes, s. The innovations of consecutive fixes telescope, so an estimate learnt over t s
+/// carries the noise of two fixes over t (heading noise σθ: σθ·√2·L/(v·t) on the offset), and
+/// with a 1 s prior a job's first seconds steered by an offset that was not there. Swept over
+/// the envelope (docs/envelope.md, Session 17: the observer's priors): 2–5 s gain cells and lose
+/// none. The drift keeps a 1 s prior: a 2 s one gained cells on the envelope's seed only and
+/// put every seed's side slope 10–13 % worse.
 const BIAS_PRIOR_S: f64 = 3.0;
-const DRIFT_PRIOR_S: f64 = 2.0;
 /// The roll at which the slip coefficient's estimate has the time constant
 /// [`ObserverParams::slip_tau`], rad (2°): at a steeper slope it learns faster, on flat ground
 /// it is left alone.

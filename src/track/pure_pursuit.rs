@@ -303,12 +303,21 @@ mod tests {
         // the rate bound leaves the look-ahead as scheduled. (Measured against the curvature
         // at the preview point alone, on the straight, the arc's wheel angle counted as a
         // correction, the look-ahead grew and the vehicle left the arc early: a turn's exit
-        // 30 cm off the next line.) Likewise in the middle of an arc of nodes 1.5 m apart,
-        // where a 2 m chord between two nodes reads a straight.
+        // 30 cm off the next line.) Likewise in the middle of an arc of nodes 1.5 and 3 m
+        // apart: with 3 m, the 2 m chord at the preview point read 0.014–0.23 /m on this
+        // 0.1 /m arc, and the look-ahead grew to 5.6–9.6 m at each of 2.6, 3.0 and 4.4 m.
         let law = PurePursuit::predictive(4.5);
         let speed = 15.0 / 3.6;
         let (r, arc) = (10.0, 12.0);
-        for (along, spacing) in [(arc - 3.0, 1.0), (4.0, 1.5), (4.7, 1.5), (5.3, 1.5)] {
+        for (along, spacing) in [
+            (arc - 3.0, 1.0),
+            (4.0, 1.5),
+            (4.7, 1.5),
+            (5.3, 1.5),
+            (2.6, 3.0),
+            (3.0, 3.0),
+            (4.4, 3.0),
+        ] {
             let a: f64 = along / r;
             let pose = Pose::new(r * a.sin(), r * (1.0 - a.cos()), a);
             let local = arc_then_straight(r, arc, spacing, &pose.pos);
