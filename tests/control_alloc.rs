@@ -31,13 +31,17 @@ fn drive_and_count(kind: TrackerKind) {
     cfg.track.kind = kind;
     let resolved = cfg.resolved();
     let mut node = agsteer::job::node_for_config(&cfg, None).unwrap();
-    let start = node.controller().path_start_pose().unwrap_or(Pose::new(
-        resolved.planning.ab.point_a.x,
-        resolved.planning.ab.point_a.y,
-        (resolved.planning.ab.point_b - resolved.planning.ab.point_a)
-            .y
-            .atan2((resolved.planning.ab.point_b - resolved.planning.ab.point_a).x),
-    ));
+    let start = node
+        .controller()
+        .path_start()
+        .map(|(p, _)| p)
+        .unwrap_or(Pose::new(
+            resolved.planning.ab.point_a.x,
+            resolved.planning.ab.point_a.y,
+            (resolved.planning.ab.point_b - resolved.planning.ab.point_a)
+                .y
+                .atan2((resolved.planning.ab.point_b - resolved.planning.ab.point_a).x),
+        ));
     let mut sim = SimNode::new(
         Simulator::new(resolved.sim.params.clone(), start, resolved.sim.speed),
         *node.enu(),

@@ -407,14 +407,21 @@ impl Controller {
         &mut self.guidance
     }
 
-    /// Where a vehicle would begin the current path: its first point, on its first segment's
-    /// heading. Used to place the simulated vehicle on a resumed job.
-    pub fn path_start_pose(&self) -> Option<Pose> {
-        let p = self.guidance.global_path();
-        if p.len() < 2 {
+    /// Where a vehicle would begin the current path: its first point, on the path's tangent
+    /// there, and the path's curvature over its first 2 m (1/m, positive left; see
+    /// [`crate::track::curvature_along`]). The tangent is the chord to the point 2 m along less
+    /// half the angle the curvature turns over it (a chord of a 1 m-sampled R 15 m arc is 2°
+    /// off the tangent). Used to place the simulated vehicle on a job's or a resumed job's
+    /// path.
+    pub fn path_start(&self) -> Option<(Pose, f64)> {
+        let points: Vec<crate::geo::Vec2> =
+            self.guidance.global_path().iter().map(|p| p.pos).collect();
+        if points.len() < 2 {
             return None;
         }
-        let d = p[1].pos - p[0].pos;
-        Some(Pose::new(p[0].pos.x, p[0].pos.y, d.y.atan2(d.x)))
+        let curvature = crate::track::curvature_along(&points, 0, 1.0, 1.0);
+        let chord = crate::track::point_along(&points, 0, 2.0) - points[0];
+        let heading = chord.y.atan2(chord.x) - 0.5 * curvature * chord.norm();
+        Some((Pose::new(points[0].x, points[0].y, heading), curvature))
     }
 }

@@ -416,24 +416,38 @@ pub fn run(
     );
     // A segment job or a resumed one starts at its current path's start (a resumed turn: the
     // turn's), offset and turned as configured; a new AB job at A.
-    let start = match &opts.resume {
-        Some(_) => node.controller().path_start_pose(),
-        None if segment_job => node.controller().path_start_pose(),
+    let path_start = match &opts.resume {
+        Some(_) => node.controller().path_start(),
+        None if segment_job => node.controller().path_start(),
         None => None,
-    }
-    .map(|p| {
-        let normal = left_normal(&crate::geo::heading_vec(p.heading));
-        let pos = p.pos + normal * sim_setup.start_offset;
-        Pose::new(pos.x, pos.y, p.heading + sim_setup.start_heading)
-    })
-    .unwrap_or_else(|| {
-        let ab = &resolved.planning.ab;
-        let dir = (ab.point_b - ab.point_a).normalize();
-        let p = ab.point_a + left_normal(&dir) * sim_setup.start_offset;
-        Pose::new(p.x, p.y, dir.y.atan2(dir.x) + sim_setup.start_heading)
+    };
+    let start = path_start
+        .map(|(p, _)| {
+            let normal = left_normal(&crate::geo::heading_vec(p.heading));
+            let pos = p.pos + normal * sim_setup.start_offset;
+            Pose::new(pos.x, pos.y, p.heading + sim_setup.start_heading)
+        })
+        .unwrap_or_else(|| {
+            let ab = &resolved.planning.ab;
+            let dir = (ab.point_b - ab.point_a).normalize();
+            let p = ab.point_a + left_normal(&dir) * sim_setup.start_offset;
+            Pose::new(p.x, p.y, dir.y.atan2(dir.x) + sim_setup.start_heading)
+        });
+    // Started on a path, the simulated driver has been steering along it: the wheels start at
+    // the path's curvature at its start (an arc's steering, not straight), forwards.
+    let start_curvature = path_start.map(|(_, k)| k).filter(|_| {
+        node.controller()
+            .guidance()
+            .global_path()
+            .first()
+            .is_some_and(|p| p.direction == crate::geo::Direction::Forward)
     });
+    let mut simulator = Simulator::new(sim_setup.params.clone(), start, speed);
+    if let Some(curvature) = start_curvature {
+        simulator.hold_curvature(curvature);
+    }
     let mut sim = SimNode::new(
-        Simulator::new(sim_setup.params.clone(), start, speed),
+        simulator,
         *node.enu(),
         SimAddresses::default(),
         opts.scenario.clone(),

@@ -43,6 +43,17 @@ impl Actuator {
         self.command = p.was_gain * self.act + p.dist.was_bias;
     }
 
+    /// Put the wheels (and the actuator behind them) at the true angle `angle` (rad, clamped to
+    /// the angle limit) and hold them there, as a driver who has been steering at it.
+    pub(super) fn set_wheel(&mut self, p: &SimParams, angle: f64) {
+        let angle = angle.clamp(-p.max_wheel_angle, p.max_wheel_angle);
+        self.act = angle;
+        self.wheel = angle;
+        self.hold(p);
+        let command = self.command;
+        self.delay.iter_mut().for_each(|c| *c = command);
+    }
+
     /// One integration step of `p.step` s.
     pub(super) fn step(&mut self, p: &SimParams) {
         let h = p.step;

@@ -213,6 +213,25 @@ impl Simulator {
         self.actuator.hold(&self.p);
     }
 
+    /// The driver has been steering along a path of curvature `curvature` (1/m, positive
+    /// left; non-finite ignored) at the present speed and holds the wheels there until a
+    /// command comes: a job started on an arc starts with the arc's steering, not with the
+    /// wheels straight. The true vehicle's steady angle: atan(L·κ), plus K·u²·κ with the
+    /// dynamic lateral model's understeer gradient K.
+    pub fn hold_curvature(&mut self, curvature: f64) {
+        if !curvature.is_finite() {
+            return;
+        }
+        let understeer = self
+            .p
+            .lateral
+            .as_ref()
+            .map_or(0.0, |l| l.understeer_gradient(self.p.wheelbase));
+        let u = self.body.speed;
+        let angle = (self.p.wheelbase * curvature).atan() + understeer * u * u * curvature;
+        self.actuator.set_wheel(&self.p, angle);
+    }
+
     /// The driver centres the wheels and keeps straight: the actuator goes, at its rate, to
     /// where the sensor reads a true angle of zero.
     pub fn centre_wheels(&mut self) {

@@ -419,3 +419,47 @@ fn the_tyres_slide_at_the_friction_limit() {
     );
     assert!(st.pose.pos.x.is_finite());
 }
+
+#[test]
+fn a_driver_holding_an_arc_s_steering_drives_the_arc_from_the_start() {
+    // Started on an R 15 m arc (centre 15 m to the left of the start, heading east) with the
+    // arc's steering held: no command comes, and the vehicle stays on the arc. The hold is in
+    // the sensor's terms and fills the dead time, so a WAS offset and gain error, a dead time
+    // and a backlash do not move the wheels.
+    let radius = 15.0;
+    let plants = [
+        ("kinematic", SimParams::default()),
+        (
+            "WAS 1.05 / +1°, dead time 0.2 s, lag, 1° backlash",
+            SimParams {
+                was_gain: 1.05,
+                dead_time: 0.2,
+                tau: 0.3,
+                dist: Disturbances {
+                    was_bias: 1f64.to_radians(),
+                    backlash: 1f64.to_radians(),
+                    ..Disturbances::default()
+                },
+                ..SimParams::default()
+            },
+        ),
+    ];
+    for (name, p) in plants {
+        let mut s = Simulator::new(p, Pose::new(0.0, 0.0, 0.0), 3.0);
+        s.hold_curvature(1.0 / radius);
+        for k in 1..=30 {
+            run(&mut s, 0.1 * k as f64);
+            let off = (s.true_state().pose.pos - crate::geo::v2(0.0, radius)).norm() - radius;
+            assert!(off.abs() < 1e-3, "{name}: {off} m off the arc at {k}");
+        }
+    }
+    // With tyre slip the held angle carries the understeer term: the steady circle at 6 m/s
+    // is the arc's (the kinematic angle alone drives one about 8 % wider here).
+    let p = ideal(Some(LateralDynamics::default()));
+    let mut s = Simulator::new(p, Pose::new(0.0, 0.0, 0.0), 6.0);
+    s.hold_curvature(1.0 / radius);
+    run(&mut s, 20.0);
+    let st = s.true_state();
+    let r = st.speed.hypot(st.lateral_velocity) / st.yaw_rate;
+    assert!((r - radius).abs() < 0.02 * radius, "R {r}");
+}

@@ -222,3 +222,36 @@ fn the_plant_keys_make_a_simulated_tractor_that_is_not_the_model() {
     .to_string();
     assert!(err.contains("sim.implement_side_force_n"), "{err}");
 }
+
+#[test]
+fn a_job_started_on_an_arc_starts_on_it_with_the_arc_s_steering() {
+    // The simulated tractor starts on the first arc (R 15 m) at its tangent with the arc's
+    // steering held, as a driver who has been following it: before agsteer engages (the
+    // address claim and the inputs take about 0.6 s) it stays on the arc. With the chord's
+    // heading and straight wheels it had left the arc by 36 cm 5 m in (10 km/h), and a slow
+    // steering never got back (rate 10°/s: 7.6 cm RMS, 92 cm max over the job).
+    let cfg = scenario_config("curve_r15", &[]);
+    let opts = DemoOptions {
+        record_work: true,
+        ..DemoOptions::default()
+    };
+    let run = agsteer::demo::run(&cfg, &opts, &mut |_| {}, &mut |_, _| {}).expect("runs");
+    let first = run.work.first().expect("a work pass");
+    let early = first
+        .samples
+        .iter()
+        .filter(|s| s.along_m <= 10.0)
+        .fold(0.0f64, |m, s| m.max(s.xte_m.abs()));
+    assert!(early < 0.02, "first 10 m: max |XTE| {:.2} cm", cm(early));
+    let before_engage = first
+        .samples
+        .iter()
+        .filter(|s| s.along_m <= 1.5)
+        .fold(0.0f64, |m, s| m.max(s.xte_m.abs()));
+    // The path is the arc's 1 m chords: 0.83 cm of sagitta between its points.
+    assert!(
+        before_engage < 0.01,
+        "first 1.5 m: max |XTE| {:.2} cm",
+        cm(before_engage)
+    );
+}

@@ -46,6 +46,11 @@ const CELLS: &[(&str, &str, f64)] = &[
     // Session 16: on curves a drift known to be the vehicle's turns with the heading (the side
     // draft's crab on R 15 m arcs: 14.1 cm RMS before).
     ("side_draft_5kN", "curve_r15", 2.49),
+    // Session 18: a job started on an arc starts with the arc's steering held (a slow
+    // steering never caught the arc it had left with straight wheels: 7.57 cm before; 20 km/h
+    // on R 30 m: 5.01 cm).
+    ("rate_10", "curve_r15", 1.00),
+    ("speed_20", "curve_r30", 0.45),
 ];
 
 #[test]
