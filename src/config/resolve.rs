@@ -387,7 +387,9 @@ impl Config {
     /// `safety.max_wheel_rate_deg_s`) turns the path at dκ/ds = ω / (L·v·cos²δ) ≥ ω / (L·v),
     /// of which a turn may use [`TURN_STEERING_SHARE`]. A turn planned faster than the
     /// steering leaves every line start off the line (the envelope's 10°/s motor at 10 km/h
-    /// follows 0.021 /m², not 0.1: 11 cm RMS on the straights). 0 stays 0 (turns of arcs).
+    /// follows 0.021 /m², not 0.1: 11 cm RMS on the straights). A lagging steering (τ,
+    /// `safety.actuator_tau_s`) sweeps no faster than the margin between the supervisor's
+    /// angle limit and the turn's angle over τ (below). 0 stays 0 (turns of arcs).
     pub fn turn_curvature_rate(&self) -> f64 {
         let sigma = self.vehicle.max_curvature_rate_per_m2;
         let rate = self
@@ -396,7 +398,26 @@ impl Config {
             .min(self.safety.max_wheel_rate_deg_s)
             .to_radians();
         let v = self.speed().abs();
-        let steering = TURN_STEERING_SHARE * rate / (self.vehicle.wheelbase_m * v);
+        // A lagging steering follows a wheel ramp at ω only τ·ω behind; the tracker can make
+        // that up only by commanding ahead of the turn's angle, and the supervisor clamps the
+        // command at the lateral-acceleration limit (`Config::turn_radius` leaves the margin
+        // between it and the turn's angle). So the ramp may be no faster than margin / τ.
+        let wheelbase = self.vehicle.wheelbase_m;
+        let limit = if v > 0.0 {
+            (self.safety.a_lat_max_m_s2 * wheelbase / (v * v))
+                .atan()
+                .min(self.max_wheel_angle())
+        } else {
+            self.max_wheel_angle()
+        };
+        let margin = limit - (wheelbase / self.turn_radius()).atan();
+        let tau = self.safety.actuator_tau_s;
+        let rate = if tau > 0.0 && margin > 0.0 {
+            rate.min(margin / tau)
+        } else {
+            rate
+        };
+        let steering = TURN_STEERING_SHARE * rate / (wheelbase * v);
         if sigma > 0.0 && steering.is_finite() && steering > 0.0 {
             sigma.min(steering)
         } else {

@@ -353,3 +353,46 @@ fn tuning_that_made_tracking_unstable_is_refused_by_name() {
         );
     }
 }
+
+#[test]
+fn a_lagging_steering_gets_turns_it_can_lead() {
+    // A first-order lag τ follows a wheel ramp at ω a constant τ·ω behind; the tracker makes
+    // that up by commanding ahead of the turn's angle, up to the supervisor's lateral
+    // acceleration limit. The planned ramp leaves that lead within the margin.
+    let at = |kmh: f64, tau: f64| {
+        let mut cfg = Config::default();
+        cfg.control.speed_kmh = kmh;
+        cfg.safety.actuator_tau_s = tau;
+        cfg
+    };
+    for (kmh, tau) in [
+        (15.0, 0.6),
+        (15.0, 0.15),
+        (10.0, 0.15),
+        (10.0, 0.4),
+        (20.0, 0.3),
+    ] {
+        let cfg = at(kmh, tau);
+        let (v, wheelbase) = (cfg.speed(), cfg.vehicle.wheelbase_m);
+        let limit = (cfg.safety.a_lat_max_m_s2 * wheelbase / (v * v))
+            .atan()
+            .min(cfg.max_wheel_angle());
+        let margin = limit - (wheelbase / cfg.turn_radius()).atan();
+        // The wheel rate the turn asks for (dδ/dt ≤ L·v·σ: small angles, cos² δ ≤ 1).
+        let omega = wheelbase * v * cfg.turn_curvature_rate();
+        let lead = tau * omega;
+        assert!(
+            lead <= margin + 1e-12,
+            "{kmh} km/h τ {tau}: {lead} > {margin}"
+        );
+        let free = at(kmh, 0.0).turn_curvature_rate();
+        assert!(cfg.turn_curvature_rate() <= free);
+        // No slower than it needs: the lead uses most of the margin, or the rate rules.
+        assert!(
+            lead >= 0.5 * margin || cfg.turn_curvature_rate() == free,
+            "{kmh} km/h τ {tau}: lead {lead} of {margin}"
+        );
+    }
+    // 0.6 s at 15 km/h: under half the rate the steering's speed alone allows.
+    assert!(at(15.0, 0.6).turn_curvature_rate() < 0.5 * at(15.0, 0.0).turn_curvature_rate());
+}

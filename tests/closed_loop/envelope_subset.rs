@@ -51,6 +51,9 @@ const CELLS: &[(&str, &str, f64)] = &[
     // on R 30 m: 5.01 cm).
     ("rate_10", "curve_r15", 1.00),
     ("speed_20", "curve_r30", 0.45),
+    // Session 18: turns no faster than a lagging steering can lead within the supervisor's
+    // angle limit (a 0.6 s lag at 15 km/h left every line start 0.7-1.3 m off: 3.23 cm).
+    ("lag_0.6", "straight_15kmh", 0.68),
 ];
 
 #[test]
