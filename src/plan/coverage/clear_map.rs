@@ -71,16 +71,7 @@ pub(super) struct ClearMap<'a> {
     /// `nx.div_ceil(BLOCK * SUPER)` a row): a block's edges are found among its super-block's,
     /// not among every edge of the field (a waypoint grid asks a new block at each node).
     supers: RefCell<Vec<Option<BlockEdges>>>,
-    /// The last cell found clear throughout, as a box (x0, y0, x1, y1) shrunk by
-    /// [`BOX_SHRINK`]: a point strictly inside it lies in that cell, so it is clear (the
-    /// points of a curve come a metre apart, several to a cell). Empty at first.
-    last_clear: std::cell::Cell<[f64; 4]>,
 }
-
-/// How far the box of the last clear cell is shrunk, m: more than the rounding of a point's
-/// offset from the origin (coordinates of up to 10⁵ m), so a point inside it is put in that
-/// cell by the division too.
-const BOX_SHRINK: f64 = 1e-7;
 
 /// Blocks per side of a super-block.
 const SUPER: usize = 8;
@@ -109,17 +100,12 @@ impl<'a> ClearMap<'a> {
                 None;
                 nx.div_ceil(BLOCK * SUPER) * ny.div_ceil(BLOCK * SUPER)
             ]),
-            last_clear: std::cell::Cell::new([f64::INFINITY, f64::INFINITY, 0.0, 0.0]),
         }
     }
 
     /// Is the implement clear at `q` (inside the boundary, off the obstacles, `half` m from
     /// every edge)? The same answer as [`implement_clear`].
     pub(super) fn clear(&self, q: &Vec2) -> bool {
-        let b = self.last_clear.get();
-        if q.x > b[0] && q.y > b[1] && q.x < b[2] && q.y < b[3] {
-            return true;
-        }
         let x = (q.x - self.origin.x) / self.cell;
         let y = (q.y - self.origin.y) / self.cell;
         // Off the grid (or not a number): outside the boundary's bounding box (the grid covers
@@ -143,16 +129,7 @@ impl<'a> ClearMap<'a> {
             known
         };
         match state {
-            CLEAR => {
-                let lo = self.origin + v2(i as f64 * self.cell, j as f64 * self.cell);
-                self.last_clear.set([
-                    lo.x + BOX_SHRINK,
-                    lo.y + BOX_SHRINK,
-                    lo.x + self.cell - BOX_SHRINK,
-                    lo.y + self.cell - BOX_SHRINK,
-                ]);
-                true
-            }
+            CLEAR => true,
             BLOCKED => false,
             s => self
                 .locals
@@ -425,43 +402,6 @@ mod tests {
             assert!(clear > 2_000, "half {half}: {clear} clear points");
             // Some cells near the edges were checked through their local edges.
             assert!(!map.locals.borrow().is_empty());
-        }
-    }
-
-    /// Along walks of short steps (the points of a curve, many to a cell, answered from the
-    /// box of the last clear cell) the map answers as [`implement_clear`] does too, across
-    /// the cells' edges and in and out of the field.
-    #[test]
-    fn the_map_agrees_along_walks() {
-        let field = Field {
-            boundary: vec![
-                v2(0.0, 0.0),
-                v2(120.0, 0.0),
-                v2(120.0, 80.0),
-                v2(70.0, 30.0),
-                v2(40.0, 90.0),
-                v2(0.0, 60.0),
-            ],
-            obstacles: vec![vec![v2(20.0, 20.0), v2(35.0, 22.0), v2(30.0, 35.0)]],
-        };
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
-        for half in [0.7, 3.0, 9.0] {
-            let map = ClearMap::new(&field, half);
-            let (mut disagree, mut clear) = (0, 0);
-            for _ in 0..200 {
-                let mut q = v2(rng.gen_range(-10.0..130.0), rng.gen_range(-10.0..100.0));
-                let heading: f64 = rng.gen_range(0.0..std::f64::consts::TAU);
-                let step = rng.gen_range(0.05..1.5);
-                for k in 0..200 {
-                    let a = heading + 0.01 * k as f64;
-                    q += v2(a.cos(), a.sin()) * step;
-                    let want = implement_clear(&field, half, &q);
-                    clear += usize::from(want);
-                    disagree += usize::from(map.clear(&q) != want);
-                }
-            }
-            assert_eq!(disagree, 0, "half {half}");
-            assert!(clear > 2_000, "half {half}: {clear} clear points");
         }
     }
 

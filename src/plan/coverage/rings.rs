@@ -6,10 +6,12 @@
 //! a few Dubins curves where the waypoint search of [`super::transit::route_graph`] costs
 //! thousands.
 
+use super::closed::EdgeHasher;
 #[cfg(test)]
 use super::transit::transit;
 use super::transit::{words_by_length, Csc};
 use crate::geo::{vec_heading, Vec2};
+use std::hash::BuildHasherDefault;
 
 /// Points of a ring tried as the place to turn onto it (or off it), at most.
 const CANDIDATES_PER_END: usize = 24;
@@ -287,8 +289,17 @@ impl Rings {
 /// Which curve an end of [`Rings::transit_with`] is: the free pose (`p1` of a curve onto a
 /// ring, `p2` of one off it), the ring, its point, the direction along it, onto or off, the
 /// radius and the spacing of the points (as bits).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct EndKey([u64; 8]);
+
+impl std::hash::Hash for EndKey {
+    /// Word by word (the standard hash of an array feeds its bytes one at a time).
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        for w in self.0 {
+            state.write_u64(w);
+        }
+    }
+}
 
 impl EndKey {
     fn new(
@@ -323,7 +334,7 @@ struct End {
 /// target's start pulled back starts where the one before it did).
 #[derive(Default)]
 pub struct Ends {
-    index: std::collections::HashMap<EndKey, usize>,
+    index: std::collections::HashMap<EndKey, usize, BuildHasherDefault<EdgeHasher>>,
     ends: Vec<End>,
 }
 
