@@ -51,7 +51,7 @@ pub fn from_geo(mp: &MultiPolygon<f64>) -> Vec<Area> {
 
 /// Largest angle between the chords of a round join, rad: arcs of 6 m radius get 0.12 m
 /// chords, fine enough for three-point curvature at 1 m spacing.
-const JOIN_ANGLE: f64 = 0.02;
+pub(super) const JOIN_ANGLE: f64 = 0.02;
 
 /// Offset every area by `distance` (m; negative shrinks the outer rings and grows the holes),
 /// with finely stepped round joins.

@@ -5,6 +5,7 @@
 //! Input is a [`Field`] in the local ENU frame (see [`crate::field`] for reading GeoJSON and
 //! ISO 11783-10 TASKDATA into one). Every stage is a pure function of its inputs.
 
+mod apart;
 pub mod bypass;
 mod clear_map;
 mod closed;
@@ -348,6 +349,9 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             .collect::<Vec<_>>(),
         &clear,
     );
+    // Pieces of the field that no transit with the implement clear joins (see `apart`).
+    let gap = p.point_spacing.max(rings.max_gap());
+    let pieces = apart::Apart::new(field, tests.clearance.0, gap);
     // A pass is worked only where its implement is clear (a guarantee): a pass that is not
     // clear throughout is cut into its clear stretches, and the cut is reported.
     let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
@@ -449,6 +453,8 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         // every plan, it cost the plans whose strict attempts succeed as much as it saved the
         // narrow fields whose attempts all fail.)
         let mut loose_headland: Option<Option<Vec<Vec2>>> = None;
+        // The curves on and off the rings of the headland attempts (strict, relaxed).
+        let mut ends = [rings::Ends::default(), rings::Ends::default()];
         for (t, way, relaxed) in attempts {
             let (cp, cn, f, hf, q, hq) = poses(t);
             if t > 0 && cp == 0 && cn == 0 {
@@ -460,21 +466,28 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             }
             let (r, step) = (p.r_min, p.point_spacing);
             let ok: &dyn Fn(&Vec2) -> bool = if relaxed { &loose } else { &clear };
+            // No strict headland attempt between pieces no clear transit joins (once a relaxed one
+            // found no way: finding the pieces costs a clip).
+            let apart = |failed: bool| !one_test && failed && pieces.apart(&f, &q);
             let pts = match way {
                 Way::Direct => transit::clear_transit(f, hf, q, hq, r, step, ok),
                 Way::Headland if t == 0 && !one_test && (relaxed || *loose_failed) => {
-                    let loose_way = loose_headland
-                        .get_or_insert_with(|| rings.transit(f, hf, q, hq, r, step, &loose));
+                    let loose_way = loose_headland.get_or_insert_with(|| {
+                        rings.transit_with(f, hf, q, hq, r, step, &loose, &mut ends[1])
+                    });
                     *loose_failed |= loose_way.is_none();
                     if relaxed {
                         loose_way.take()
-                    } else if loose_way.is_none() {
+                    } else if loose_way.is_none() || apart(*loose_failed) {
                         None
                     } else {
-                        rings.transit(f, hf, q, hq, r, step, ok)
+                        rings.transit_with(f, hf, q, hq, r, step, ok, &mut ends[0])
                     }
                 }
-                Way::Headland => rings.transit(f, hf, q, hq, r, step, ok),
+                Way::Headland if !relaxed && apart(*loose_failed) => None,
+                Way::Headland => {
+                    rings.transit_with(f, hf, q, hq, r, step, ok, &mut ends[usize::from(relaxed)])
+                }
                 // (Only relaxed: the loose grid's test is `ok`.)
                 Way::Waypoints => {
                     transit::route_graph(f, hf, q, hq, r, step, loose_grid(), ROUTE_MAX_EXPANSIONS)

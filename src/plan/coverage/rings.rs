@@ -6,10 +6,12 @@
 //! a few Dubins curves where the waypoint search of [`super::transit::route_graph`] costs
 //! thousands.
 
+use super::closed::EdgeHasher;
 #[cfg(test)]
 use super::transit::transit;
 use super::transit::{words_by_length, Csc};
 use crate::geo::{vec_heading, Vec2};
+use std::hash::BuildHasherDefault;
 
 /// Points of a ring tried as the place to turn onto it (or off it), at most.
 const CANDIDATES_PER_END: usize = 24;
@@ -137,6 +139,14 @@ impl Rings {
         }
     }
 
+    /// The largest distance between consecutive points of a ring (0 with no ring), m.
+    pub fn max_gap(&self) -> f64 {
+        self.rings
+            .iter()
+            .flat_map(|r| r.cum.windows(2).map(|w| w[1] - w[0]))
+            .fold(0.0, f64::max)
+    }
+
     /// A clear transit from (`p1`, heading `h1`) to (`p2`, `h2`): a Dubins curve of radius
     /// `r` onto a ring, the ring's clear points, a Dubins curve off it; the shortest such of
     /// the candidates tried, `None` when none is clear. Points about `step` m apart.
@@ -151,9 +161,28 @@ impl Rings {
         step: f64,
         clear: &dyn Fn(&Vec2) -> bool,
     ) -> Option<Vec<Vec2>> {
+        self.transit_with(p1, h1, p2, h2, r, step, clear, &mut Ends::default())
+    }
+
+    /// [`Self::transit`] with the curves onto and off the rings kept in `ends` for the next
+    /// transit from or to the same pose: the same answer, with the curves of a pose that an
+    /// earlier call solved and checked not solved or checked again. `ends` must only ever be
+    /// used with one test `clear` (its checks are kept).
+    #[allow(clippy::too_many_arguments)]
+    pub fn transit_with(
+        &self,
+        p1: Vec2,
+        h1: f64,
+        p2: Vec2,
+        h2: f64,
+        r: f64,
+        step: f64,
+        clear: &dyn Fn(&Vec2) -> bool,
+        ends: &mut Ends,
+    ) -> Option<Vec<Vec2>> {
         let reach = 4.0 * r;
         let mut best: Option<(f64, Vec<Vec2>)> = None;
-        for ring in &self.rings {
+        for (ri, ring) in self.rings.iter().enumerate() {
             let entries = ring.near(&p1, reach);
             let exits = ring.near(&p2, reach);
             if entries.is_empty() || exits.is_empty() {
@@ -172,45 +201,46 @@ impl Rings {
                 continue;
             }
             for dir in [1, -1] {
-                // The curves on at each entry and off at each exit, shortest first (solved once:
-                // their lengths bound the joins, then the joins verified check their points).
-                let curves = |a: (Vec2, f64), b: (Vec2, f64)| {
-                    let words = words_by_length(a.0, a.1, b.0, b.1, r);
-                    let length = words.first().map(|c| c.length);
-                    length.map(|l| (l, words))
-                };
-                let on: Vec<(usize, (f64, Vec<Csc>))> = entries
+                // The curves on at each entry and off at each exit, shortest first (solved once,
+                // or found in `ends`: their lengths bound the joins, then the joins verified
+                // check their points): (ring point, the end's index in `ends`, its length).
+                let on: Vec<(usize, usize, f64)> = entries
                     .iter()
                     .filter_map(|&i| {
-                        Some((i, curves((p1, h1), (ring.pts[i], ring.heading(i, dir)))?))
+                        let pose = (ring.pts[i], ring.heading(i, dir));
+                        let key = EndKey::new((p1, h1), (ri, i, dir, true), r, step);
+                        let e = ends.solve(key, || words_by_length(p1, h1, pose.0, pose.1, r));
+                        Some((i, e, ends.length(e)?))
                     })
                     .collect();
-                let off: Vec<(usize, (f64, Vec<Csc>))> = exits
+                let off: Vec<(usize, usize, f64)> = exits
                     .iter()
                     .filter_map(|&j| {
-                        Some((j, curves((ring.pts[j], ring.heading(j, dir)), (p2, h2))?))
+                        let pose = (ring.pts[j], ring.heading(j, dir));
+                        let key = EndKey::new((p2, h2), (ri, j, dir, false), r, step);
+                        let e = ends.solve(key, || words_by_length(pose.0, pose.1, p2, h2, r));
+                        Some((j, e, ends.length(e)?))
                     })
                     .collect();
-                let ins: Vec<(usize, f64)> = on.iter().map(|(i, c)| (*i, c.0)).collect();
-                let outs: Vec<(usize, f64)> = off.iter().map(|(j, c)| (*j, c.0)).collect();
-                // The first curve whose points are all clear ([`transit`] of the same poses).
-                let first_clear = |words: &[Csc]| words.iter().find_map(|c| c.points(step, clear));
                 // Every join costs at least the shortest way on plus the shortest way off.
                 let least =
-                    |v: &[(usize, f64)]| v.iter().map(|e| e.1).fold(f64::INFINITY, f64::min);
+                    |v: &[(usize, usize, f64)]| v.iter().map(|e| e.2).fold(f64::INFINITY, f64::min);
                 if best
                     .as_ref()
-                    .is_some_and(|b| b.0 <= least(&ins) + least(&outs))
+                    .is_some_and(|b| b.0 <= least(&on) + least(&off))
                 {
                     continue;
                 }
-                let mut joins: Vec<(f64, usize, usize)> = ins
+                // (cost, entry, exit), the entry and exit as positions in `on` and `off`.
+                let mut joins: Vec<(f64, usize, usize)> = on
                     .iter()
-                    .flat_map(|&(i, li)| {
-                        outs.iter()
-                            .map(move |&(j, lj)| (li + ring.along(i, j, dir) + lj, i, j))
+                    .enumerate()
+                    .flat_map(|(a, &(i, _, li))| {
+                        off.iter()
+                            .enumerate()
+                            .map(move |(b, &(j, _, lj))| (li + ring.along(i, j, dir) + lj, a, b))
                     })
-                    .filter(|&(_, i, j)| ring.stretch_clear(i, j, dir))
+                    .filter(|&(_, a, b)| ring.stretch_clear(on[a].0, off[b].0, dir))
                     .collect();
                 // The cheapest MAX_VERIFIED in order of cost (ties in the order made, as a
                 // stable sort of them all leaves them): a selection, then a sort of those few.
@@ -224,32 +254,26 @@ impl Rings {
                 }
                 order.sort_unstable_by(by_cost);
                 joins = order.iter().map(|&(_, k)| joins[k]).collect();
-                let mut curve_in = std::collections::HashMap::new();
-                let mut curve_out = std::collections::HashMap::new();
-                for &(cost, i, j) in joins.iter().take(MAX_VERIFIED) {
+                for &(cost, a, b) in joins.iter().take(MAX_VERIFIED) {
                     if best.as_ref().is_some_and(|b| b.0 <= cost) {
                         break;
                     }
-                    let a = curve_in
-                        .entry(i)
-                        .or_insert_with(|| {
-                            // (The entries and exits are in ring order.)
-                            let k = on.binary_search_by_key(&i, |e| e.0).ok()?;
-                            first_clear(&on[k].1 .1)
-                        })
-                        .clone();
-                    let Some(a) = a else { continue };
-                    let b = curve_out
-                        .entry(j)
-                        .or_insert_with(|| {
-                            let k = off.binary_search_by_key(&j, |e| e.0).ok()?;
-                            first_clear(&off[k].1 .1)
-                        })
-                        .clone();
-                    let Some(b) = b else { continue };
-                    let mut pts = a;
+                    // A join with an end known not to be clear is passed over first (the
+                    // other end's check, not needed for it, is left for a join that needs it).
+                    let (ea, eb) = (on[a].1, off[b].1);
+                    if ends.known_blocked(ea) || ends.known_blocked(eb) {
+                        continue;
+                    }
+                    if !ends.check(ea, step, clear) || !ends.check(eb, step, clear) {
+                        continue;
+                    }
+                    let (Some(pa), Some(pb)) = (ends.points(ea), ends.points(eb)) else {
+                        continue;
+                    };
+                    let (i, j) = (on[a].0, off[b].0);
+                    let mut pts = pa.to_vec();
                     pts.extend(ring.stretch(i, j, dir).into_iter().skip(1));
-                    pts.extend(b.into_iter().skip(1));
+                    pts.extend(pb.iter().skip(1));
                     let len = crate::geo::polygon::polyline_length(&pts);
                     if best.as_ref().is_none_or(|b| len < b.0) {
                         best = Some((len, pts));
@@ -262,10 +286,173 @@ impl Rings {
     }
 }
 
+/// Which curve an end of [`Rings::transit_with`] is: the free pose (`p1` of a curve onto a
+/// ring, `p2` of one off it), the ring, its point, the direction along it, onto or off, the
+/// radius and the spacing of the points (as bits).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct EndKey([u64; 8]);
+
+impl std::hash::Hash for EndKey {
+    /// Word by word (the standard hash of an array feeds its bytes one at a time).
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        for w in self.0 {
+            state.write_u64(w);
+        }
+    }
+}
+
+impl EndKey {
+    fn new(
+        (p, h): (Vec2, f64),
+        (ring, point, dir, onto): (usize, usize, i32, bool),
+        r: f64,
+        step: f64,
+    ) -> Self {
+        let tag = (u64::from(dir > 0) << 1) | u64::from(onto);
+        EndKey([
+            p.x.to_bits(),
+            p.y.to_bits(),
+            h.to_bits(),
+            ring as u64,
+            point as u64,
+            tag,
+            r.to_bits(),
+            step.to_bits(),
+        ])
+    }
+}
+
+/// One curve onto or off a ring: its words shortest first, and the points of its first clear
+/// word once checked (`Some(None)`: none is clear).
+struct End {
+    words: Vec<Csc>,
+    clear: Option<Option<Vec<Vec2>>>,
+}
+
+/// The curves onto and off the rings that [`Rings::transit_with`] solved and checked, for the
+/// next transit from or to the same pose with the same test (a transit's attempt with its
+/// target's start pulled back starts where the one before it did).
+#[derive(Default)]
+pub struct Ends {
+    index: std::collections::HashMap<EndKey, usize, BuildHasherDefault<EdgeHasher>>,
+    ends: Vec<End>,
+}
+
+impl Ends {
+    /// The index of the end `key`, its words solved by `solve` when first asked.
+    fn solve(&mut self, key: EndKey, solve: impl FnOnce() -> Vec<Csc>) -> usize {
+        if let Some(&e) = self.index.get(&key) {
+            return e;
+        }
+        self.ends.push(End {
+            words: solve(),
+            clear: None,
+        });
+        self.index.insert(key, self.ends.len() - 1);
+        self.ends.len() - 1
+    }
+
+    /// The length of end `e`'s shortest word; `None` when it has none.
+    fn length(&self, e: usize) -> Option<f64> {
+        self.ends.get(e)?.words.first().map(|c| c.length)
+    }
+
+    /// Is end `e` checked and none of its words clear?
+    fn known_blocked(&self, e: usize) -> bool {
+        self.ends
+            .get(e)
+            .is_some_and(|end| matches!(end.clear, Some(None)))
+    }
+
+    /// Is one of end `e`'s words clear (its first clear word's points, `step` m apart, kept)?
+    /// Checked once.
+    fn check(&mut self, e: usize, step: f64, clear: &dyn Fn(&Vec2) -> bool) -> bool {
+        let Some(end) = self.ends.get_mut(e) else {
+            return false;
+        };
+        let words = &end.words;
+        end.clear
+            .get_or_insert_with(|| words.iter().find_map(|c| c.points(step, clear)))
+            .is_some()
+    }
+
+    /// The points of end `e`'s first clear word, once checked.
+    fn points(&self, e: usize) -> Option<&[Vec2]> {
+        self.ends.get(e)?.clear.as_ref()?.as_deref()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::geo::v2;
+
+    /// [`Rings::transit_with`] with one store of ends for many transits (some from one pose
+    /// to several goals, some from several poses to one goal, some asked twice) gives the
+    /// answer [`Rings::transit`] gives with a store of its own, point for point.
+    #[test]
+    fn kept_ends_give_the_same_transits() {
+        use rand::{Rng, SeedableRng};
+        let corners = [
+            v2(0.0, 0.0),
+            v2(100.0, 0.0),
+            v2(100.0, 100.0),
+            v2(80.0, 100.0),
+            v2(80.0, 20.0),
+            v2(20.0, 20.0),
+            v2(20.0, 100.0),
+            v2(0.0, 100.0),
+            v2(0.0, 0.0),
+        ];
+        let inner = [
+            v2(10.0, 10.0),
+            v2(90.0, 10.0),
+            v2(90.0, 90.0),
+            v2(10.0, 90.0),
+            v2(10.0, 10.0),
+        ];
+        let tracks = [
+            crate::geo::polygon::resample(&corners, 1.0),
+            crate::geo::polygon::resample(&inner, 1.0),
+        ];
+        // Clear within 10.5 m of the U's track, but not in a square in its bottom arm.
+        let clear = |q: &Vec2| {
+            corners
+                .windows(2)
+                .any(|s| crate::geo::polygon::point_segment_distance(q, &s[0], &s[1]) <= 10.5)
+                && !(q.x > 45.0 && q.x < 55.0 && q.y > 2.0 && q.y < 8.0)
+        };
+        let rings = Rings::new(&tracks, &clear);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut pose = || {
+            let q = v2(rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0));
+            (q, rng.gen_range(-3.1..3.1))
+        };
+        let mut ends = Ends::default();
+        let (mut found, mut none) = (0, 0);
+        let mut asked = Vec::new();
+        for k in 0..40 {
+            let (a, b) = (pose(), pose());
+            asked.push((a, b));
+            // From the last start to a new goal, from a new start to the last goal, and again.
+            if k % 3 == 1 {
+                let (last, _) = asked[k - 1];
+                asked.push((last, b));
+                asked.push((a, asked[k - 1].1));
+            }
+            if k % 5 == 2 {
+                asked.push(asked[k / 2]);
+            }
+        }
+        for &((p1, h1), (p2, h2)) in &asked {
+            let want = rings.transit(p1, h1, p2, h2, 3.0, 0.5, &clear);
+            let got = rings.transit_with(p1, h1, p2, h2, 3.0, 0.5, &clear, &mut ends);
+            assert_eq!(got, want, "from {p1:?} to {p2:?}");
+            found += usize::from(want.is_some());
+            none += usize::from(want.is_none());
+        }
+        assert!(found > 10 && none > 2, "{found} found, {none} not");
+    }
 
     /// A U-shaped field's ring: the way from one arm's tip to the other's goes round the bay,
     /// where a direct curve would cross it.
