@@ -387,13 +387,9 @@ mod tests {
     use super::*;
     use crate::geo::v2;
 
-    /// [`Rings::transit_with`] with one store of ends for many transits (some from one pose
-    /// to several goals, some from several poses to one goal, some asked twice) gives the
-    /// answer [`Rings::transit`] gives with a store of its own, point for point.
-    #[test]
-    fn kept_ends_give_the_same_transits() {
-        use rand::{Rng, SeedableRng};
-        let corners = [
+    /// The corners of a U (arms 20 m wide, bay 60 m wide and 80 m deep), closed.
+    fn u_corners() -> [Vec2; 9] {
+        [
             v2(0.0, 0.0),
             v2(100.0, 0.0),
             v2(100.0, 100.0),
@@ -403,7 +399,16 @@ mod tests {
             v2(20.0, 100.0),
             v2(0.0, 100.0),
             v2(0.0, 0.0),
-        ];
+        ]
+    }
+
+    /// [`Rings::transit_with`] with one store of ends for many transits (some from one pose
+    /// to several goals, some from several poses to one goal, some asked twice) gives the
+    /// answer [`Rings::transit`] gives with a store of its own, point for point.
+    #[test]
+    fn kept_ends_give_the_same_transits() {
+        use rand::{Rng, SeedableRng};
+        let corners = u_corners();
         let inner = [
             v2(10.0, 10.0),
             v2(90.0, 10.0),
@@ -459,17 +464,7 @@ mod tests {
     #[test]
     fn a_transit_follows_the_ring_round_a_bay() {
         // Track round a U (arms 20 m wide, bay 60 m wide and 80 m deep), 1 m apart.
-        let corners = [
-            v2(0.0, 0.0),
-            v2(100.0, 0.0),
-            v2(100.0, 100.0),
-            v2(80.0, 100.0),
-            v2(80.0, 20.0),
-            v2(20.0, 20.0),
-            v2(20.0, 100.0),
-            v2(0.0, 100.0),
-            v2(0.0, 0.0),
-        ];
+        let corners = u_corners();
         let track = crate::geo::polygon::resample(&corners, 1.0);
         // Clear: within 10.5 m of the track (a corridor), sharp corners allowed for the test.
         let near_track = |q: &Vec2| {
