@@ -149,25 +149,11 @@ impl Rings {
 
     /// A clear transit from (`p1`, heading `h1`) to (`p2`, `h2`): a Dubins curve of radius
     /// `r` onto a ring, the ring's clear points, a Dubins curve off it; the shortest such of
-    /// the candidates tried, `None` when none is clear. Points about `step` m apart.
-    #[allow(clippy::too_many_arguments)]
-    pub fn transit(
-        &self,
-        p1: Vec2,
-        h1: f64,
-        p2: Vec2,
-        h2: f64,
-        r: f64,
-        step: f64,
-        clear: &dyn Fn(&Vec2) -> bool,
-    ) -> Option<Vec<Vec2>> {
-        self.transit_with(p1, h1, p2, h2, r, step, clear, &mut Ends::default())
-    }
-
-    /// [`Self::transit`] with the curves onto and off the rings kept in `ends` for the next
-    /// transit from or to the same pose: the same answer, with the curves of a pose that an
-    /// earlier call solved and checked not solved or checked again. `ends` must only ever be
-    /// used with one test `clear` (its checks are kept).
+    /// the candidates tried, `None` when none is clear. Points about `step` m apart. The
+    /// curves onto and off the rings are kept in `ends` for the next transit from or to the
+    /// same pose: the same answer as with a fresh `Ends::default()`, with the curves of a
+    /// pose that an earlier call solved and checked not solved or checked again. `ends` must
+    /// only ever be used with one test `clear` (its checks are kept).
     #[allow(clippy::too_many_arguments)]
     pub fn transit_with(
         &self,
@@ -404,7 +390,7 @@ mod tests {
 
     /// [`Rings::transit_with`] with one store of ends for many transits (some from one pose
     /// to several goals, some from several poses to one goal, some asked twice) gives the
-    /// answer [`Rings::transit`] gives with a store of its own, point for point.
+    /// answer it gives with a store of its own, point for point.
     #[test]
     fn kept_ends_give_the_same_transits() {
         use rand::{Rng, SeedableRng};
@@ -450,7 +436,7 @@ mod tests {
             }
         }
         for &((p1, h1), (p2, h2)) in &asked {
-            let want = rings.transit(p1, h1, p2, h2, 3.0, 0.5, &clear);
+            let want = rings.transit_with(p1, h1, p2, h2, 3.0, 0.5, &clear, &mut Ends::default());
             let got = rings.transit_with(p1, h1, p2, h2, 3.0, 0.5, &clear, &mut ends);
             assert_eq!(got, want, "from {p1:?} to {p2:?}");
             found += usize::from(want.is_some());
@@ -476,7 +462,7 @@ mod tests {
         let from = v2(10.0, 90.0);
         let to = v2(90.0, 90.0);
         let pts = rings
-            .transit(
+            .transit_with(
                 from,
                 std::f64::consts::FRAC_PI_2,
                 to,
@@ -484,6 +470,7 @@ mod tests {
                 3.0,
                 0.5,
                 &near_track,
+                &mut Ends::default(),
             )
             .expect("a way round the bay");
         assert!(pts.iter().all(near_track));
