@@ -403,13 +403,7 @@ impl Config {
         // command at the lateral-acceleration limit (`Config::turn_radius` leaves the margin
         // between it and the turn's angle). So the ramp may be no faster than margin / τ.
         let wheelbase = self.vehicle.wheelbase_m;
-        let limit = if v > 0.0 {
-            (self.safety.a_lat_max_m_s2 * wheelbase / (v * v))
-                .atan()
-                .min(self.max_wheel_angle())
-        } else {
-            self.max_wheel_angle()
-        };
+        let limit = self.safety_params().angle_limit(v);
         let margin = limit - (wheelbase / self.turn_radius()).atan();
         let tau = self.safety.actuator_tau_s;
         let rate = if tau > 0.0 && margin > 0.0 {

@@ -210,6 +210,20 @@ impl Default for SafetyParams {
     }
 }
 
+impl SafetyParams {
+    /// The largest wheel angle allowed at `speed` (m/s), rad: the angle limit, and the angle
+    /// whose kinematic lateral acceleration v²·tan δ / L is `a_lat_max`.
+    pub fn angle_limit(&self, speed: f64) -> f64 {
+        let v2 = speed * speed;
+        let by_alat = if v2 > 1e-9 {
+            (self.a_lat_max * self.wheelbase / v2).atan()
+        } else {
+            self.max_wheel_angle
+        };
+        self.max_wheel_angle.min(by_alat)
+    }
+}
+
 /// What goes to the steering frame this period.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SteeringCommand {
@@ -737,14 +751,7 @@ impl Supervisor {
 
     /// The largest wheel angle allowed at the current speed (angle and lateral acceleration).
     pub fn angle_limit(&self) -> f64 {
-        let p = &self.params;
-        let v2 = self.speed * self.speed;
-        let by_alat = if v2 > 1e-9 {
-            (p.a_lat_max * p.wheelbase / v2).atan()
-        } else {
-            p.max_wheel_angle
-        };
-        p.max_wheel_angle.min(by_alat)
+        self.params.angle_limit(self.speed)
     }
 
     /// The next engaged command: toward `demand` by at most the rate allowance, within the
