@@ -306,7 +306,7 @@ impl Controller {
         }
         // The wheels as they are, in the driving direction, less the sensor's estimated offset.
         let sensor_offset = if needs.observer {
-            self.estimator.wheel_offset()
+            self.estimator.wheel_offset_for_steering()
         } else {
             0.0
         };
@@ -346,7 +346,7 @@ impl Controller {
             // The steering controller servos the sensed angle to the command, so a sensor
             // reading `wheel_offset` more than the wheels leaves them short by as much:
             // command the estimated offset on top.
-            offset += self.estimator.wheel_offset();
+            offset += self.estimator.wheel_offset_for_steering();
         }
         if offset != 0.0 && tr.valid {
             let max = self.params.tracker.max_wheel_angle;
