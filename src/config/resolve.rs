@@ -223,6 +223,7 @@ impl Config {
                     bias_tau: t.observer_bias_tau_s,
                     drift_tau: t.observer_drift_tau_s,
                     min_speed: t.observer_min_speed_mps,
+                    offset_min_speed: t.observer_offset_min_speed_mps,
                     bias_limit: t.observer_bias_limit_deg.to_radians(),
                     drift_limit: t.observer_drift_limit_mps,
                     slip_tau: t.observer_slip_tau_s,

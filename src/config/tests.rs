@@ -67,6 +67,7 @@ fn sim_disturbance_keys_parse_and_validate() {
 fn observer_and_arcs_keys_parse_and_validate() {
     let cfg = Config::parse_with(
         "[track]\nobserver_drift_tau_s = -1\nobserver_min_speed_mps = 0\n\
+         observer_offset_min_speed_mps = 20\n\
          observer_slip_limit_mps_per_deg = 2\nobserver_coast_max_s = 700\n\
          [job]\nkind = \"arcs\"\narc_sweep_deg = 360\nline_num = 0\n",
         &[],
@@ -77,6 +78,7 @@ fn observer_and_arcs_keys_parse_and_validate() {
     for m in [
         "track.observer_drift_tau_s = -1: must be 0 (off) or in 1..=600",
         "track.observer_min_speed_mps = 0: must be in 0.1..=10",
+        "track.observer_offset_min_speed_mps = 20: must be in 0.1..=10",
         "track.observer_slip_limit_mps_per_deg = 2: must be in 0..=1",
         "track.observer_coast_max_s = 700: must be in 0..=600",
         "job.arc_sweep_deg = 360: must be in 1..=359",
@@ -84,7 +86,7 @@ fn observer_and_arcs_keys_parse_and_validate() {
     ] {
         assert!(msgs.contains(&m.to_string()), "{m} not in {msgs:?}");
     }
-    assert_eq!(msgs.len(), 6, "{msgs:?}");
+    assert_eq!(msgs.len(), 7, "{msgs:?}");
     // The observer is on by default (the default tracker uses it).
     let t = TrackConfig::default();
     assert!(t.observer_bias_tau_s > 0.0 && t.observer_drift_tau_s > 0.0);

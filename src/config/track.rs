@@ -77,8 +77,11 @@ pub struct TrackConfig {
     pub observer_bias_tau_s: f64,
     /// Time constant of the world-frame drift (slip) estimate, s (0 = off, else 1..=600).
     pub observer_drift_tau_s: f64,
-    /// The observer learns only above this speed, m/s.
+    /// The observer learns its drift and slip only above this speed, m/s.
     pub observer_min_speed_mps: f64,
+    /// The observer learns the wheel-angle offset only above this speed, m/s: the offset shows
+    /// as a heading change of v·δ/L, so at a crawl it is lost in the heading's noise.
+    pub observer_offset_min_speed_mps: f64,
     /// Largest wheel-angle offset the observer may estimate, degrees. The offset it learns is
     /// the sensor's zero error (calibration leaves ≤ 0.1°) plus the steady steer a side force
     /// needs: a 5 kN implement side draft at 1.5 m behind the axle learns −2.97°, and with the
@@ -145,7 +148,8 @@ impl Default for TrackConfig {
             curvature_scale_limit: 0.3,
             observer_bias_tau_s: 20.0,
             observer_drift_tau_s: 60.0,
-            observer_min_speed_mps: 1.0,
+            observer_min_speed_mps: 0.2,
+            observer_offset_min_speed_mps: 1.0,
             observer_bias_limit_deg: 6.0,
             observer_drift_limit_mps: 0.3,
             observer_slip_tau_s: 30.0,
@@ -249,6 +253,12 @@ impl TrackConfig {
         c.range(
             "track.observer_min_speed_mps",
             t.observer_min_speed_mps,
+            0.1,
+            10.0,
+        );
+        c.range(
+            "track.observer_offset_min_speed_mps",
+            t.observer_offset_min_speed_mps,
             0.1,
             10.0,
         );

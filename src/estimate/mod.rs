@@ -104,6 +104,10 @@ pub struct ObserverParams {
     pub drift_tau: f64,
     /// Learns only above this speed, m/s.
     pub min_speed: f64,
+    /// Learns the wheel-angle offset only above this speed, m/s (at least `min_speed`): its
+    /// innovation is a heading change of v·δ/L, so its gain L/(v·τ) multiplies the heading's
+    /// noise as the speed falls.
+    pub offset_min_speed: f64,
     /// Largest wheel-angle offset, rad.
     pub bias_limit: f64,
     /// Largest drift speed, m/s.
@@ -141,6 +145,7 @@ impl Default for ObserverParams {
             bias_tau: 0.0,
             drift_tau: 0.0,
             min_speed: 1.0,
+            offset_min_speed: 1.0,
             bias_limit: 3f64.to_radians(),
             drift_limit: 0.3,
             slip_tau: 0.0,
@@ -495,7 +500,8 @@ impl Estimator {
         let tau = |configured: f64| configured.min(self.learnt.max(BIAS_PRIOR_S));
         // The wheel angle over the interval, less the offset.
         let delta = self.wheel_angle_at(t_prev + 0.5 * dt) - self.bias;
-        if o.bias_tau > 0.0 && delta.abs() < BIAS_MAX_WHEEL {
+        let offset_observable = v.abs().min(v_new.abs()) >= o.offset_min_speed;
+        if o.bias_tau > 0.0 && delta.abs() < BIAS_MAX_WHEEL && offset_observable {
             let c = delta.cos();
             let gain = self.params.wheelbase * c * c / (v * tau(o.bias_tau));
             self.bias = (self.bias - d_heading * gain).clamp(-o.bias_limit, o.bias_limit);
