@@ -54,6 +54,9 @@ const CELLS: &[(&str, &str, f64)] = &[
     // Session 18: turns no faster than a lagging steering can lead within the supervisor's
     // angle limit (a 0.6 s lag at 15 km/h left every line start 0.7-1.3 m off: 3.23 cm).
     ("lag_0.6", "straight_15kmh", 0.68),
+    // Session 19: the drift learnt down to 0.2 m/s (a 2° slope's slip, a 6° crab at 1 km/h:
+    // 18.5 cm RMS before).
+    ("speed_1", "slip_side_slope", 0.31),
 ];
 
 #[test]
