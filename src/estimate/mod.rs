@@ -16,6 +16,7 @@ use nalgebra::Vector3;
 
 mod drift_memory;
 mod lateral_filter;
+mod significance;
 use drift_memory::DriftMemory;
 use lateral_filter::LateralFilter;
 
@@ -213,16 +214,6 @@ const BIAS_PRIOR_S: f64 = 3.0;
 /// it is left alone.
 const SLIP_REFERENCE_ROLL: f64 = 0.035;
 
-/// A drift or offset estimate steers only as far as it stands out of its own noise: by this
-/// many standard deviations of its error ([`Estimator::drift_velocity`],
-/// [`Estimator::wheel_offset_for_steering`]; docs/envelope.md, "Session 19").
-const SIGNIFICANCE: f64 = 1.0;
-
-/// `x` moved towards 0 by `by` (≥ 0), never past it.
-fn soft_threshold(x: f64, by: f64) -> f64 {
-    x.signum() * (x.abs() - by).max(0.0)
-}
-
 /// The estimate handed to guidance and tracking.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VehicleEstimate {
@@ -286,8 +277,8 @@ pub struct Estimator {
     /// Estimated variance of a fix's heading noise, rad², from the heading innovations the
     /// offset learns from (half their mean square: each is the difference of two fixes' noise).
     heading_noise_var: f64,
-    /// The offset estimate's error from the heading noise, rad, as of its latest update (see
-    /// [`Estimator::wheel_offset_for_steering`]).
+    /// The offset estimate's error from the heading noise, rad, as of its latest update
+    /// ([`significance`]).
     offset_noise: f64,
     /// The previous fix's lateral innovation, m.
     prev_lateral: Option<f64>,
@@ -389,12 +380,10 @@ impl Estimator {
     }
 
     /// The wheel-angle offset as the tracker steers for it: only as far as it stands out of
-    /// its own noise (soft-thresholded at [`SIGNIFICANCE`] standard deviations of its error),
-    /// as the drift ([`Estimator::drift_velocity`]). The heading innovations the offset learns
-    /// from telescope, so an estimate averaged over T s at speed v carries the heading noise
-    /// of two fixes, σθ·√2·L/(v·T): about 0.03° in a job's first seconds at 15 km/h (σθ 0.1°).
+    /// its own noise ([`significance`]; about 0.03° in a job's first seconds at 15 km/h with
+    /// a heading noise of 0.1°).
     pub fn wheel_offset_for_steering(&self) -> f64 {
-        soft_threshold(self.bias, SIGNIFICANCE * self.offset_noise)
+        significance::steered(self.bias, self.offset_noise)
     }
 
     /// The estimated world-frame drift velocity, m/s (without the slope slip).
@@ -404,26 +393,17 @@ impl Estimator {
 
     /// The estimated drift velocity (world frame, m/s) of a vehicle heading `heading` (rad) at
     /// the latest roll, the world drift plus the slope slip, as the tracker steers for it: its
-    /// part across the heading only as far as it stands out of its own noise (soft-thresholded
-    /// at [`SIGNIFICANCE`] standard deviations of its error; the along part as it is).
-    ///
-    /// The error: the lateral innovations of consecutive fixes telescope, so an estimate
-    /// averaged over T s carries the noise of two fixes, σ·√2/T (σ the fixes' noise,
-    /// [`Estimator::position_noise`]), and the filter's variance along its regressor
-    /// h = (n, −sin roll) is 1/T in its units. When learning starts, or starts afresh across a
-    /// new direction, that is about σ·√2 per second, and at 15 km/h with 1 cm fixes that noise
-    /// steered a job's first pass up to 1.8 cm off its line where the references stayed within
-    /// 0.8 cm (docs/envelope.md, "Session 19"). A true drift passes less the threshold, which
-    /// falls as the estimate settles (0.05 cm/s after a minute at 1 cm, 10 Hz).
+    /// part across the heading only as far as it stands out of its own noise
+    /// ([`significance`]: the error from the fixes' noise and the lateral filter's variance
+    /// along h = (n, −sin roll)), the part along as it is.
     pub fn drift_velocity(&self, heading: f64) -> Vec2 {
         let n = left_normal(&heading_vec(heading));
         let sin_roll = self.roll.sin();
         let whole = self.drift - n * (self.slip * sin_roll);
         let across = whole.dot(&n);
         let h = Vector3::new(n.x, n.y, -sin_roll);
-        let per_second = h.dot(&(self.lateral.p * h)).max(0.0);
-        let sigma = std::f64::consts::SQRT_2 * self.noise_var.sqrt() * per_second;
-        whole + n * (soft_threshold(across, SIGNIFICANCE * sigma) - across)
+        let error = significance::drift_error(self.noise_var.sqrt(), h.dot(&(self.lateral.p * h)));
+        whole + n * (significance::steered(across, error) - across)
     }
 
     /// Integrate the bicycle model from `pose` at `t0` over `span` s at speed `v`, with the
@@ -509,7 +489,7 @@ impl Estimator {
             // the noise of two headings through its gain.
             let sample = (d_heading * d_heading).min(16.0 * 2.0 * self.heading_noise_var) / 2.0;
             self.heading_noise_var += (sample - self.heading_noise_var) / NOISE_FIXES;
-            self.offset_noise = std::f64::consts::SQRT_2 * self.heading_noise_var.sqrt() * gain;
+            self.offset_noise = significance::offset_error(self.heading_noise_var.sqrt(), gain);
         }
         // The lateral rate error e = Δl/Δt measures h·(θ − θ̂) with θ = (drift, slip) and
         // h = (n, −sin roll): one Kalman update of the three together.
@@ -803,3 +783,5 @@ impl Estimator {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_start_up;
