@@ -62,7 +62,12 @@ pub(super) struct ClearMap<'a> {
     cell: f64,
     nx: usize,
     ny: usize,
-    state: RefCell<Vec<u32>>,
+    /// `1 / cell`: a point's cell found by two products (a point on a cell's side, put in
+    /// either cell by the rounding, lies within a micrometre of both cells' discs, and their
+    /// states allow a micrometre).
+    inv_cell: f64,
+    /// Per cell, its state (a `Cell` each: one load per point, no borrow flag).
+    state: Vec<std::cell::Cell<u32>>,
     locals: RefCell<Vec<Local>>,
     /// Per block (row-major, `nx.div_ceil(BLOCK)` a row): its edges and the rings it lies
     /// inside, `None` until first needed.
@@ -93,7 +98,8 @@ impl<'a> ClearMap<'a> {
             cell,
             nx,
             ny,
-            state: RefCell::new(vec![UNKNOWN; nx * ny]),
+            inv_cell: 1.0 / cell,
+            state: vec![std::cell::Cell::new(UNKNOWN); nx * ny],
             locals: RefCell::new(Vec::new()),
             blocks: RefCell::new(vec![None; nx.div_ceil(BLOCK) * ny.div_ceil(BLOCK)]),
             supers: RefCell::new(vec![
@@ -106,8 +112,8 @@ impl<'a> ClearMap<'a> {
     /// Is the implement clear at `q` (inside the boundary, off the obstacles, `half` m from
     /// every edge)? The same answer as [`implement_clear`].
     pub(super) fn clear(&self, q: &Vec2) -> bool {
-        let x = (q.x - self.origin.x) / self.cell;
-        let y = (q.y - self.origin.y) / self.cell;
+        let x = (q.x - self.origin.x) * self.inv_cell;
+        let y = (q.y - self.origin.y) * self.inv_cell;
         // Off the grid (or not a number): outside the boundary's bounding box (the grid covers
         // it with a cell to spare), so outside the field. (Asked of the boundary's every edge,
         // the points of curves that swing out past the field's edge cost as much as the rest.)
@@ -118,12 +124,12 @@ impl<'a> ClearMap<'a> {
         }
         let (i, j) = (x as usize, y as usize);
         let k = j * self.nx + i;
-        let known = self.state.borrow()[k];
+        let known = self.state[k].get();
         let state = if known == UNKNOWN {
             let centre =
                 self.origin + v2((i as f64 + 0.5) * self.cell, (j as f64 + 0.5) * self.cell);
             let s = self.classify(centre, &self.block_edges(i / BLOCK, j / BLOCK));
-            self.state.borrow_mut()[k] = s;
+            self.state[k].set(s);
             s
         } else {
             known
@@ -518,9 +524,9 @@ mod tests {
                 disagree += usize::from(map.clear(&q) != want);
                 if !want {
                     blocked += 1;
-                    let x = ((q.x - map.origin.x) / map.cell) as usize;
-                    let y = ((q.y - map.origin.y) / map.cell) as usize;
-                    let state = map.state.borrow().get(y * map.nx + x).copied();
+                    let x = ((q.x - map.origin.x) * map.inv_cell) as usize;
+                    let y = ((q.y - map.origin.y) * map.inv_cell) as usize;
+                    let state = map.state.get(y * map.nx + x).map(|c| c.get());
                     in_blocked_cells += usize::from(state == Some(BLOCKED));
                 }
             }
