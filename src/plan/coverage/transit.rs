@@ -11,6 +11,8 @@ use std::cell::RefCell;
 use std::f64::consts::TAU;
 use std::rc::Rc;
 
+#[path = "finish.rs"]
+mod finish;
 #[path = "free.rs"]
 mod free;
 
@@ -539,9 +541,18 @@ fn search(
     // The cell of a displacement (di, dj) in the table's layout.
     let span_cell =
         |di: i64, dj: i64| (di + EDGE_REACH) as usize * EDGE_SPAN + (dj + EDGE_REACH) as usize;
-    let mut expansions = 0;
+    let (mut expansions, mut pops) = (0, 0);
     while let Some((Reverse(queued), s, from)) = heap.pop() {
         let s = s as usize;
+        // (Once, after some states off the queue: can any state finish? See `finish`.)
+        pops += 1;
+        let mark = search.wrapping_sub(1);
+        let ends = ((p1, h1), (p2, h2));
+        if pops == finish::ASK_AFTER
+            && finish::out_of_reach(grid, ends.0, ends.1, r, step, &to_goal, mark)
+        {
+            return None;
+        }
         if done[s] {
             continue;
         }
