@@ -61,15 +61,15 @@ pub(super) fn out_of_reach(
         if !open(k) {
             continue;
         }
-        for s in k * H..(k + 1) * H {
+        for (h, state) in reaches[k * H..(k + 1) * H].iter_mut().enumerate() {
             checks += 1;
-            let (q, hq) = pose(s);
             if checks > BUDGET {
                 return false;
             }
+            let (q, hq) = pose(k * H + h);
             if clear_transit(q, hq, p2, h2, r, step, clear).is_some() {
-                reaches[s] = true;
-                stack.push(s);
+                *state = true;
+                stack.push(k * H + h);
             }
         }
     }
