@@ -62,7 +62,12 @@ pub(super) struct ClearMap<'a> {
     cell: f64,
     nx: usize,
     ny: usize,
-    state: RefCell<Vec<u32>>,
+    /// `1 / cell`: a point's cell found by two products (a point on a cell's side, put in
+    /// either cell by the rounding, lies within a micrometre of both cells' discs, and their
+    /// states allow a micrometre).
+    inv_cell: f64,
+    /// Per cell, its state (a `Cell` each: one load per point, no borrow flag).
+    state: Vec<std::cell::Cell<u32>>,
     locals: RefCell<Vec<Local>>,
     /// Per block (row-major, `nx.div_ceil(BLOCK)` a row): its edges and the rings it lies
     /// inside, `None` until first needed.
@@ -93,7 +98,8 @@ impl<'a> ClearMap<'a> {
             cell,
             nx,
             ny,
-            state: RefCell::new(vec![UNKNOWN; nx * ny]),
+            inv_cell: 1.0 / cell,
+            state: vec![std::cell::Cell::new(UNKNOWN); nx * ny],
             locals: RefCell::new(Vec::new()),
             blocks: RefCell::new(vec![None; nx.div_ceil(BLOCK) * ny.div_ceil(BLOCK)]),
             supers: RefCell::new(vec![
@@ -106,8 +112,8 @@ impl<'a> ClearMap<'a> {
     /// Is the implement clear at `q` (inside the boundary, off the obstacles, `half` m from
     /// every edge)? The same answer as [`implement_clear`].
     pub(super) fn clear(&self, q: &Vec2) -> bool {
-        let x = (q.x - self.origin.x) / self.cell;
-        let y = (q.y - self.origin.y) / self.cell;
+        let x = (q.x - self.origin.x) * self.inv_cell;
+        let y = (q.y - self.origin.y) * self.inv_cell;
         // Off the grid (or not a number): outside the boundary's bounding box (the grid covers
         // it with a cell to spare), so outside the field. (Asked of the boundary's every edge,
         // the points of curves that swing out past the field's edge cost as much as the rest.)
@@ -118,12 +124,12 @@ impl<'a> ClearMap<'a> {
         }
         let (i, j) = (x as usize, y as usize);
         let k = j * self.nx + i;
-        let known = self.state.borrow()[k];
+        let known = self.state[k].get();
         let state = if known == UNKNOWN {
             let centre =
                 self.origin + v2((i as f64 + 0.5) * self.cell, (j as f64 + 0.5) * self.cell);
             let s = self.classify(centre, &self.block_edges(i / BLOCK, j / BLOCK));
-            self.state.borrow_mut()[k] = s;
+            self.state[k].set(s);
             s
         } else {
             known
@@ -238,16 +244,34 @@ impl<'a> ClearMap<'a> {
         let clear_of_edges = block
             .iter()
             .all(|(_, a, b)| point_segment_distance(&centre, a, b) >= self.half + reach - 1e-6);
-        if clear_of_edges
-            && inside_of(0, &self.field.boundary, &centre)
-            && self
-                .field
-                .obstacles
-                .iter()
-                .enumerate()
-                .all(|(k, o)| !inside_of(k + 1, o, &centre))
-        {
+        let free = || {
+            inside_of(0, &self.field.boundary, &centre)
+                && self
+                    .field
+                    .obstacles
+                    .iter()
+                    .enumerate()
+                    .all(|(k, o)| !inside_of(k + 1, o, &centre))
+        };
+        if clear_of_edges && free() {
             return CLEAR;
+        }
+        // Blocked throughout (a point of a blocked curve is most often in such a cell, near an
+        // edge: one lookup instead of its distances to the edges near it): the centre within
+        // `half - reach` of an edge, so every point of the cell within `half` of it; or the
+        // centre farther than that from every edge (a millimetre at least, so its side of each
+        // ring is sure) and outside the field or inside an obstacle, so a point of the cell
+        // that is inside the field and off the obstacles lies across an edge from the centre,
+        // within `reach` (< `half`) of that edge.
+        if reach <= self.half - 1e-3 {
+            let within = self.half - reach - 1e-5;
+            if block
+                .iter()
+                .any(|(_, a, b)| point_segment_distance(&centre, a, b) <= within)
+                || !free()
+            {
+                return BLOCKED;
+            }
         }
         let rings = std::iter::once(&self.field.boundary).chain(self.field.obstacles.iter());
         let mut edges = Vec::new();
@@ -456,6 +480,60 @@ mod tests {
                 "half {half}: {} {:?}",
                 disagree.len(),
                 &disagree[..disagree.len().min(5)]
+            );
+        }
+    }
+
+    /// Near the edges, where the cells blocked throughout are (within `half` less a cell's
+    /// half diagonal of an edge, or outside the field or inside an obstacle): the map answers
+    /// as [`implement_clear`] does at points within two half widths of an edge on either
+    /// side, and most of the points it finds not clear there it finds in such cells.
+    #[test]
+    fn the_map_agrees_near_the_edges() {
+        let field = Field {
+            boundary: vec![
+                v2(0.0, 0.0),
+                v2(120.0, 0.0),
+                v2(120.0, 80.0),
+                v2(70.0, 30.0),
+                v2(40.0, 90.0),
+                v2(0.0, 60.0),
+            ],
+            obstacles: vec![vec![
+                v2(20.0, 20.0),
+                v2(35.0, 22.0),
+                v2(30.0, 35.0),
+                v2(18.0, 30.0),
+            ]],
+        };
+        let rings: Vec<&Vec<Vec2>> = std::iter::once(&field.boundary)
+            .chain(field.obstacles.iter())
+            .collect();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for half in [0.6, 1.5, 1.72, 3.0, 9.0] {
+            let map = ClearMap::new(&field, half);
+            let (mut disagree, mut blocked, mut in_blocked_cells) = (0, 0, 0);
+            for _ in 0..40_000 {
+                let ring = rings[rng.gen_range(0..rings.len())];
+                let i = rng.gen_range(0..ring.len());
+                let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+                let along = a + (b - a) * rng.gen_range(-0.05..1.05);
+                let normal = crate::geo::left_normal(&(b - a).normalize());
+                let q = along + normal * rng.gen_range(-2.0 * half..2.0 * half);
+                let want = implement_clear(&field, half, &q);
+                disagree += usize::from(map.clear(&q) != want);
+                if !want {
+                    blocked += 1;
+                    let x = ((q.x - map.origin.x) * map.inv_cell) as usize;
+                    let y = ((q.y - map.origin.y) * map.inv_cell) as usize;
+                    let state = map.state.get(y * map.nx + x).map(|c| c.get());
+                    in_blocked_cells += usize::from(state == Some(BLOCKED));
+                }
+            }
+            assert_eq!(disagree, 0, "half {half}");
+            assert!(
+                2 * in_blocked_cells > blocked,
+                "half {half}: {in_blocked_cells} of {blocked} in cells blocked throughout"
             );
         }
     }

@@ -211,6 +211,7 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     let loose = |q: &Vec2| loose_map.as_ref().unwrap_or(&clear_map).clear(q);
     let (grid, loose_grid) = (std::cell::OnceCell::new(), std::cell::OnceCell::new());
     let tests = Tests {
+        field,
         clear: &clear,
         loose: &loose,
         clearance: (strict_half, loose_half),
@@ -224,6 +225,8 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
 /// The clearance tests of one field, width, r_min and point spacing, and their waypoint grids
 /// (built on first need: most plans never need them).
 struct Tests<'a> {
+    /// The field.
+    field: &'a Field,
     /// The implement clear of the edge and the obstacles.
     clear: &'a dyn Fn(&Vec2) -> bool,
     /// The tractor inside the field and off the obstacles ([`TRANSIT_CLEARANCE_M`]).
@@ -285,21 +288,18 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
     // the field, each with the test of its curves.
     let (grid_lo, grid_hi) =
         crate::geo::polygon::bbox(field.boundary.iter()).unwrap_or((v2(0.0, 0.0), v2(1.0, 1.0)));
-    let grid_step = 2.0 * p.r_min;
-    let waypoint_grid = || {
-        tests.grid.get_or_init(|| {
-            let c = tests.clearance.0;
-            transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, clear, c)
-        })
+    let grid_of = |test, c| {
+        let c = (c, Some(tests.field));
+        transit::WaypointGrid::new(grid_lo, grid_hi, 2.0 * p.r_min, 20_000, test, c)
     };
+    let waypoint_grid = || tests.grid.get_or_init(|| grid_of(clear, tests.clearance.0));
     let loose_grid = || {
         if one_test {
             return waypoint_grid();
         }
-        tests.loose_grid.get_or_init(|| {
-            let c = tests.clearance.1;
-            transit::WaypointGrid::new(grid_lo, grid_hi, grid_step, 20_000, loose, c)
-        })
+        tests
+            .loose_grid
+            .get_or_init(|| grid_of(loose, tests.clearance.1))
     };
     let warnings = std::cell::RefCell::new(Vec::<String>::new());
 

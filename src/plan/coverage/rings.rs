@@ -199,6 +199,18 @@ impl Rings {
                         Some((i, e, ends.length(e)?))
                     })
                     .collect();
+                // Every join costs at least the shortest way on: none beats the best so far
+                // when that does not (the bound below, with the ways off left out).
+                let least =
+                    |v: &[(usize, usize, f64)]| v.iter().map(|e| e.2).fold(f64::INFINITY, f64::min);
+                if best.as_ref().is_some_and(|b| b.0 <= least(&on)) {
+                    continue;
+                }
+                // No join of this direction is clear when no curve onto the ring is: the ways
+                // off are then not solved, nor the joins made (see [`Ends::any_clear`]).
+                if !ends.any_clear(&on, step, clear) {
+                    continue;
+                }
                 let off: Vec<(usize, usize, f64)> = exits
                     .iter()
                     .filter_map(|&j| {
@@ -209,12 +221,14 @@ impl Rings {
                     })
                     .collect();
                 // Every join costs at least the shortest way on plus the shortest way off.
-                let least =
-                    |v: &[(usize, usize, f64)]| v.iter().map(|e| e.2).fold(f64::INFINITY, f64::min);
                 if best
                     .as_ref()
                     .is_some_and(|b| b.0 <= least(&on) + least(&off))
                 {
+                    continue;
+                }
+                // Nor when no curve off it is.
+                if !ends.any_clear(&off, step, clear) {
                     continue;
                 }
                 // (cost, entry, exit), the entry and exit as positions in `on` and `off`.
@@ -360,6 +374,29 @@ impl Ends {
         end.clear
             .get_or_insert_with(|| words.iter().find_map(|c| c.points(step, clear)))
             .is_some()
+    }
+
+    /// Is one of the ends `v` ((ring point, end, length) as [`Rings::transit_with`] lists
+    /// them) clear? Checked shortest first, up to the first clear one; each end's check is
+    /// kept, so a join made after this checks no end again. A direction of a ring with no
+    /// clear end on one side has no clear join (a join needs a clear end on each side): most
+    /// of the failing headland attempts of narrow fields (de_bb_holes_irregular, dk_marker_strip
+    /// at w 3 m) found no clear curve onto the ring in three directions of four, after solving
+    /// the curves off it and making and ordering the joins of every pair.
+    fn any_clear(
+        &mut self,
+        v: &[(usize, usize, f64)],
+        step: f64,
+        clear: &dyn Fn(&Vec2) -> bool,
+    ) -> bool {
+        if v.iter().any(|e| self.points(e.1).is_some()) {
+            return true;
+        }
+        let mut order: Vec<(f64, usize)> = v.iter().map(|e| (e.2, e.1)).collect();
+        order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        order
+            .into_iter()
+            .any(|(_, e)| !self.known_blocked(e) && self.check(e, step, clear))
     }
 
     /// The points of end `e`'s first clear word, once checked.

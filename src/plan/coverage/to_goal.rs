@@ -250,7 +250,14 @@ mod tests {
                     point_segment_distance(q, &boundary[i], &boundary[(i + 1) % n]) >= half
                 })
         };
-        let grid = WaypointGrid::new(v2(0.0, 0.0), v2(200.0, 100.0), 10.0, 20_000, &clear, half);
+        let grid = WaypointGrid::new(
+            v2(0.0, 0.0),
+            v2(200.0, 100.0),
+            10.0,
+            20_000,
+            &clear,
+            (half, None),
+        );
         // Goal just right of the slot, 20 m up; the node left of it at (90, 20).
         let goal = v2(97.0, 20.0);
         let open = grid.open_distances(&goal, 30.0);

@@ -11,6 +11,11 @@ use std::cell::RefCell;
 use std::f64::consts::TAU;
 use std::rc::Rc;
 
+#[path = "finish.rs"]
+mod finish;
+#[path = "free.rs"]
+mod free;
+
 /// One Dubins CSC curve: arc about `c1`, straight from `t1` along `theta`, arc about `c2`.
 pub(super) struct Csc {
     c1: Vec2,
@@ -268,20 +273,25 @@ pub struct WaypointGrid<'a> {
     /// The answers of the searches made, by their poses, radius, spacing and budget (the
     /// plans of a field with several headland pass counts ask the same ones).
     answers: RefCell<std::collections::HashMap<[u64; 9], Option<Vec<Vec2>>>>,
+    /// The nodes' distances to the field's edges: the edges known clear unchecked.
+    free: free::Free<'a>,
 }
 
 impl<'a> WaypointGrid<'a> {
     /// Nodes every `step` m over the box `lo`–`hi` where `clear` holds; at most `max_nodes`
     /// (the step grows to fit). The curves of every search on the grid keep `clear` at every
     /// point. `clearance`: the distance from the field's edges and obstacles `clear` keeps, m
-    /// (the ground that is not clear is at least twice that thick).
+    /// (the ground that is not clear is at least twice that thick), and the field when `clear`
+    /// is [`super::implement_clear`] of it with that distance (its edges far from a node then
+    /// tell the curves from the node that are clear without checking their points; `None`:
+    /// every curve checked point by point).
     pub fn new(
         lo: Vec2,
         hi: Vec2,
         step: f64,
         max_nodes: usize,
         clear: &'a dyn Fn(&Vec2) -> bool,
-        clearance: f64,
+        (clearance, field): (f64, Option<&'a super::Field>),
     ) -> Self {
         let span = hi - lo;
         let step = step.max((span.x.max(0.0) * span.y.max(0.0) / max_nodes.max(1) as f64).sqrt());
@@ -299,6 +309,7 @@ impl<'a> WaypointGrid<'a> {
             edges: RefCell::default(),
             closed: RefCell::default(),
             answers: RefCell::default(),
+            free: free::Free::new(field, clearance, nx * ny),
         }
     }
 
@@ -530,9 +541,18 @@ fn search(
     // The cell of a displacement (di, dj) in the table's layout.
     let span_cell =
         |di: i64, dj: i64| (di + EDGE_REACH) as usize * EDGE_SPAN + (dj + EDGE_REACH) as usize;
-    let mut expansions = 0;
+    let (mut expansions, mut pops) = (0, 0);
     while let Some((Reverse(queued), s, from)) = heap.pop() {
         let s = s as usize;
+        // (Once, after some states off the queue: can any state finish? See `finish`.)
+        pops += 1;
+        let mark = search.wrapping_sub(1);
+        let ends = ((p1, h1), (p2, h2));
+        if pops == finish::ASK_AFTER
+            && finish::out_of_reach(grid, ends.0, ends.1, r, step, &to_goal, mark)
+        {
+            return None;
+        }
         if done[s] {
             continue;
         }
@@ -565,10 +585,12 @@ fn search(
             };
             earlier.unwrap_or_else(|| {
                 let (base, words) = words_of(from, s);
+                // (The shortest word clear unchecked where the edges are far: see `free`.)
+                let far = |w: &EdgeWord| grid.free.covers(from as usize / H, &base, w.length);
                 let k = words
                     .iter()
                     .enumerate()
-                    .find(|(_, w)| all_clear(&w.pts, base, clear))
+                    .find(|(w, word)| (*w == 0 && far(word)) || all_clear(&word.pts, base, clear))
                     .map(|(w, found)| (w as u8, found.length));
                 grid.edges.borrow_mut().checked.insert(edge, (k, search));
                 (k, true)
