@@ -391,11 +391,9 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
 
-    /// The map answers as [`implement_clear`] does, point for point, on a concave field with
-    /// an obstacle, near its edges and vertices and outside it.
-    #[test]
-    fn the_map_agrees_with_the_direct_check() {
-        let field = Field {
+    /// A concave field (a notch from the north-east) with one obstacle.
+    fn concave_field_with_obstacle() -> Field {
+        Field {
             boundary: vec![
                 v2(0.0, 0.0),
                 v2(120.0, 0.0),
@@ -410,7 +408,14 @@ mod tests {
                 v2(30.0, 35.0),
                 v2(18.0, 30.0),
             ]],
-        };
+        }
+    }
+
+    /// The map answers as [`implement_clear`] does, point for point, on a concave field with
+    /// an obstacle, near its edges and vertices and outside it.
+    #[test]
+    fn the_map_agrees_with_the_direct_check() {
+        let field = concave_field_with_obstacle();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         for half in [0.7, 3.0, 9.0] {
             let map = ClearMap::new(&field, half);
@@ -490,22 +495,7 @@ mod tests {
     /// side, and most of the points it finds not clear there it finds in such cells.
     #[test]
     fn the_map_agrees_near_the_edges() {
-        let field = Field {
-            boundary: vec![
-                v2(0.0, 0.0),
-                v2(120.0, 0.0),
-                v2(120.0, 80.0),
-                v2(70.0, 30.0),
-                v2(40.0, 90.0),
-                v2(0.0, 60.0),
-            ],
-            obstacles: vec![vec![
-                v2(20.0, 20.0),
-                v2(35.0, 22.0),
-                v2(30.0, 35.0),
-                v2(18.0, 30.0),
-            ]],
-        };
+        let field = concave_field_with_obstacle();
         let rings: Vec<&Vec<Vec2>> = std::iter::once(&field.boundary)
             .chain(field.obstacles.iter())
             .collect();
