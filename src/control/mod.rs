@@ -342,12 +342,10 @@ impl Controller {
             dt,
             learning,
         );
-        if needs.observer {
-            // The steering controller servos the sensed angle to the command, so a sensor
-            // reading `wheel_offset` more than the wheels leaves them short by as much:
-            // command the estimated offset on top.
-            offset += self.estimator.wheel_offset_for_steering();
-        }
+        // The steering controller servos the sensed angle to the command, so a sensor reading
+        // `sensor_offset` more than the wheels leaves them short by as much: command the
+        // estimated offset on top (0 without the observer).
+        offset += sensor_offset;
         if offset != 0.0 && tr.valid {
             let max = self.params.tracker.max_wheel_angle;
             tr.wheel_angle = (tr.wheel_angle + offset).clamp(-max, max);

@@ -173,6 +173,14 @@ const NOISE_START: f64 = 0.01;
 /// The heading noise's starting value, rad (0.1°, a dual-antenna receiver's).
 const HEADING_NOISE_START: f64 = 0.1 * std::f64::consts::PI / 180.0;
 
+/// A noise's variance `var` after one `sample` that is the difference of two of its draws
+/// (variance 2σ²): over [`NOISE_FIXES`] samples, each clipped at 4 σ so that a jump's onset
+/// barely moves it.
+fn learn_variance(var: f64, sample: f64) -> f64 {
+    let s = (sample * sample).min(16.0 * 2.0 * var) / 2.0;
+    var + (s - var) / NOISE_FIXES
+}
+
 /// Why the estimator is dead-reckoning instead of taking the fix positions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Coast {
@@ -352,9 +360,7 @@ impl Estimator {
         } else {
             lateral
         };
-        let cap = 16.0 * 2.0 * self.noise_var;
-        let s = (sample * sample).min(cap) / 2.0;
-        self.noise_var += (s - self.noise_var) / NOISE_FIXES;
+        self.noise_var = learn_variance(self.noise_var, sample);
     }
 
     /// Whether the next fixes are RTK float (coast through them, see
@@ -487,8 +493,7 @@ impl Estimator {
             self.bias = (self.bias - d_heading * gain).clamp(-o.bias_limit, o.bias_limit);
             // The heading innovations telescope like the lateral ones: the estimate carries
             // the noise of two headings through its gain.
-            let sample = (d_heading * d_heading).min(16.0 * 2.0 * self.heading_noise_var) / 2.0;
-            self.heading_noise_var += (sample - self.heading_noise_var) / NOISE_FIXES;
+            self.heading_noise_var = learn_variance(self.heading_noise_var, d_heading);
             self.offset_noise = significance::offset_error(self.heading_noise_var.sqrt(), gain);
         }
         // The lateral rate error e = Δl/Δt measures h·(θ − θ̂) with θ = (drift, slip) and

@@ -4,6 +4,7 @@
 //! Contract: plain data and their checks, no planning. Everything in `plan::*` may use these;
 //! this module uses only [`crate::geo`].
 
+use crate::geo::polygon::point_segment_distance;
 use crate::geo::{Direction, Vec2};
 use serde::{Deserialize, Serialize};
 
@@ -52,6 +53,19 @@ pub struct Field {
     /// Obstacles (holes of the boundary and separate obstacle features), each
     /// counter-clockwise, not closed, inside the boundary.
     pub obstacles: Vec<Vec<Vec2>>,
+}
+
+impl Field {
+    /// The distance from `q` to the nearest edge of the boundary or of an obstacle, m.
+    pub fn distance_to_edges(&self, q: &Vec2) -> f64 {
+        std::iter::once(&self.boundary)
+            .chain(self.obstacles.iter())
+            .flat_map(|ring| {
+                let n = ring.len();
+                (0..n).map(move |i| point_segment_distance(q, &ring[i], &ring[(i + 1) % n]))
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
 }
 
 /// What a plan segment is for. Serialised as the GeoJSON `kind` property.

@@ -7,7 +7,6 @@
 //! 6 400 and 4 200, checked each edge's 30–70 points, though most of the field lies farther
 //! than the edges are long from its boundary.)
 
-use crate::geo::polygon::point_segment_distance;
 use crate::geo::Vec2;
 use crate::plan::coverage::Field;
 use std::cell::RefCell;
@@ -50,17 +49,7 @@ impl<'a> Free<'a> {
         };
         let known = self.dist.borrow().get(k).copied().unwrap_or(f64::NAN);
         let d = if known.is_nan() {
-            let ring_dist = |ring: &[Vec2]| {
-                let n = ring.len();
-                (0..n)
-                    .map(|i| point_segment_distance(at, &ring[i], &ring[(i + 1) % n]))
-                    .fold(f64::INFINITY, f64::min)
-            };
-            let d = field
-                .obstacles
-                .iter()
-                .map(|o| ring_dist(o))
-                .fold(ring_dist(&field.boundary), f64::min);
+            let d = field.distance_to_edges(at);
             if let Some(x) = self.dist.borrow_mut().get_mut(k) {
                 *x = d;
             }

@@ -4,7 +4,7 @@
 
 use super::super::{Field, FieldPlan, SegmentKind};
 use super::{merged, three_point_curvature};
-use crate::geo::polygon::{contains_point, point_segment_distance};
+use crate::geo::polygon::contains_point;
 use crate::geo::Vec2;
 use serde::Serialize;
 
@@ -67,16 +67,6 @@ impl std::fmt::Display for Violation {
     }
 }
 
-fn distance_to_rings(field: &Field, q: &Vec2) -> f64 {
-    std::iter::once(&field.boundary)
-        .chain(field.obstacles.iter())
-        .flat_map(|ring| {
-            let n = ring.len();
-            (0..n).map(move |i| point_segment_distance(q, &ring[i], &ring[(i + 1) % n]))
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
 /// Collects runs of consecutive offending points of one segment into violations.
 struct Runs<'a> {
     out: &'a mut Vec<Violation>,
@@ -137,7 +127,7 @@ pub fn check_plan(field: &Field, plan: &FieldPlan, line_width: f64, r_min: f64) 
             last: None,
         };
         for q in &pts {
-            let bad = (!contains_point(&field.boundary, q)).then(|| distance_to_rings(field, q));
+            let bad = (!contains_point(&field.boundary, q)).then(|| field.distance_to_edges(q));
             outside.point(bad, q, ViolationKind::OutsideBoundary, seg);
         }
         outside.close();
@@ -151,7 +141,7 @@ pub fn check_plan(field: &Field, plan: &FieldPlan, line_width: f64, r_min: f64) 
                 .obstacles
                 .iter()
                 .any(|o| contains_point(o, q))
-                .then(|| distance_to_rings(field, q));
+                .then(|| field.distance_to_edges(q));
             inside.point(bad, q, ViolationKind::InsideObstacle, seg);
         }
         inside.close();
@@ -164,7 +154,7 @@ pub fn check_plan(field: &Field, plan: &FieldPlan, line_width: f64, r_min: f64) 
             for q in &pts {
                 let inside_field = contains_point(&field.boundary, q)
                     && !field.obstacles.iter().any(|o| contains_point(o, q));
-                let d = distance_to_rings(field, q);
+                let d = field.distance_to_edges(q);
                 let bad = (inside_field && d < half - CLEARANCE_SLACK_M).then_some(half - d);
                 clear.point(bad, q, ViolationKind::FootprintNotClear, seg);
             }
