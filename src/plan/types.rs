@@ -56,6 +56,15 @@ pub struct Field {
 }
 
 impl Field {
+    /// Is `q` inside the boundary and outside every obstacle?
+    pub fn contains(&self, q: &Vec2) -> bool {
+        crate::geo::polygon::contains_point(&self.boundary, q)
+            && !self
+                .obstacles
+                .iter()
+                .any(|o| crate::geo::polygon::contains_point(o, q))
+    }
+
     /// The distance from `q` to the nearest edge of the boundary or of an obstacle, m.
     pub fn distance_to_edges(&self, q: &Vec2) -> f64 {
         std::iter::once(&self.boundary)

@@ -385,6 +385,9 @@ struct SweepRow {
     footprint_violations: usize,
     curvature_violations: usize,
     max_curvature_ratio: f64,
+    /// Places where the plan goes on with no transit inside the field (the planner's
+    /// warnings name them).
+    transit_gaps: usize,
     plan_time_ms: f64,
 }
 
@@ -491,6 +494,7 @@ where
                     footprint_violations: 0,
                     curvature_violations: 0,
                     max_curvature_ratio: 0.0,
+                    transit_gaps: 0,
                     plan_time_ms,
                 };
                 let (unreachable_m2, unreachable_pieces) =
@@ -525,6 +529,7 @@ where
                         row.footprint_violations = count(ViolationKind::FootprintNotClear);
                         row.curvature_violations = count(ViolationKind::Curvature);
                         row.max_curvature_ratio = m.max_curvature * r;
+                        row.transit_gaps = plan.transit_gaps;
                     }
                 }
                 let worked = match (&row.error, &row.refused) {
@@ -588,12 +593,14 @@ where
     let worked_97 = count(&|r| r.covered_fraction >= 0.97);
     let reachable_97 = count(&|r| r.reachable_worked_fraction >= 0.97);
     let overlap_3 = count(&|r| r.overlap_fraction <= 0.03);
+    let with_gaps = count(&|r| r.transit_gaps > 0);
+    let gaps: usize = rows.iter().filter(planned).map(|r| r.transit_gaps).sum();
     let worst = rows
         .iter()
         .filter(|r| r.field_ha <= 100.0)
         .max_by(|a, b| a.plan_time_ms.total_cmp(&b.plan_time_ms));
     println!(
-        "{} plans: {} refused (no swath fits, headland passes alone < {:.0} %), {} errors; of the {} planned: field worked median {:.2} %, min {:.2} %; overlap max {:.2} %; {} plans with violations; {} worked ≥ 97 % of the field, {} ≥ 97 % of its reachable ground, {} with overlap ≤ 3 %",
+        "{} plans: {} refused (no swath fits, headland passes alone < {:.0} %), {} errors; of the {} planned: field worked median {:.2} %, min {:.2} %; overlap max {:.2} %; {} plans with violations; {} worked ≥ 97 % of the field, {} ≥ 97 % of its reachable ground, {} with overlap ≤ 3 %; {} plans go on without a transit inside the field at {} places",
         rows.len(),
         refused,
         100.0 * HEADLAND_ONLY_MIN_WORKED,
@@ -605,7 +612,9 @@ where
         violating,
         worked_97,
         reachable_97,
-        overlap_3
+        overlap_3,
+        with_gaps,
+        gaps
     );
     if let Some(w) = worst {
         println!(

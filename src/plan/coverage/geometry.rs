@@ -100,6 +100,26 @@ pub fn inscribed_width(area: &Area) -> f64 {
     2.0 * inside
 }
 
+/// The areas with every vertex dropped that lies within `tolerance` m of the outline without
+/// it (Ramer–Douglas–Peucker).
+pub fn simplified(areas: &[Area], tolerance: f64) -> Vec<Area> {
+    use geo::Simplify;
+    from_geo(&MultiPolygon::new(areas.iter().map(to_geo).collect()).simplify(tolerance))
+}
+
+/// Length of every ring of `area`, closing edges included, m.
+pub fn perimeter(area: &Area) -> f64 {
+    std::iter::once(&area.0)
+        .chain(area.1.iter())
+        .map(|ring| {
+            let n = ring.len();
+            (0..n)
+                .map(|i| (ring[(i + 1) % n] - ring[i]).norm())
+                .sum::<f64>()
+        })
+        .sum()
+}
+
 /// Rotate `p` by `angle` rad counter-clockwise about the origin.
 #[inline]
 pub fn rotate(p: &Vec2, angle: f64) -> Vec2 {

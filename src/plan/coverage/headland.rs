@@ -12,7 +12,7 @@
 //! such a bend and the corner is what the metrics report as unworked near the corner; the pass
 //! keeps its offset everywhere else (the whole ring is no longer raised to r_min).
 
-use super::geometry::{offset, Area};
+use super::geometry::{offset, simplified, Area};
 use super::CoverageParams;
 pub use crate::geo::polygon::resample;
 use crate::geo::{cross, v2, Vec2};
@@ -381,6 +381,8 @@ pub fn subtract_obstacles(areas: &[Area], obstacles: &[Vec<Vec2>], margin: f64) 
 pub struct Passes {
     pub field: Vec<Vec<Vec2>>,
     pub obstacles: Vec<Vec<Vec2>>,
+    /// Each pass's area (the pass runs along its rings), outermost first.
+    pub areas: Vec<Vec<Area>>,
 }
 
 /// The headland passes of the field with its headland obstacles: pass k runs along the rings of
@@ -403,8 +405,63 @@ pub fn passes_around(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoveragePar
                     .extend(tracks_of(&[(h.clone(), vec![])], p.point_spacing));
             }
         }
+        out.areas.push(opened);
     }
     out
+}
+
+/// Vertices of the leftover ground dropped within this distance of its outline, m
+/// ([`with_leftover`]): its offsets' fine arcs made the clipper cross every edge with every
+/// other (over a second on one parcel), for ground drawn to a few centimetres anyway.
+const LEFTOVER_SIMPLIFY_M: f64 = 0.05;
+
+/// How much wider than the implement each footprint is taken when the leftover ground is
+/// found, m ([`with_leftover`]).
+const LEFTOVER_SLACK_M: f64 = 0.05;
+
+/// The working area with the ground inside the outermost pass that neither the passes'
+/// footprints nor `working` cover, where a disc an implement wide fits (an opening of radius
+/// w/2) and the piece is larger than 4·w²: in an arm narrower than the inner passes need (each
+/// pass is opened at r_min and vanishes there) that ground was never worked; as working area it
+/// gets swaths, with turns on the passes' ground where they fit.
+pub fn with_leftover(working: Vec<Area>, passes: &Passes, p: &CoverageParams) -> Vec<Area> {
+    if passes.areas.is_empty() {
+        return working;
+    }
+    let half = p.line_width / 2.0;
+    let min_area = 4.0 * p.line_width * p.line_width;
+    // Inside pass k's footprint and outside pass k + 1's (the working area's after the last):
+    // the footprints tile the headland, so their edges coincide where both passes run; each
+    // footprint is taken LEFTOVER_SLACK_M wider, which keeps the clipper off coincident edges.
+    let reach = half + LEFTOVER_SLACK_M;
+    let areas: Vec<Vec<Area>> = passes
+        .areas
+        .iter()
+        .map(|a| simplified(a, LEFTOVER_SIMPLIFY_M))
+        .collect();
+    let left: Vec<Area> = (0..areas.len())
+        .flat_map(|k| {
+            let inner = match areas.get(k + 1) {
+                Some(next) => offset(next, reach),
+                None => offset(&simplified(&working, LEFTOVER_SIMPLIFY_M), LEFTOVER_SLACK_M),
+            };
+            difference(&offset(&areas[k], -reach), &inner)
+        })
+        // Slivers (mean thickness 2·area/perimeter under w/2) go first, cheaply.
+        .filter(|a| {
+            let area = super::geometry::area_m2(a);
+            area > min_area && 2.0 * area >= half * super::geometry::perimeter(a)
+        })
+        .collect();
+    let eroded = offset(&simplified(&left, LEFTOVER_SIMPLIFY_M), -half);
+    let left: Vec<Area> = offset(&simplified(&eroded, LEFTOVER_SIMPLIFY_M), half)
+        .into_iter()
+        .filter(|a| super::geometry::area_m2(a) > min_area)
+        .collect();
+    if left.is_empty() {
+        return working;
+    }
+    union(&working, &left)
 }
 
 /// The area of pass centres at offset `d` (boundary shrunk by `d`, obstacles grown by `d`, the

@@ -16,6 +16,8 @@ pub mod geometry;
 pub mod headland;
 pub mod metrics;
 pub mod narrow;
+mod params;
+mod reverse;
 pub mod rings;
 mod runs;
 pub mod swath_angle;
@@ -24,6 +26,7 @@ mod to_goal;
 pub mod transit;
 
 pub use crate::plan::types::{Field, PlanSegment, SegmentKind};
+pub use params::{CoverageParams, FieldPlan, HeadlandOrder, RouteOrder, SwathAngle};
 pub use runs::obstacle_size;
 
 use clear_map::ClearMap;
@@ -31,94 +34,6 @@ use runs::drive_run;
 
 use crate::geo::{v2, vec_heading, wrap_angle, Direction, Vec2};
 use crate::plan::types::PlanError;
-use serde::{Deserialize, Serialize};
-
-/// How the swath direction is chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", tag = "objective")]
-pub enum SwathAngle {
-    /// Minimum span of the convex hull (rotating calipers over the edge directions; seed 003).
-    #[default]
-    MinSpan,
-    /// The least total number of turns across the cells after decomposition.
-    MinTurns,
-    /// A fixed direction, rad CCW from East (e.g. parallel to an AB line or the longest edge).
-    Fixed { angle: f64 },
-}
-
-/// Order of the swaths inside a cell.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RouteOrder {
-    /// Boustrophedon when `line_width ≥ 2·r_min`, else the seed-000 block skip order.
-    #[default]
-    Auto,
-    /// Adjacent swaths in turn (fishtail turns when `line_width < 2·r_min`).
-    Sequential,
-    /// The seed-000 block/TSP skip order.
-    Skip,
-}
-
-/// When the headland passes are driven.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum HeadlandOrder {
-    /// Headland passes first, outermost first (the swaths' turns then run on worked ground;
-    /// mowing, spraying, harvest).
-    #[default]
-    First,
-    /// Swaths first, then the headland passes, innermost first: tillage and seeding work the
-    /// headland last, over the tracks their turns left.
-    Last,
-}
-
-/// Everything the coverage planner needs besides the field. Units in the names' docs.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CoverageParams {
-    /// Implement working width = swath spacing, m.
-    pub line_width: f64,
-    /// Minimum turning radius, m.
-    pub r_min: f64,
-    /// Number of headland passes around the field (each `line_width` wide).
-    pub headland_passes: usize,
-    /// Spacing of plan points, m.
-    pub point_spacing: f64,
-    /// Swath direction objective.
-    pub swath_angle: SwathAngle,
-    /// Swath order inside each cell.
-    pub route: RouteOrder,
-    /// Obstacles whose largest dimension ([`obstacle_size`]) is at most this are passed on
-    /// detours (the swaths run through them; each blocked stretch becomes a smooth path round
-    /// the obstacle); larger ones get headland passes and split the swaths, m.
-    pub small_obstacle_max_m: f64,
-    /// Largest curvature rate per metre driven, 1/m², for continuous-curvature fishtail turns
-    /// (clothoid + arc + clothoid); 0 = fishtails of arcs only.
-    pub max_curvature_rate: f64,
-    /// Headland passes before or after the swaths.
-    pub headland_order: HeadlandOrder,
-}
-
-/// A complete field plan: segments in driving order plus the areas they were made for.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct FieldPlan {
-    /// Every segment in driving order (headland passes, swaths, turns, detours, transits).
-    pub segments: Vec<PlanSegment>,
-    /// The working area (inside the headland) as polygons: (outer ring, holes), all CCW.
-    pub working_area: Vec<(Vec<Vec2>, Vec<Vec<Vec2>>)>,
-    /// Number of cells after decomposition.
-    pub cells: usize,
-    /// Swath direction of each cell, rad CCW from East.
-    pub swath_angles: Vec<f64>,
-    /// Number of work swaths.
-    pub swaths: usize,
-    /// Overlap of adjacent swath footprints from balancing, m² (estimate: the extra width
-    /// times the mean swath length).
-    pub overlap_m2: f64,
-    /// Turn shapes solved in the canonical frame (each reused for every alike turn).
-    pub turn_shapes_solved: usize,
-    /// What the planner could not make clear, each naming the place (local frame, m).
-    pub warnings: Vec<String>,
-}
 
 /// A point of a path keeps the implement inside the field and off the obstacles: inside the
 /// boundary and at least `half` m from every boundary edge and every obstacle.
@@ -136,44 +51,13 @@ pub fn implement_clear(field: &Field, half: f64, q: &Vec2) -> bool {
             .all(|o| !contains_point(o, q) && far(o))
 }
 
-impl CoverageParams {
-    fn validate(&self) -> Result<(), PlanError> {
-        PlanError::check("line_width", self.line_width, self.line_width > 0.0)?;
-        PlanError::check("r_min", self.r_min, self.r_min > 0.0)?;
-        PlanError::check(
-            "point_spacing",
-            self.point_spacing,
-            self.point_spacing > 0.0,
-        )?;
-        PlanError::check(
-            "max_curvature_rate",
-            self.max_curvature_rate,
-            self.max_curvature_rate >= 0.0,
-        )?;
-        PlanError::check(
-            "small_obstacle_max_m",
-            self.small_obstacle_max_m,
-            self.small_obstacle_max_m >= 0.0,
-        )?;
-        Ok(())
-    }
-
-    fn turn_params(&self) -> crate::plan::turns::TurnParams {
-        crate::plan::turns::TurnParams {
-            r_min: self.r_min,
-            arc_step: 2f64.to_radians(),
-            merge_distance: 0.05,
-            point_spacing: self.point_spacing,
-            max_points: 100_000,
-            max_curvature_rate: self.max_curvature_rate,
-        }
-    }
-}
-
 /// How far a transit that cannot keep the implement clear of the edge keeps its path inside
 /// the field and off the obstacles, m (about half a tractor's width; the implement is lifted
 /// and may reach over the edge there): the guarantee for paths that do not work.
 pub const TRANSIT_CLEARANCE_M: f64 = 1.5;
+
+/// The reversing transits' ends are pulled back this many points at a time.
+const REVERSE_CUT_STEP: usize = 4;
 
 /// States a transit's waypoint search may expand before giving up.
 const ROUTE_MAX_EXPANSIONS: usize = 20_000;
@@ -276,7 +160,12 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         &large,
         margin,
     );
-    let working = headland::working_area(&field.boundary, &large, p);
+    let passes = headland::passes_around(&field.boundary, &large, p);
+    let working = headland::with_leftover(
+        headland::working_area(&field.boundary, &large, p),
+        &passes,
+        p,
+    );
     // Points are checked; the chords between them may cut a little inside the arcs
     // (`tests.clear`). Transits that find no way with the implement clear of the edge keep the
     // tractor inside the field and off the obstacles (`tests.loose`; the guarantee for
@@ -302,6 +191,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             .get_or_init(|| grid_of(loose, tests.clearance.1))
     };
     let warnings = std::cell::RefCell::new(Vec::<String>::new());
+    let transit_gaps = std::cell::Cell::new(0);
 
     // Cells and their swath directions.
     let global_angle = match p.swath_angle {
@@ -339,7 +229,8 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
     let headland::Passes {
         field: field_passes,
         obstacles: obstacle_passes,
-    } = headland::passes_around(&field.boundary, &large, p);
+        ..
+    } = passes;
     // Transits may follow the headland passes (field and obstacles) where they are clear.
     let rings = rings::Rings::new(
         &field_passes
@@ -503,19 +394,37 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         // the plan goes on from the target without a transit, so each part is worked on its
         // own and the warning names the gap. (A curve out of the field would break a
         // guarantee; dropping the target would leave the rest of the field unworked.)
+        // Else backing out: a Reeds–Shepp path with only the tractor inside the field, the
+        // ends pulled back as the forward attempts were.
+        let cut = |segments: &mut Vec<PlanSegment>, cp: usize| {
+            if let Some(last) = segments.last_mut().filter(|_| cp > 0) {
+                last.points.truncate(last.points.len() - cp);
+            }
+        };
+        if found.is_none() {
+            for t in (0..=max_cut).step_by(REVERSE_CUT_STEP) {
+                let (cp, cn, f, hf, q, hq) = poses(t);
+                let Some(parts) =
+                    reverse::transit((f, hf), (q, hq), p.r_min, p.point_spacing, &loose)
+                else {
+                    continue;
+                };
+                cut(segments, cp);
+                for (direction, pts) in parts {
+                    push(segments, SegmentKind::Transit, direction, cell, pts);
+                }
+                return cn;
+            }
+        }
         let Some((pts, cut_prev, cut_next)) = found else {
+            transit_gaps.set(transit_gaps.get() + 1);
             warnings.borrow_mut().push(format!(
                 "no transit inside the field from ({:.1}, {:.1}) to ({:.1}, {:.1}): the plan goes on there without one (parts joined only by a neck too narrow to turn through; drive round outside the field)",
                 from.x, from.y, to.x, to.y
             ));
             return 0;
         };
-        if cut_prev > 0 {
-            if let Some(last) = segments.last_mut() {
-                let keep = last.points.len() - cut_prev;
-                last.points.truncate(keep);
-            }
-        }
+        cut(segments, cut_prev);
         push(
             segments,
             SegmentKind::Transit,
@@ -774,6 +683,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
                     &mut cache,
                     &mut block_orders,
                     &clear,
+                    field,
                     &mut segments,
                     &mut at,
                     &mut go_to,
@@ -793,6 +703,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         overlap_m2,
         turn_shapes_solved: cache.solved,
         warnings: warnings.into_inner(),
+        transit_gaps: transit_gaps.get(),
     })
 }
 

@@ -20,6 +20,10 @@ pub(super) type Detour<'a> = dyn Fn(Vec2, f64, Vec2, f64) -> Option<Vec<Vec2>> +
 /// the length of a half circle plus the straight legs it replaces (no loops round the field).
 const ASYMMETRIC_TURN_MAX_LENGTH: f64 = 1.5;
 
+/// A straight between a turn and a swath shorter than this is not added: the turn's end point
+/// moves onto the swath's instead, m.
+const SNAP_M: f64 = 0.01;
+
 /// Largest dimension of an obstacle (greatest distance between two of its vertices), m.
 pub fn obstacle_size(ring: &[Vec2]) -> f64 {
     let mut size: f64 = 0.0;
@@ -127,6 +131,7 @@ pub(super) fn drive_run(
     cache: &mut crate::plan::turns::TurnCache,
     orders: &mut BlockOrders,
     clear: &dyn Fn(&Vec2) -> bool,
+    field: &crate::plan::types::Field,
     segments: &mut Vec<PlanSegment>,
     at: &mut Option<(Vec2, f64)>,
     go_to: &mut GoTo<'_>,
@@ -219,19 +224,38 @@ pub(super) fn drive_run(
                 };
                 let mut parts = cache.turn(world(apex, y), d, world(apex, y2), tp)?;
                 let lead_in = world(e_new, y);
+                // A lead-in or tail shorter than SNAP_M moves the turn's end point instead:
+                // a point that close to the next bends the path sharply in the checks.
                 if let Some(first) = parts.first_mut() {
-                    let mut pts = transit::straight(lead_in, first.points[0], p.point_spacing);
-                    pts.pop();
-                    pts.extend(first.points.iter().copied());
-                    first.points = pts;
+                    if (first.points[0] - lead_in).norm() < SNAP_M {
+                        first.points[0] = lead_in;
+                    } else {
+                        let mut pts = transit::straight(lead_in, first.points[0], p.point_spacing);
+                        pts.pop();
+                        pts.extend(first.points.iter().copied());
+                        first.points = pts;
+                    }
                 }
                 if let Some(last) = parts.last_mut() {
-                    let from = *last.points.last().unwrap_or(&lead_in);
-                    let tail = transit::straight(from, world(start2, y2), p.point_spacing);
-                    last.points.extend(tail.into_iter().skip(1));
+                    let (from, to) = (*last.points.last().unwrap_or(&lead_in), world(start2, y2));
+                    if (to - from).norm() < SNAP_M {
+                        if let Some(q) = last.points.last_mut() {
+                            *q = to;
+                        }
+                    } else {
+                        let tail = transit::straight(from, to, p.point_spacing);
+                        last.points.extend(tail.into_iter().skip(1));
+                    }
                 }
                 let ok = parts.iter().all(|t| t.points.iter().all(clear));
-                if ok || best.is_none() {
+                // With no clear turn, the least pulled-back one that keeps the tractor in the
+                // field (the implement is raised).
+                if ok
+                    || (best.is_none()
+                        && parts
+                            .iter()
+                            .all(|t| t.points.iter().all(|q| field.contains(q))))
+                {
                     best = Some((parts, e_new, start2));
                 }
                 if ok {
@@ -239,6 +263,9 @@ pub(super) fn drive_run(
                 }
             }
             let Some((parts, e_new, start2)) = best else {
+                // No turn in the field: the next swath is reached by a transit.
+                pieces.push((SegmentKind::Transit, Direction::Forward, Vec::new()));
+                forward = !forward;
                 continue;
             };
             // This swath ends where its turn begins.

@@ -227,3 +227,47 @@ fn headland_order_last_works_the_swaths_first_and_the_headland_from_the_inside_o
     let ml = metrics::plan_metrics(&field, &last, 6.0);
     assert!((mf.covered_fraction - ml.covered_fraction).abs() < 0.005);
 }
+
+/// A block with an arm 24 m wide (w 3 m, r_min 8 m, 4 passes): only the outermost pass fits
+/// in the arm (pass k is opened at r_min), and the ground inside it, 18 m wide, was never
+/// worked (no working area there: the field shrunk by 4·w); 78.5 % of the field was worked.
+/// Now swaths work it, with reversing transits where no turn fits, the plan within the
+/// guarantees and joined. (Turned by 0.3 rad: the field with its edges on the axes runs the
+/// metrics' footprint stroke out of memory, before this change too.)
+#[test]
+fn an_arm_narrower_than_the_inner_passes_is_worked() {
+    let (sin, cos) = 0.3f64.sin_cos();
+    let turned = |x: f64, y: f64| v2(x * cos - y * sin, x * sin + y * cos);
+    let field = Field {
+        boundary: vec![
+            turned(0.0, 0.0),
+            turned(100.0, 0.0),
+            turned(100.0, 100.0),
+            turned(24.0, 100.0),
+            turned(24.0, 250.0),
+            turned(0.0, 250.0),
+        ],
+        obstacles: vec![],
+    };
+    let p = params(3.0, 8.0, 4);
+    let plan = plan_field(&field, &p).unwrap();
+    // The guarantees (turns and transits keep the tractor in the field; the implement is
+    // raised there) and one path throughout.
+    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
+    assert!(violations.is_empty(), "{violations:?}");
+    for pair in plan.segments.windows(2) {
+        assert!((pair[1].points[0] - *pair[0].points.last().unwrap()).norm() < 1e-6);
+    }
+    let m = metrics::plan_metrics(&field, &plan, p.line_width);
+    // Work whose middle is in the arm (beyond y' = 110 m in the field's own frame).
+    let in_arm = |q: &Vec2| -q.x * sin + q.y * cos > 110.0;
+    let arm_work: f64 = plan
+        .segments
+        .iter()
+        .filter(|s| s.kind == SegmentKind::Work && in_arm(&s.points[s.points.len() / 2]))
+        .map(|s| crate::geo::polygon::polyline_length(&s.points))
+        .sum();
+    assert!(arm_work > 500.0, "arm work {arm_work} m");
+    assert!(m.covered_fraction > 0.85, "covered {}", m.covered_fraction);
+    assert_eq!(plan.transit_gaps, 0);
+}

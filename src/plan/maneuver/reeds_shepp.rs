@@ -204,13 +204,15 @@ fn lp_rm_s_lm_rp(x: f64, y: f64, phi: f64, sp: f64, cp: f64) -> Option<(f64, f64
 struct Best {
     word: Option<RsWord>,
     len: f64,
+    /// Every word offered, when asked for ([`reeds_shepp_paths`]).
+    all: Option<Vec<RsWord>>,
 }
 
 impl Best {
     #[inline]
     fn offer(&mut self, letters: &[RsLetter], lengths: &[f64]) {
         let len: f64 = lengths.iter().map(|l| l.abs()).sum();
-        if len < self.len {
+        if len < self.len || self.all.is_some() {
             let mut w = RsWord {
                 letters: [S; 5],
                 lengths: [0.0; 5],
@@ -218,8 +220,13 @@ impl Best {
             };
             w.letters[..letters.len()].copy_from_slice(letters);
             w.lengths[..lengths.len()].copy_from_slice(lengths);
-            self.len = len;
-            self.word = Some(w);
+            if let Some(all) = &mut self.all {
+                all.push(w);
+            }
+            if len < self.len {
+                self.len = len;
+                self.word = Some(w);
+            }
         }
     }
 }
@@ -310,6 +317,22 @@ fn ccscc(x: f64, y: f64, phi: f64, sp: f64, cp: f64, b: &mut Best) {
 /// Shortest word from `start` to `goal` for turning radius `r_min_m` (None if r ≤ 0 or the
 /// inputs are not finite).
 pub fn reeds_shepp_word(start: &Pose, goal: &Pose, r_min_m: f64) -> Option<RsWord> {
+    words(start, goal, r_min_m, false)?.word
+}
+
+/// Every Reeds-Shepp path from `start` to `goal` for turning radius `r_min_m` that the formulas
+/// give (up to 48 words, a few of them alike), shortest first: where the shortest leaves the
+/// free space, a longer one may not.
+pub fn reeds_shepp_paths(start: &Pose, goal: &Pose, r_min_m: f64) -> Vec<CurvePath> {
+    let mut all = words(start, goal, r_min_m, true)
+        .and_then(|b| b.all)
+        .unwrap_or_default();
+    all.sort_by(|a, b| a.length().total_cmp(&b.length()));
+    all.iter().map(|w| path_of(start, w, r_min_m)).collect()
+}
+
+/// The formulas' words (the shortest, and every one when `collect`).
+fn words(start: &Pose, goal: &Pose, r_min_m: f64, collect: bool) -> Option<Best> {
     if !(r_min_m > 0.0 && r_min_m.is_finite()) {
         return None;
     }
@@ -325,13 +348,14 @@ pub fn reeds_shepp_word(start: &Pose, goal: &Pose, r_min_m: f64) -> Option<RsWor
     let mut best = Best {
         word: None,
         len: f64::INFINITY,
+        all: collect.then(Vec::new),
     };
     csc(x, y, phi, sp, cp, &mut best);
     ccc(x, y, phi, sp, cp, &mut best);
     cccc(x, y, phi, sp, cp, &mut best);
     ccsc(x, y, phi, sp, cp, &mut best);
     ccscc(x, y, phi, sp, cp, &mut best);
-    best.word
+    Some(best)
 }
 
 /// Length (m) of the shortest Reeds-Shepp path.
@@ -342,6 +366,11 @@ pub fn reeds_shepp_length(start: &Pose, goal: &Pose, r_min_m: f64) -> Option<f64
 /// Shortest Reeds-Shepp path as arcs of curvature ±1/r and lines (zero-length parts omitted).
 pub fn reeds_shepp_shortest(start: &Pose, goal: &Pose, r_min_m: f64) -> Option<CurvePath> {
     let w = reeds_shepp_word(start, goal, r_min_m)?;
+    Some(path_of(start, &w, r_min_m))
+}
+
+/// Word `w` from `start` as arcs and lines (zero-length parts omitted).
+fn path_of(start: &Pose, w: &RsWord, r_min_m: f64) -> CurvePath {
     let mut segments = Vec::with_capacity(w.n);
     for i in 0..w.n {
         let l = w.lengths[i];
@@ -360,10 +389,10 @@ pub fn reeds_shepp_shortest(start: &Pose, goal: &Pose, r_min_m: f64) -> Option<C
             S => CurveSegment::line(dir, len),
         });
     }
-    Some(CurvePath {
+    CurvePath {
         start: *start,
         segments,
-    })
+    }
 }
 
 #[cfg(test)]

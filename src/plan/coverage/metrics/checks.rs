@@ -152,8 +152,7 @@ pub fn check_plan(field: &Field, plan: &FieldPlan, line_width: f64, r_min: f64) 
                 last: None,
             };
             for q in &pts {
-                let inside_field = contains_point(&field.boundary, q)
-                    && !field.obstacles.iter().any(|o| contains_point(o, q));
+                let inside_field = field.contains(q);
                 let d = field.distance_to_edges(q);
                 let bad = (inside_field && d < half - CLEARANCE_SLACK_M).then_some(half - d);
                 clear.point(bad, q, ViolationKind::FootprintNotClear, seg);

@@ -1,0 +1,57 @@
+//! Transits with reversing (seed 004's Reeds–Shepp paths): where no forward transit stays
+//! inside the field (a swath ending in a pocket narrower than a turn, parts joined by a neck),
+//! a farmer backs out and drives on. Tried by [`super::plan_field`] before the plan goes on
+//! with a gap.
+
+use crate::geo::{Direction, Pose, Vec2};
+use crate::plan::maneuver::{drive::split_at_cusps, reeds_shepp::reeds_shepp_paths};
+
+/// The shortest Reeds–Shepp path of radius `r_min` (m) from `from` to `to` (position, heading
+/// rad) whose points, sampled every `spacing` m, all pass `ok`, as parts driven in one direction
+/// each; `None` when every word's path fails somewhere.
+pub fn transit(
+    from: (Vec2, f64),
+    to: (Vec2, f64),
+    r_min: f64,
+    spacing: f64,
+    ok: &dyn Fn(&Vec2) -> bool,
+) -> Option<Vec<(Direction, Vec<Vec2>)>> {
+    let pose = |(pos, heading): (Vec2, f64)| Pose { pos, heading };
+    reeds_shepp_paths(&pose(from), &pose(to), r_min)
+        .iter()
+        .map(|path| split_at_cusps(path, spacing))
+        .find(|parts| parts.iter().all(|part| part.points.iter().all(ok)))
+        .map(|parts| {
+            parts
+                .into_iter()
+                .filter(|part| part.points.len() >= 2)
+                .map(|part| (part.direction, part.points))
+                .collect()
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geo::v2;
+    use std::f64::consts::PI;
+
+    /// Between two ends of adjacent swaths 3 m apart at the end of a pocket 5 m deep, no
+    /// forward turn of radius 8 m fits; the reversing transit does, inside the pocket, and
+    /// reverses at least once.
+    #[test]
+    fn backs_out_of_a_pocket_no_forward_turn_fits() {
+        // The pocket: x ≤ 0 (the swath ends at x = 0), |y| ≤ 12, 60 m long.
+        let inside = |q: &Vec2| q.x <= 0.5 && q.x >= -60.0 && q.y.abs() <= 12.0;
+        let from = (v2(0.0, 0.0), 0.0);
+        let to = (v2(0.0, 3.0), PI);
+        let parts = transit(from, to, 8.0, 0.5, &inside).expect("a reversing way");
+        assert!(parts.iter().any(|(d, _)| *d == Direction::Reverse));
+        let first = parts.first().unwrap().1[0];
+        let last = *parts.last().unwrap().1.last().unwrap();
+        assert!((first - from.0).norm() < 1e-6 && (last - to.0).norm() < 1e-6);
+        // In a pocket 1.5 m deep, no way: every word's path fails somewhere.
+        let shallow = |q: &Vec2| inside(q) && q.x >= -1.0;
+        assert!(transit(from, to, 8.0, 0.5, &shallow).is_none());
+    }
+}
