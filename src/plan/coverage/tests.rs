@@ -232,8 +232,8 @@ fn headland_order_last_works_the_swaths_first_and_the_headland_from_the_inside_o
 /// in the arm (pass k is opened at r_min), and the ground inside it, 18 m wide, was never
 /// worked (no working area there: the field shrunk by 4·w); 78.5 % of the field was worked.
 /// Now swaths work it, with reversing transits where no turn fits, the plan within the
-/// guarantees and joined. (Turned by 0.3 rad: the field with its edges on the axes runs the
-/// metrics' footprint stroke out of memory, before this change too.)
+/// guarantees and joined. (Turned by 0.3 rad; the same field on the axes is
+/// `metrics::tests::footprints_of_a_plan_on_the_axes`.)
 #[test]
 fn an_arm_narrower_than_the_inner_passes_is_worked() {
     let (sin, cos) = 0.3f64.sin_cos();

@@ -143,3 +143,45 @@ fn three_point_curvature_of_circle_points() {
         0.0
     );
 }
+
+/// A plan whose passes and swaths lie on the East and North axes (a block with an arm 24 m wide,
+/// w 3 m, r_min 8 m): stroked in one buffer, its footprint ran out of memory; it is the same as
+/// the footprint of the plan turned by 0.3 rad.
+#[test]
+fn footprints_of_a_plan_on_the_axes() {
+    use crate::plan::coverage::{plan_field, tests::params};
+    let field = Field {
+        boundary: vec![
+            v2(0.0, 0.0),
+            v2(100.0, 0.0),
+            v2(100.0, 100.0),
+            v2(24.0, 100.0),
+            v2(24.0, 250.0),
+            v2(0.0, 250.0),
+        ],
+        obstacles: vec![],
+    };
+    let plan = plan_field(&field, &params(3.0, 8.0, 4)).unwrap();
+    let area = footprint(&plan.segments, 3.0).unsigned_area();
+    let (sin, cos) = 0.3f64.sin_cos();
+    let turned: Vec<PlanSegment> = plan
+        .segments
+        .iter()
+        .map(|s| PlanSegment {
+            points: s
+                .points
+                .iter()
+                .map(|q| v2(q.x * cos - q.y * sin, q.x * sin + q.y * cos))
+                .collect(),
+            ..s.clone()
+        })
+        .collect();
+    let turned_area = footprint(&turned, 3.0).unsigned_area();
+    assert!(area > 0.9 * 13_600.0, "footprint {area} m² of 13 600");
+    assert!(
+        (area - turned_area).abs() < 1e-6 * area,
+        "{area} against {turned_area}"
+    );
+    let m = plan_metrics(&field, &plan, 3.0);
+    assert!(m.covered_fraction > 0.0 && m.covered_fraction <= 1.0);
+}
