@@ -56,8 +56,9 @@ pub fn implement_clear(field: &Field, half: f64, q: &Vec2) -> bool {
 /// and may reach over the edge there): the guarantee for paths that do not work.
 pub const TRANSIT_CLEARANCE_M: f64 = 1.5;
 
-/// The reversing transits' ends are pulled back this many points at a time.
-const REVERSE_CUT_STEP: usize = 4;
+/// The reversing transits are tried with the ends pulled back this many times, evenly up to
+/// the forward attempts' longest pull-back (none first).
+const REVERSE_CUTS: usize = 4;
 
 /// States a transit's waypoint search may expand before giving up.
 const ROUTE_MAX_EXPANSIONS: usize = 20_000;
@@ -402,7 +403,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             }
         };
         if found.is_none() {
-            for t in (0..=max_cut).step_by(REVERSE_CUT_STEP) {
+            for t in (0..REVERSE_CUTS).map(|i| i * max_cut / (REVERSE_CUTS - 1)) {
                 let (cp, cn, f, hf, q, hq) = poses(t);
                 let Some(parts) =
                     reverse::transit((f, hf), (q, hq), p.r_min, p.point_spacing, &loose)

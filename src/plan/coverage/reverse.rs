@@ -6,8 +6,14 @@
 use crate::geo::{Direction, Pose, Vec2};
 use crate::plan::maneuver::{drive::split_at_cusps, reeds_shepp::reeds_shepp_paths};
 
+/// Words longer than the shortest by more than this many full circles of radius r_min are not
+/// tried: no farmer backs out that way, and sampling every word of a gap that stays cost more
+/// than the plan.
+const LONGER_BY_TURNS: f64 = 1.0;
+
 /// The shortest Reeds–Shepp path of radius `r_min` (m) from `from` to `to` (position, heading
-/// rad) whose points, sampled every `spacing` m, all pass `ok`, as parts driven in one direction
+/// rad), at most [`LONGER_BY_TURNS`] circles longer than the shortest, whose points, sampled
+/// every `spacing` m, all pass `ok`, as parts driven in one direction
 /// each; `None` when every word's path fails somewhere.
 pub fn transit(
     from: (Vec2, f64),
@@ -17,8 +23,11 @@ pub fn transit(
     ok: &dyn Fn(&Vec2) -> bool,
 ) -> Option<Vec<(Direction, Vec<Vec2>)>> {
     let pose = |(pos, heading): (Vec2, f64)| Pose { pos, heading };
-    reeds_shepp_paths(&pose(from), &pose(to), r_min)
+    let paths = reeds_shepp_paths(&pose(from), &pose(to), r_min);
+    let longest = paths.first()?.length() + LONGER_BY_TURNS * std::f64::consts::TAU * r_min;
+    paths
         .iter()
+        .take_while(|path| path.length() <= longest)
         .map(|path| split_at_cusps(path, spacing))
         .find(|parts| parts.iter().all(|part| part.points.iter().all(ok)))
         .map(|parts| {
