@@ -320,23 +320,32 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             )
         };
         // Without shortening any work first (direct, then along the headland), then pulling
-        // the ends back metre by metre, then along the headland again; all with the implement
-        // clear of the edge. Then with only the tractor inside the field: direct, along the
-        // headland, through waypoints.
+        // the ends back metre by metre up to r_min, then backing out (a Reeds–Shepp path with
+        // only the tractor inside the field, no work shortened), then pulling back further,
+        // then along the headland again; all with the implement clear of the edge. Then with
+        // only the tractor inside the field: direct, along the headland, through waypoints,
+        // and backing out with the ends pulled back.
         #[derive(Clone, Copy, Debug)]
         enum Way {
             Direct,
             Headland,
             Waypoints,
+            Reverse,
         }
+        let before_reverse = ((p.r_min / p.point_spacing).ceil() as usize).min(max_cut);
         let mut attempts = vec![(0, Way::Direct, false), (0, Way::Headland, false)];
-        attempts.extend((1..=max_cut).map(|t| (t, Way::Direct, false)));
+        attempts.extend((1..=before_reverse).map(|t| (t, Way::Direct, false)));
+        attempts.push((0, Way::Reverse, true));
+        attempts.extend((before_reverse + 1..=max_cut).map(|t| (t, Way::Direct, false)));
         attempts.push((max_cut, Way::Headland, false));
         attempts.extend([
             (0, Way::Direct, true),
             (0, Way::Headland, true),
             (0, Way::Waypoints, true),
         ]);
+        attempts.extend(
+            (1..REVERSE_CUTS).map(|i| (i * max_cut / (REVERSE_CUTS - 1), Way::Reverse, true)),
+        );
         let mut found = None;
         // The relaxed headland attempt without shortening, made first (once) where the tests
         // differ and one of this plan's relaxed headland attempts found no way before: its
@@ -352,7 +361,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             if t > 0 && cp == 0 && cn == 0 {
                 continue;
             }
-            if relaxed && one_test && t == 0 && !matches!(way, Way::Waypoints) {
+            if relaxed && one_test && t == 0 && matches!(way, Way::Direct | Way::Headland) {
                 // The strict attempt with the same poses and test found nothing.
                 continue;
             }
@@ -384,6 +393,11 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
                 Way::Waypoints => {
                     transit::route_graph(f, hf, q, hq, r, step, loose_grid(), ROUTE_MAX_EXPANSIONS)
                 }
+                Way::Reverse => None,
+            };
+            let pts = match way {
+                Way::Reverse => reverse::transit((f, hf), (q, hq), r, step, &loose),
+                _ => pts.map(|pts| vec![(Direction::Forward, pts)]),
             };
             if let Some(pts) = pts {
                 tracing::trace!(t, ?way, relaxed, "transit found");
@@ -395,28 +409,11 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         // the plan goes on from the target without a transit, so each part is worked on its
         // own and the warning names the gap. (A curve out of the field would break a
         // guarantee; dropping the target would leave the rest of the field unworked.)
-        // Else backing out: a Reeds–Shepp path with only the tractor inside the field, the
-        // ends pulled back as the forward attempts were.
         let cut = |segments: &mut Vec<PlanSegment>, cp: usize| {
             if let Some(last) = segments.last_mut().filter(|_| cp > 0) {
                 last.points.truncate(last.points.len() - cp);
             }
         };
-        if found.is_none() {
-            for t in (0..REVERSE_CUTS).map(|i| i * max_cut / (REVERSE_CUTS - 1)) {
-                let (cp, cn, f, hf, q, hq) = poses(t);
-                let Some(parts) =
-                    reverse::transit((f, hf), (q, hq), p.r_min, p.point_spacing, &loose)
-                else {
-                    continue;
-                };
-                cut(segments, cp);
-                for (direction, pts) in parts {
-                    push(segments, SegmentKind::Transit, direction, cell, pts);
-                }
-                return cn;
-            }
-        }
         let Some((pts, cut_prev, cut_next)) = found else {
             transit_gaps.set(transit_gaps.get() + 1);
             warnings.borrow_mut().push(format!(
@@ -426,13 +423,9 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             return 0;
         };
         cut(segments, cut_prev);
-        push(
-            segments,
-            SegmentKind::Transit,
-            Direction::Forward,
-            cell,
-            pts,
-        );
+        for (direction, pts) in pts {
+            push(segments, SegmentKind::Transit, direction, cell, pts);
+        }
         cut_next
     };
 
