@@ -405,19 +405,20 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
                 break;
             }
         }
-        // No way inside the field (parts joined only by a neck narrower than the turns need):
-        // the plan goes on from the target without a transit, so each part is worked on its
-        // own and the warning names the gap. (A curve out of the field would break a
-        // guarantee; dropping the target would leave the rest of the field unworked.)
         let cut = |segments: &mut Vec<PlanSegment>, cp: usize| {
             if let Some(last) = segments.last_mut().filter(|_| cp > 0) {
                 last.points.truncate(last.points.len() - cp);
             }
         };
+        // No way inside the field, forward or backing out (parts joined only by a neck, or a
+        // pocket, narrower than the turns need): the plan goes on from the target without a
+        // transit, so each part is worked on its own and the warning names the gap. (A curve
+        // out of the field would break a guarantee; dropping the target would leave the rest
+        // of the field unworked.)
         let Some((pts, cut_prev, cut_next)) = found else {
             transit_gaps.set(transit_gaps.get() + 1);
             warnings.borrow_mut().push(format!(
-                "no transit inside the field from ({:.1}, {:.1}) to ({:.1}, {:.1}): the plan goes on there without one (parts joined only by a neck too narrow to turn through; drive round outside the field)",
+                "no transit inside the field from ({:.1}, {:.1}) to ({:.1}, {:.1}): the plan goes on there without one (no path forward or backing out at r_min stays inside the field between them: a neck or a pocket too narrow to turn in; drive there by hand)",
                 from.x, from.y, to.x, to.y
             ));
             return 0;
