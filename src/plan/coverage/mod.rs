@@ -38,17 +38,15 @@ use crate::plan::types::PlanError;
 /// A point of a path keeps the implement inside the field and off the obstacles: inside the
 /// boundary and at least `half` m from every boundary edge and every obstacle.
 pub fn implement_clear(field: &Field, half: f64, q: &Vec2) -> bool {
-    use crate::geo::polygon::{contains_point, point_segment_distance};
-    let far = |ring: &[Vec2]| {
+    use crate::geo::polygon::point_segment_distance;
+    let far = |ring: &Vec<Vec2>| {
         let n = ring.len();
         (0..n).all(|i| point_segment_distance(q, &ring[i], &ring[(i + 1) % n]) >= half - 1e-6)
     };
-    contains_point(&field.boundary, q)
-        && far(&field.boundary)
-        && field
-            .obstacles
-            .iter()
-            .all(|o| !contains_point(o, q) && far(o))
+    field.contains(q)
+        && std::iter::once(&field.boundary)
+            .chain(&field.obstacles)
+            .all(far)
 }
 
 /// How far a transit that cannot keep the implement clear of the edge keeps its path inside
@@ -396,7 +394,9 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
                 Way::Reverse => None,
             };
             let pts = match way {
-                Way::Reverse => reverse::transit((f, hf), (q, hq), r, step, &loose),
+                Way::Reverse => {
+                    reverse::transit((f, hf), (q, hq), r, p.max_curvature_rate, step, &loose)
+                }
                 _ => pts.map(|pts| vec![(Direction::Forward, pts)]),
             };
             if let Some(pts) = pts {
@@ -405,11 +405,6 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
                 break;
             }
         }
-        let cut = |segments: &mut Vec<PlanSegment>, cp: usize| {
-            if let Some(last) = segments.last_mut().filter(|_| cp > 0) {
-                last.points.truncate(last.points.len() - cp);
-            }
-        };
         // No way inside the field, forward or backing out (parts joined only by a neck, or a
         // pocket, narrower than the turns need): the plan goes on from the target without a
         // transit, so each part is worked on its own and the warning names the gap. (A curve
@@ -423,7 +418,9 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             ));
             return 0;
         };
-        cut(segments, cut_prev);
+        if let Some(last) = segments.last_mut().filter(|_| cut_prev > 0) {
+            last.points.truncate(last.points.len() - cut_prev);
+        }
         for (direction, pts) in pts {
             push(segments, SegmentKind::Transit, direction, cell, pts);
         }

@@ -96,25 +96,16 @@ pub struct FieldPlan {
 }
 
 impl CoverageParams {
+    /// The implement and obstacle limits here; r_min, the point spacing and the curvature rate
+    /// as the turns check them.
     pub(super) fn validate(&self) -> Result<(), PlanError> {
         PlanError::check("line_width", self.line_width, self.line_width > 0.0)?;
-        PlanError::check("r_min", self.r_min, self.r_min > 0.0)?;
-        PlanError::check(
-            "point_spacing",
-            self.point_spacing,
-            self.point_spacing > 0.0,
-        )?;
-        PlanError::check(
-            "max_curvature_rate",
-            self.max_curvature_rate,
-            self.max_curvature_rate >= 0.0,
-        )?;
         PlanError::check(
             "small_obstacle_max_m",
             self.small_obstacle_max_m,
             self.small_obstacle_max_m >= 0.0,
         )?;
-        Ok(())
+        self.turn_params().validate()
     }
 
     pub(super) fn turn_params(&self) -> crate::plan::turns::TurnParams {
