@@ -462,3 +462,44 @@ fn a_gap_no_transit_crosses_is_named_not_driven_outside() {
     );
     assert!(plan.swaths > 0);
 }
+
+/// A real parcel in three blocks (`at_invekos_hole` at w 12 m, r_min 8 m), each worked whole
+/// before the next: the transit to a block's next headland pass finds no way to the pass's
+/// first choice of start and pulls it back. The pass then goes on past its start over the
+/// stretch pulled back, so every pass is still a whole ring (none is cut into stretches here:
+/// no warning says so), where before the stretch was left unworked.
+#[test]
+fn a_headland_pass_whose_start_is_pulled_back_is_still_worked_round() {
+    let cfg = Config::default();
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tools/fields/real/at_invekos_hole.geojson"
+    );
+    let text = std::fs::read_to_string(path).expect("the real field is in the repository");
+    let loaded = agsteer::field::load_field(&text, &cfg.field_load_options()).expect("loads");
+    let mut p = cfg.coverage_params();
+    p.line_width = 12.0;
+    p.r_min = 8.0;
+    let plan = plan_field(&loaded.field, &p).expect("a plan");
+    assert!(check_plan(&loaded.field, &plan, p.line_width, p.r_min).is_empty());
+    assert!(
+        !plan.warnings.iter().any(|w| w.contains("stretches")),
+        "{:?}",
+        plan.warnings
+    );
+    let passes: Vec<_> = plan
+        .segments
+        .iter()
+        .filter(|s| s.kind == SegmentKind::Headland)
+        .collect();
+    assert!(passes.len() >= 6, "{} passes", passes.len());
+    for s in passes {
+        let (a, b) = (s.points[0], s.points[s.points.len() - 1]);
+        assert!(
+            (a - b).norm() < 1e-6,
+            "pass {} ends {:.1} m from its start",
+            s.index,
+            (a - b).norm()
+        );
+    }
+}

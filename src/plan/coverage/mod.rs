@@ -17,6 +17,7 @@ pub mod headland;
 pub mod metrics;
 pub mod narrow;
 mod params;
+mod regions;
 mod reverse;
 pub mod rings;
 mod runs;
@@ -223,6 +224,8 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         }
     }
 
+    // The pieces of the outermost pass's area, worked one after the other.
+    let regions = regions::Regions::new(passes.areas.first());
     // Headland passes: the field's (outermost first), then the obstacles' (nearest first),
     // those that keep clear of the field edge and the other obstacles.
     let headland::Passes {
@@ -541,148 +544,174 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         HeadlandOrder::First => [true, false],
         HeadlandOrder::Last => [false, true],
     };
-    for headland_phase in phases {
-        if headland_phase {
-            loop {
-                let ring = match field_tracks.pop_front() {
-                    Some(r) => r,
-                    None if !obstacle_tracks.is_empty() => {
-                        let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
-                        let dist = |t: &Vec<Vec2>| {
-                            t.iter()
-                                .map(|q| (q - here).norm())
-                                .fold(f64::INFINITY, f64::min)
-                        };
-                        let k = (0..obstacle_tracks.len())
-                            .min_by(|&i, &j| {
-                                dist(&obstacle_tracks[i]).total_cmp(&dist(&obstacle_tracks[j]))
-                            })
-                            .unwrap_or(0);
-                        obstacle_tracks.swap_remove(k)
+    // Each region's work in the order of the phases, then the nearest region's left (see
+    // `regions`): the first region is that of the first headland pass or swath run.
+    let first = field_tracks.front().and_then(|t| t.first().copied());
+    let first = first.or_else(|| pending.first().map(|(_, a, run, l)| run_start(run, l, *a)));
+    let mut region = first.map_or(0, |q| regions.of(&q));
+    loop {
+        let in_region = |q: Option<&Vec2>| q.is_none_or(|q| regions.of(q) == region);
+        for headland_phase in phases {
+            if headland_phase {
+                loop {
+                    let next = field_tracks.iter().position(|t| in_region(t.first()));
+                    let ring = match next.and_then(|k| field_tracks.remove(k)) {
+                        Some(r) => r,
+                        None if obstacle_tracks.iter().any(|t| in_region(t.first())) => {
+                            let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
+                            let dist = |t: &Vec<Vec2>| {
+                                t.iter()
+                                    .map(|q| (q - here).norm())
+                                    .fold(f64::INFINITY, f64::min)
+                            };
+                            let k = (0..obstacle_tracks.len())
+                                .filter(|&i| in_region(obstacle_tracks[i].first()))
+                                .min_by(|&i, &j| {
+                                    dist(&obstacle_tracks[i]).total_cmp(&dist(&obstacle_tracks[j]))
+                                })
+                                .unwrap_or(0);
+                            obstacle_tracks.swap_remove(k)
+                        }
+                        None => break,
+                    };
+                    let n = ring.len();
+                    if n < 4 {
+                        continue;
                     }
-                    None => break,
-                };
-                let n = ring.len();
-                if n < 4 {
-                    continue;
-                }
-                if (ring[n - 1] - ring[0]).norm() > 1e-9 {
-                    // An open stretch of a cut pass: driven from its end nearer the vehicle.
-                    let here = at.map(|a| a.0).unwrap_or(ring[0]);
-                    let mut track = ring;
-                    if (track[n - 1] - here).norm() < (track[0] - here).norm() {
-                        track.reverse();
+                    if (ring[n - 1] - ring[0]).norm() > 1e-9 {
+                        // An open stretch of a cut pass: driven from its end nearer the vehicle.
+                        let here = at.map(|a| a.0).unwrap_or(ring[0]);
+                        let mut track = ring;
+                        if (track[n - 1] - here).norm() < (track[0] - here).norm() {
+                            track.reverse();
+                        }
+                        let cut = go_to(&mut segments, &mut at, &track, 0);
+                        let track = track[cut..].to_vec();
+                        let n = track.len();
+                        if n >= 2 {
+                            let end = (track[n - 1], vec_heading(&(track[n - 1] - track[n - 2])));
+                            push(
+                                &mut segments,
+                                SegmentKind::Headland,
+                                Direction::Forward,
+                                0,
+                                track,
+                            );
+                            at = Some(end);
+                        }
+                        continue;
                     }
-                    let cut = go_to(&mut segments, &mut at, &track, 0);
-                    let track = track[cut..].to_vec();
-                    let n = track.len();
-                    if n >= 2 {
-                        let end = (track[n - 1], vec_heading(&(track[n - 1] - track[n - 2])));
-                        push(
-                            &mut segments,
-                            SegmentKind::Headland,
-                            Direction::Forward,
-                            0,
-                            track,
-                        );
-                        at = Some(end);
-                    }
-                    continue;
-                }
-                // Start the closed track where the transit from the vehicle is clear: a little ahead
-                // of it (the first pass: mid the longest boundary edge).
-                let open = &ring[..n - 1];
-                let target = match at {
-                    Some((q, h)) => q + crate::geo::heading_vec(h) * (2.5 * p.r_min),
-                    None => {
-                        let b = &field.boundary;
-                        let i = (0..b.len())
-                            .max_by(|&i, &j| {
-                                let li = (b[(i + 1) % b.len()] - b[i]).norm();
-                                let lj = (b[(j + 1) % b.len()] - b[j]).norm();
-                                li.total_cmp(&lj)
-                            })
-                            .unwrap_or(0);
-                        0.5 * (b[i] + b[(i + 1) % b.len()])
-                    }
-                };
-                let nearest = (0..open.len())
-                    .min_by(|&i, &j| {
-                        (open[i] - target)
-                            .norm()
-                            .total_cmp(&(open[j] - target).norm())
-                    })
-                    .unwrap_or(0);
-                let m = open.len();
-                let mut start = nearest;
-                if let Some((q, h)) = at {
-                    // At most about 48 candidate starts around the track (each try is a whole curve).
-                    for k in (0..m).step_by((m / 48).max(1)) {
-                        let i = (nearest + k) % m;
-                        let hi = vec_heading(&(open[(i + 1) % m] - open[i]));
-                        if transit::clear_transit(
-                            q,
-                            h,
-                            open[i],
-                            hi,
-                            p.r_min,
-                            p.point_spacing,
-                            &clear,
-                        )
-                        .is_some()
-                        {
-                            start = i;
-                            break;
+                    // Start the closed track where the transit from the vehicle is clear: a little ahead
+                    // of it (the first pass: mid the longest boundary edge).
+                    let open = &ring[..n - 1];
+                    let target = match at {
+                        Some((q, h)) => q + crate::geo::heading_vec(h) * (2.5 * p.r_min),
+                        None => {
+                            let b = &field.boundary;
+                            let i = (0..b.len())
+                                .max_by(|&i, &j| {
+                                    let li = (b[(i + 1) % b.len()] - b[i]).norm();
+                                    let lj = (b[(j + 1) % b.len()] - b[j]).norm();
+                                    li.total_cmp(&lj)
+                                })
+                                .unwrap_or(0);
+                            0.5 * (b[i] + b[(i + 1) % b.len()])
+                        }
+                    };
+                    let nearest = (0..open.len())
+                        .min_by(|&i, &j| {
+                            (open[i] - target)
+                                .norm()
+                                .total_cmp(&(open[j] - target).norm())
+                        })
+                        .unwrap_or(0);
+                    let m = open.len();
+                    let mut start = nearest;
+                    if let Some((q, h)) = at {
+                        // At most about 48 candidate starts around the track (each try is a whole curve).
+                        for k in (0..m).step_by((m / 48).max(1)) {
+                            let i = (nearest + k) % m;
+                            let hi = vec_heading(&(open[(i + 1) % m] - open[i]));
+                            if transit::clear_transit(
+                                q,
+                                h,
+                                open[i],
+                                hi,
+                                p.r_min,
+                                p.point_spacing,
+                                &clear,
+                            )
+                            .is_some()
+                            {
+                                start = i;
+                                break;
+                            }
                         }
                     }
+                    let mut track: Vec<Vec2> = (0..m).map(|k| open[(start + k) % m]).collect();
+                    track.push(open[start]);
+                    let cut = go_to(&mut segments, &mut at, &track, 0);
+                    // A start pulled back (no way to it): the pass goes on past its start over the
+                    // stretch cut, so the whole ring is still worked once.
+                    let mut track = track[cut..].to_vec();
+                    track.extend((1..=cut).map(|k| open[(start + k) % m]));
+                    let n = track.len();
+                    let hl = vec_heading(&(track[n - 1] - track[n - 2]));
+                    push(
+                        &mut segments,
+                        SegmentKind::Headland,
+                        Direction::Forward,
+                        0,
+                        track.clone(),
+                    );
+                    at = Some((track[n - 1], hl));
                 }
-                let mut track: Vec<Vec2> = (0..m).map(|k| open[(start + k) % m]).collect();
-                track.push(open[start]);
-                let n = track.len();
-                let cut = go_to(&mut segments, &mut at, &track, 0);
-                let track = track[cut..].to_vec();
-                let n = n - cut;
-                let hl = vec_heading(&(track[n - 1] - track[n - 2]));
-                push(
-                    &mut segments,
-                    SegmentKind::Headland,
-                    Direction::Forward,
-                    0,
-                    track.clone(),
-                );
-                at = Some((track[n - 1], hl));
+            } else {
+                loop {
+                    let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
+                    let nearest = pending
+                        .iter()
+                        .enumerate()
+                        .map(|(k, (_, angle, run, lines))| (k, run_start(run, lines, *angle)))
+                        .filter(|(_, q)| in_region(Some(q)))
+                        .map(|(k, q)| (k, (q - here).norm()))
+                        .fold(None, |b: Option<(usize, f64)>, c| match b {
+                            Some(b) if b.1 <= c.1 => Some(b),
+                            _ => Some(c),
+                        });
+                    let Some((k, _)) = nearest else {
+                        break;
+                    };
+                    let (ci, angle, run, lines) = pending.swap_remove(k);
+                    drive_run(
+                        &run,
+                        &lines,
+                        angle,
+                        ci,
+                        p,
+                        &tp,
+                        &mut cache,
+                        &mut block_orders,
+                        &clear,
+                        field,
+                        &mut segments,
+                        &mut at,
+                        &mut go_to,
+                        &detour,
+                        &small_discs,
+                    )?;
+                }
             }
-        } else {
-            while !pending.is_empty() {
-                let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
-                let (k, _) = pending
-                    .iter()
-                    .enumerate()
-                    .map(|(k, (_, angle, run, lines))| {
-                        let (line, (x0, _)) = run[0];
-                        let q = swaths::unrotate(v2(x0, lines.ys[line]), *angle);
-                        (k, (q - here).norm())
-                    })
-                    .fold((0, f64::INFINITY), |b, c| if c.1 < b.1 { c } else { b });
-                let (ci, angle, run, lines) = pending.swap_remove(k);
-                drive_run(
-                    &run,
-                    &lines,
-                    angle,
-                    ci,
-                    p,
-                    &tp,
-                    &mut cache,
-                    &mut block_orders,
-                    &clear,
-                    field,
-                    &mut segments,
-                    &mut at,
-                    &mut go_to,
-                    &detour,
-                    &small_discs,
-                )?;
-            }
+        }
+        let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
+        let starts = field_tracks
+            .iter()
+            .chain(&obstacle_tracks)
+            .filter_map(|t| t.first().copied())
+            .chain(pending.iter().map(|(_, a, run, l)| run_start(run, l, *a)));
+        match regions.next(here, starts) {
+            Some(next) => region = next,
+            None => break,
         }
     }
 
@@ -697,6 +726,12 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         warnings: warnings.into_inner(),
         transit_gaps: transit_gaps.get(),
     })
+}
+
+/// Where a swath run starts, in the field's frame.
+fn run_start(run: &[swaths::RunSwath], lines: &swaths::SwathLines, angle: f64) -> Vec2 {
+    let (line, (x0, _)) = run[0];
+    swaths::unrotate(v2(x0, lines.ys[line]), angle)
 }
 
 #[cfg(test)]

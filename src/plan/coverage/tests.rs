@@ -271,3 +271,50 @@ fn an_arm_narrower_than_the_inner_passes_is_worked() {
     assert!(m.covered_fraction > 0.85, "covered {}", m.covered_fraction);
     assert_eq!(plan.transit_gaps, 0);
 }
+
+/// Two blocks joined by a neck 12 m wide (w 3 m, r_min 8 m, 3 passes): the outermost pass's
+/// area is two pieces, one per block, and the neck is tight to drive through. Each block is
+/// worked whole (its headland passes and swaths) before the other: the work crosses the neck
+/// once. Before, the headland passes alternated between the blocks, pass by pass.
+#[test]
+fn a_field_of_two_blocks_is_worked_block_by_block() {
+    let (sin, cos) = 0.2f64.sin_cos();
+    let turned = |x: f64, y: f64| v2(x * cos - y * sin, x * sin + y * cos);
+    let field = Field {
+        boundary: [
+            (0.0, 0.0),
+            (120.0, 0.0),
+            (120.0, 80.0),
+            (66.0, 80.0),
+            (66.0, 100.0),
+            (120.0, 100.0),
+            (120.0, 180.0),
+            (0.0, 180.0),
+            (0.0, 100.0),
+            (54.0, 100.0),
+            (54.0, 80.0),
+            (0.0, 80.0),
+        ]
+        .into_iter()
+        .map(|(x, y)| turned(x, y))
+        .collect(),
+        obstacles: vec![],
+    };
+    let p = params(3.0, 8.0, 3);
+    let plan = plan_field(&field, &p).unwrap();
+    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
+    assert!(violations.is_empty(), "{violations:?}");
+    // The block of each worked segment (by its middle point, in the field's own frame).
+    let upper = |q: &Vec2| -q.x * sin + q.y * cos > 90.0;
+    let blocks: Vec<bool> = plan
+        .segments
+        .iter()
+        .filter(|s| matches!(s.kind, SegmentKind::Work | SegmentKind::Headland))
+        .map(|s| upper(&s.points[s.points.len() / 2]))
+        .collect();
+    let crossings = blocks.windows(2).filter(|b| b[0] != b[1]).count();
+    assert!(blocks.contains(&true) && blocks.contains(&false));
+    assert_eq!(crossings, 1, "blocks in order {blocks:?}");
+    let m = metrics::plan_metrics(&field, &plan, p.line_width);
+    assert!(m.covered_fraction > 0.95, "covered {}", m.covered_fraction);
+}
