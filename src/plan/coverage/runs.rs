@@ -208,9 +208,45 @@ pub(super) fn drive_run(
                     _ => None,
                 }
             };
+            // Backing up at the full ends (a K-turn, the implement clear throughout) where no
+            // forward turn fits without pulling them back.
+            let backing = || {
+                let (h1, h2) = (vec_heading(&d), vec_heading(&(-d)));
+                let (q1, q2) = (world(e, y), world(end2, y2));
+                let parts = super::reverse::turn(
+                    (q1, h1),
+                    (q2, h2),
+                    p.r_min,
+                    p.max_curvature_rate,
+                    p.point_spacing,
+                    clear,
+                )?;
+                let length: f64 = parts
+                    .iter()
+                    .map(|(_, pts)| crate::geo::polygon::polyline_length(pts))
+                    .sum();
+                let bound = ASYMMETRIC_TURN_MAX_LENGTH
+                    * (std::f64::consts::PI * p.r_min + (y2 - y).abs() + (end2 - e).abs());
+                (length <= bound).then(|| {
+                    let parts = parts
+                        .into_iter()
+                        .map(|(direction, points)| crate::plan::turns::TurnPart {
+                            direction,
+                            points,
+                        })
+                        .collect::<Vec<_>>();
+                    (parts, e, end2)
+                })
+            };
             for t in 0..=tries {
                 if t > 0 {
                     if let Some(found) = dubins((t - 1) as f64) {
+                        best = Some(found);
+                        break;
+                    }
+                }
+                if t == 1 {
+                    if let Some(found) = backing() {
                         best = Some(found);
                         break;
                     }
