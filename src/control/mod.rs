@@ -59,6 +59,8 @@ pub struct ControlOutput {
     pub track: Option<TrackOutput>,
     /// Driving direction of the path being followed.
     pub direction: Direction,
+    /// The path's curvature at the vehicle, 1/m (positive left), when there is a path.
+    pub path_curvature: Option<f64>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -262,6 +264,7 @@ impl Controller {
             heading_error: None,
             track: None,
             direction: Direction::Forward,
+            path_curvature: None,
         };
         let Some(est) = self.job_estimate(t) else {
             return Ok(out);
@@ -295,9 +298,10 @@ impl Controller {
             pose = course_pose(&pose, drift, est.speed.abs(), min);
         }
         let local = self.guidance.local_path();
+        let path_curvature = curvature_along(local.points(), local.index_local(), 1.0, 1.0);
+        out.path_curvature = Some(path_curvature);
         if needs.observer {
             // The drift is kept per direction of straight driving (estimate::drift_memory).
-            let path_curvature = curvature_along(local.points(), local.index_local(), 1.0, 1.0);
             self.estimator.set_work(
                 direction == Direction::Forward && self.guidance.tag() == crate::geo::Tag::Work,
             );

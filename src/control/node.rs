@@ -653,6 +653,7 @@ impl ControllerNode {
                     heading_error: None,
                     track: None,
                     direction: crate::geo::Direction::Forward,
+                    path_curvature: None,
                 }
             }
         };
@@ -694,6 +695,8 @@ impl ControllerNode {
             }
             self.operator.replies.clear();
         }
+        self.supervisor
+            .set_path_curvature(c.path_curvature.unwrap_or(0.0));
         let cmd = match calibration {
             Some(demand) => self.supervisor.step(t, demand, Some(0.0), Some(0.0)),
             None => self

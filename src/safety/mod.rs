@@ -274,6 +274,8 @@ pub struct Supervisor {
     work_line: Option<u64>,
     /// Its sharpest curvature, 1/m.
     line_curvature: f64,
+    /// The path's curvature at the vehicle, 1/m (positive left; [`Supervisor::set_path_curvature`]).
+    path_curvature: f64,
     tracking: TrackingMonitor,
     /// A tracking fault held until the line changes or the operator disengages.
     tracking_latch: Option<FaultCode>,
@@ -313,6 +315,7 @@ impl Supervisor {
             history_head: 0,
             work_line: None,
             line_curvature: 0.0,
+            path_curvature: 0.0,
             tracking: TrackingMonitor::new(),
             tracking_latch: None,
             heading_check: HeadingCheck::new(),
@@ -340,6 +343,17 @@ impl Supervisor {
         }
         self.line_curvature = if max_curvature.is_finite() {
             max_curvature.abs()
+        } else {
+            0.0
+        };
+    }
+
+    /// The path's curvature at the vehicle this period, 1/m (positive left): a swing of the
+    /// cross-track error that follows a change of the path's bend is the path's, not a weave
+    /// (see [`tracking`]).
+    pub fn set_path_curvature(&mut self, curvature: f64) {
+        self.path_curvature = if curvature.is_finite() {
+            curvature
         } else {
             0.0
         };
@@ -650,6 +664,11 @@ impl Supervisor {
             // bend asks for half the band or more moves them by design.
             let bend_wheel_angle = (p.wheelbase * self.line_curvature).atan();
             let watch_wheel = bend_wheel_angle < 0.5 * p.tracking.unstable_wheel;
+            let path_bend = if self.path_curvature.abs() > tracking::BEND_CURVATURE {
+                self.path_curvature.signum() as i8
+            } else {
+                0
+            };
             let verdict = self.tracking.update(
                 &p.tracking,
                 t,
@@ -657,6 +676,7 @@ impl Supervisor {
                 xte,
                 self.wheel_angle,
                 watch_wheel,
+                path_bend,
                 self.speed,
             );
             let code = match verdict {

@@ -224,6 +224,40 @@ fn engaged_on_a_line(params: SafetyParams) -> (Supervisor, f64) {
     (s, t)
 }
 
+/// A headland pass of S-bends at r_min: the path bends left for 4 s, then right for 4 s, and
+/// the cross-track error leaves the ±0.2 m band on the outside of each bend (0.3 m, the
+/// tracker lagging the curvature's step). Those swings follow the path's bends, not a weave:
+/// no fault over a minute. The same swings with the path straight are a weave.
+#[test]
+fn swings_that_follow_the_paths_bends_are_not_a_weave() {
+    for bending in [true, false] {
+        let (mut s, mut t) = engaged_on_a_line(SafetyParams::default());
+        let start = t;
+        let mut fault = None;
+        while t < start + 60.0 {
+            t += DT;
+            feed_good(&mut s, t);
+            let phase = ((t - start) / 4.0).floor() as i64;
+            let side = if phase % 2 == 0 { 1.0 } else { -1.0 };
+            // The error peaks a second into each bend, on its outside (right of a left bend).
+            let into = (t - start) - 4.0 * phase as f64;
+            let x = -side * 0.3 * (std::f64::consts::PI * into / 4.0).sin();
+            s.set_path_curvature(if bending { side / 8.0 } else { 0.0 });
+            let c = s.step(t, Some(0.0), Some(x), Some(0.0));
+            if !c.engaged {
+                fault = Some((t - start, c.fault));
+                break;
+            }
+        }
+        if bending {
+            assert_eq!(fault, None, "the path's own bends");
+        } else {
+            let (at, code) = fault.expect("a weave on a straight path");
+            assert_eq!(code, FaultCode::TrackingUnstable, "at {at} s");
+        }
+    }
+}
+
 #[test]
 fn a_weave_on_a_work_line_disengages_and_is_held_until_the_next_line() {
     let (mut s, mut t) = engaged_on_a_line(SafetyParams::default());

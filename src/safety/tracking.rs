@@ -9,7 +9,13 @@
 //!   counted when the signal crosses the band on the side opposite to the previous swing, so
 //!   noise inside the band counts nothing, one step (a curve entry: the wheel angle leaves its
 //!   mean once and comes back) counts one swing, and a damped overshoot (an acquisition) whose
-//!   swings shrink restarts the count: only a limit cycle or a growing weave trips;
+//!   swings shrink restarts the count: only a limit cycle or a growing weave trips. A swing
+//!   of the cross-track error that starts after the path itself bent the other way (its
+//!   curvature at the vehicle changed side, or came out of or went into a bend) restarts the
+//!   count too: on a headland pass of S-bends at r_min the error leaves the band on the outside
+//!   of each bend, one side and then the other, by the path's design and not the tracker's
+//!   (a 305 m pass of `f2c_nl_field_188` at w 6 m, r_min 8 m was given back as unstable after
+//!   75 s while tracked at 5.8 cm RMS);
 //! - `off_line`: |XTE| beyond `off_line` for longer than `off_line_time`, once the line has been
 //!   acquired (|XTE| below `off_line` since the line started: a turn's exit error is not an
 //!   offset); or the line not acquired within `off_line_acquire` m driven on it (a vehicle
@@ -68,6 +74,10 @@ impl Default for TrackingParams {
     }
 }
 
+/// A path whose curvature at the vehicle is beyond this bends there, 1/m (a radius of 100 m:
+/// the wheels about 1.5° off straight on a 2.8 m wheelbase).
+pub const BEND_CURVATURE: f64 = 0.01;
+
 /// What the monitor found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TrackingVerdict {
@@ -108,8 +118,17 @@ impl SwingCounter {
     }
 
     /// Feed `x` at `t`; true when `swings` alternate, non-decaying swings started within
-    /// `window`.
-    fn update(&mut self, t: f64, x: f64, band: f64, swings: usize, window: f64) -> bool {
+    /// `window`. `restart`: a swing that starts now begins a new run (the signal's cause
+    /// changed since the last swing).
+    fn update(
+        &mut self,
+        t: f64,
+        x: f64,
+        band: f64,
+        swings: usize,
+        window: f64,
+        restart: bool,
+    ) -> bool {
         if band <= 0.0 || swings == 0 {
             return false;
         }
@@ -126,9 +145,12 @@ impl SwingCounter {
         if side == self.side {
             return false;
         }
+        if restart {
+            self.len = 0;
+        }
         if self.side != 0 {
             // The swing that just ended: a decaying one restarts the run from itself.
-            if self.prev_peak.is_some_and(|p| self.peak < DECAY_RATIO * p) {
+            if !restart && self.prev_peak.is_some_and(|p| self.peak < DECAY_RATIO * p) {
                 self.len = 1;
             }
             self.prev_peak = Some(self.peak);
@@ -155,6 +177,10 @@ pub struct TrackingMonitor {
     wheel_swings: SwingCounter,
     /// The wheel angle's moving mean, rad (None until the first sample).
     wheel_mean: Option<f64>,
+    /// The path's bend at the vehicle in the last period: +1 left, −1 right, 0 straight.
+    path_bend: i8,
+    /// The path's bend changed since the cross-track error's last swing started.
+    path_turned: bool,
     /// The line has been acquired (|XTE| below `off_line` since the line started).
     acquired: bool,
     /// Distance driven on the line while not acquired, m.
@@ -174,6 +200,8 @@ impl TrackingMonitor {
             xte_swings: SwingCounter::new(),
             wheel_swings: SwingCounter::new(),
             wheel_mean: None,
+            path_bend: 0,
+            path_turned: false,
             acquired: false,
             unacquired: 0.0,
             off_since: None,
@@ -189,7 +217,8 @@ impl TrackingMonitor {
     /// error (m, when known), the measured wheel angle (rad) and the speed (m/s). The wheel
     /// angle's swings are counted only when `watch_wheel` (a straight line: on a curved one,
     /// a headland pass round a field's corners, the wheels leave their mean at every bend by
-    /// design, and only the cross-track error tells a weave).
+    /// design, and only the cross-track error tells a weave). `path_bend`: the path's bend at
+    /// the vehicle, +1 left, −1 right, 0 straight (or not known).
     #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
@@ -199,8 +228,13 @@ impl TrackingMonitor {
         xte: Option<f64>,
         wheel_angle: f64,
         watch_wheel: bool,
+        path_bend: i8,
         speed: f64,
     ) -> TrackingVerdict {
+        if path_bend != self.path_bend {
+            self.path_bend = path_bend;
+            self.path_turned = true;
+        }
         let mean = match self.wheel_mean {
             Some(m) if p.wheel_mean_tau > 0.0 => {
                 m + (wheel_angle - m) * (dt / p.wheel_mean_tau).min(1.0)
@@ -217,6 +251,7 @@ impl TrackingMonitor {
                 p.unstable_wheel,
                 p.unstable_swings,
                 p.unstable_window,
+                false,
             )
         {
             verdict = TrackingVerdict::Unstable;
@@ -224,10 +259,19 @@ impl TrackingMonitor {
         let Some(x) = xte.filter(|x| x.is_finite()) else {
             return verdict;
         };
-        if self
-            .xte_swings
-            .update(t, x, p.unstable_xte, p.unstable_swings, p.unstable_window)
-        {
+        // A swing starts when the error crosses the band on the other side: then whether the
+        // path bent since the last one is consumed.
+        let side = self.xte_swings.side;
+        let starts = (x > p.unstable_xte && side != 1) || (x < -p.unstable_xte && side != -1);
+        let restart = starts && std::mem::take(&mut self.path_turned);
+        if self.xte_swings.update(
+            t,
+            x,
+            p.unstable_xte,
+            p.unstable_swings,
+            p.unstable_window,
+            restart,
+        ) {
             verdict = TrackingVerdict::Unstable;
         }
         if p.off_line > 0.0 {
@@ -329,7 +373,7 @@ mod tests {
         let mut t = 0.0;
         while t < secs {
             let (x, w) = f(t);
-            let v = m.update(p, t, DT, Some(x), w, true, 2.5);
+            let v = m.update(p, t, DT, Some(x), w, true, 0, 2.5);
             if v != TrackingVerdict::Ok {
                 return Some((t, v));
             }
