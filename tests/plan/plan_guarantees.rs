@@ -433,26 +433,33 @@ fn tally() {
     eprintln!("by shape: [cases, no plan, violating, missed by check_plan] {tally:?}");
 }
 
+/// The real field `name` of tools/fields/real/, read as `agsteer plan` reads it, planned with
+/// the default configuration at width `w` and turning radius `r_min` (m).
+fn real_plan(name: &str, w: f64, r_min: f64) -> (Field, CoverageParams, FieldPlan) {
+    let cfg = Config::default();
+    let path = format!(
+        "{}/tools/fields/real/{name}.geojson",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(path).expect("the real field is in the repository");
+    let loaded = agsteer::field::load_field(&text, &cfg.field_load_options()).expect("loads");
+    let mut p = cfg.coverage_params();
+    p.line_width = w;
+    p.r_min = r_min;
+    let plan = plan_field(&loaded.field, &p).expect("a plan");
+    (loaded.field, p, plan)
+}
+
 /// A real parcel whose parts join only by necks a few metres wide (`de_bb_concave` at w 12 m,
 /// r_min 8 m): before session 5 five transits found no way inside the field and were planned
 /// as the shortest curve, out of it (exit 4). The plan now goes on from the target without a
 /// transit and names each gap, so it keeps every guarantee and says where the parts part.
 #[test]
 fn a_gap_no_transit_crosses_is_named_not_driven_outside() {
-    let cfg = Config::default();
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tools/fields/real/de_bb_concave.geojson"
-    );
-    let text = std::fs::read_to_string(path).expect("the real field is in the repository");
-    let loaded = agsteer::field::load_field(&text, &cfg.field_load_options()).expect("loads");
-    let mut p = cfg.coverage_params();
-    p.line_width = 12.0;
-    p.r_min = 8.0;
-    let plan = plan_field(&loaded.field, &p).expect("a plan");
-    let found = independent_violations(&loaded.field, &plan, p.line_width, p.r_min);
+    let (field, p, plan) = real_plan("de_bb_concave", 12.0, 8.0);
+    let found = independent_violations(&field, &plan, p.line_width, p.r_min);
     assert!(found.is_empty(), "{}", found.join("; "));
-    assert!(check_plan(&loaded.field, &plan, p.line_width, p.r_min).is_empty());
+    assert!(check_plan(&field, &plan, p.line_width, p.r_min).is_empty());
     assert!(
         plan.warnings
             .iter()
@@ -470,18 +477,8 @@ fn a_gap_no_transit_crosses_is_named_not_driven_outside() {
 /// no warning says so), where before the stretch was left unworked.
 #[test]
 fn a_headland_pass_whose_start_is_pulled_back_is_still_worked_round() {
-    let cfg = Config::default();
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tools/fields/real/at_invekos_hole.geojson"
-    );
-    let text = std::fs::read_to_string(path).expect("the real field is in the repository");
-    let loaded = agsteer::field::load_field(&text, &cfg.field_load_options()).expect("loads");
-    let mut p = cfg.coverage_params();
-    p.line_width = 12.0;
-    p.r_min = 8.0;
-    let plan = plan_field(&loaded.field, &p).expect("a plan");
-    assert!(check_plan(&loaded.field, &plan, p.line_width, p.r_min).is_empty());
+    let (field, p, plan) = real_plan("at_invekos_hole", 12.0, 8.0);
+    assert!(check_plan(&field, &plan, p.line_width, p.r_min).is_empty());
     assert!(
         !plan.warnings.iter().any(|w| w.contains("stretches")),
         "{:?}",

@@ -398,7 +398,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             };
             let pts = match way {
                 Way::Reverse => {
-                    reverse::transit((f, hf), (q, hq), r, p.max_curvature_rate, step, &loose)
+                    reverse::transit((f, hf), (q, hq), r, p.max_curvature_rate, step, &loose, 0.0)
                 }
                 _ => pts.map(|pts| vec![(Direction::Forward, pts)]),
             };

@@ -13,47 +13,30 @@ use crate::plan::maneuver::{drive::split_at_cusps, reeds_shepp::reeds_shepp_path
 /// than the plan.
 const LONGER_BY_TURNS: f64 = 1.0;
 
+/// A plain word's forward first part shorter than this is not used for a turn between swaths,
+/// m (see [`transit`]): long enough to steer from straight to full lock and back, 2·κ_max/σ_max
+/// with a curvature-rate limit `sigma_max` > 0 (1/m²), else 0.
+pub fn turn_lead_in(r_min: f64, sigma_max: f64) -> f64 {
+    if sigma_max > 0.0 {
+        2.0 / (r_min * sigma_max)
+    } else {
+        0.0
+    }
+}
+
 /// The shortest Reeds–Shepp path of radius `r_min` (m) from `from` to `to` (position, heading
 /// rad), at most [`LONGER_BY_TURNS`] circles longer than the shortest, whose points, sampled
 /// every `spacing` m, all pass `ok`, as parts driven in one direction
 /// each; `None` when every word's path fails somewhere.
 /// With a curvature-rate limit `sigma_max` > 0 (1/m²), the shortest continuous-curvature path
 /// is tried first: the steering cannot follow a curvature step at full lock backing out.
+/// A plain word whose first part drives forward is used only when that part is at least
+/// `lead_in` m long ([`turn_lead_in`] for a turn, which starts at a swath's end with the
+/// wheels straight; 0 for a transit). Shorter, the tractor reached the cusp off the path and
+/// heading wrong, and was 0.7–1.6 m RMS off the reversing leg after it in the simulator
+/// (`f2c_nl_field_188` at w 6 m, r_min 8 m, first parts 0.1–2.2 m long); the words that back
+/// up first were tracked within 2–6 cm RMS.
 pub fn transit(
-    from: (Vec2, f64),
-    to: (Vec2, f64),
-    r_min: f64,
-    sigma_max: f64,
-    spacing: f64,
-    ok: &dyn Fn(&Vec2) -> bool,
-) -> Option<Vec<(Direction, Vec<Vec2>)>> {
-    paths(from, to, r_min, sigma_max, spacing, ok, 0.0)
-}
-
-/// [`transit`] for a turn between swaths, which starts at a swath's end with the wheels straight:
-/// with a curvature-rate limit `sigma_max` > 0, a plain word whose first part drives forward is
-/// tried only when that part is long enough to steer from straight to full lock and back
-/// (2·κ_max/σ_max). Shorter, the tractor reached the cusp off the path and heading wrong, and
-/// was 0.7–1.6 m RMS off the reversing leg after it in the simulator (`f2c_nl_field_188` at
-/// w 6 m, r_min 8 m, first parts 0.1–2.2 m long); the words that back up first were tracked
-/// within 2–6 cm RMS.
-pub fn turn(
-    from: (Vec2, f64),
-    to: (Vec2, f64),
-    r_min: f64,
-    sigma_max: f64,
-    spacing: f64,
-    ok: &dyn Fn(&Vec2) -> bool,
-) -> Option<Vec<(Direction, Vec<Vec2>)>> {
-    let lead_in = if sigma_max > 0.0 {
-        2.0 / (r_min * sigma_max)
-    } else {
-        0.0
-    };
-    paths(from, to, r_min, sigma_max, spacing, ok, lead_in)
-}
-
-fn paths(
     from: (Vec2, f64),
     to: (Vec2, f64),
     r_min: f64,
@@ -120,7 +103,7 @@ mod tests {
         let inside = |q: &Vec2| q.x <= 0.5 && q.x >= -60.0 && q.y.abs() <= 12.0;
         let from = (v2(0.0, 0.0), 0.0);
         let to = (v2(0.0, 3.0), PI);
-        let parts = transit(from, to, 8.0, 0.0, 0.5, &inside).expect("a reversing way");
+        let parts = transit(from, to, 8.0, 0.0, 0.5, &inside, 0.0).expect("a reversing way");
         assert!(parts.iter().any(|(d, _)| *d == Direction::Reverse));
         let first = parts.first().unwrap().1[0];
         let last = *parts.last().unwrap().1.last().unwrap();
@@ -138,8 +121,8 @@ mod tests {
         };
         // (Room for the longer smooth path: 20 m ahead, 30 m each side.)
         let roomy = |q: &Vec2| q.x <= 20.0 && q.x >= -60.0 && q.y.abs() <= 30.0;
-        let plain = transit(from, to, 8.0, 0.0, 0.25, &roomy).expect("a plain way");
-        let smooth = transit(from, to, 8.0, 0.1, 0.25, &roomy).expect("a smooth way");
+        let plain = transit(from, to, 8.0, 0.0, 0.25, &roomy, 0.0).expect("a plain way");
+        let smooth = transit(from, to, 8.0, 0.1, 0.25, &roomy, 0.0).expect("a smooth way");
         assert!(
             end_curvature(&plain) > 0.1,
             "plain {}",
@@ -152,6 +135,6 @@ mod tests {
         );
         // In a pocket 1.5 m deep, no way: every word's path fails somewhere.
         let shallow = |q: &Vec2| inside(q) && q.x >= -1.0;
-        assert!(transit(from, to, 8.0, 0.0, 0.5, &shallow).is_none());
+        assert!(transit(from, to, 8.0, 0.0, 0.5, &shallow, 0.0).is_none());
     }
 }

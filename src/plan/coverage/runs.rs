@@ -213,13 +213,14 @@ pub(super) fn drive_run(
             let backing = || {
                 let (h1, h2) = (vec_heading(&d), vec_heading(&(-d)));
                 let (q1, q2) = (world(e, y), world(end2, y2));
-                let parts = super::reverse::turn(
+                let parts = super::reverse::transit(
                     (q1, h1),
                     (q2, h2),
                     p.r_min,
                     p.max_curvature_rate,
                     p.point_spacing,
                     clear,
+                    super::reverse::turn_lead_in(p.r_min, p.max_curvature_rate),
                 )?;
                 let length: f64 = parts
                     .iter()
