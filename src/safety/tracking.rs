@@ -103,6 +103,8 @@ struct SwingCounter {
     times: [f64; MAX_SWINGS],
     len: usize,
     head: usize,
+    /// The next swing begins a new run ([`SwingCounter::restart_at_next_swing`]).
+    restart: bool,
 }
 
 impl SwingCounter {
@@ -114,21 +116,18 @@ impl SwingCounter {
             times: [0.0; MAX_SWINGS],
             len: 0,
             head: 0,
+            restart: false,
         }
     }
 
+    /// The next swing begins a new run: the signal's cause changed since the last one.
+    fn restart_at_next_swing(&mut self) {
+        self.restart = true;
+    }
+
     /// Feed `x` at `t`; true when `swings` alternate, non-decaying swings started within
-    /// `window`. `restart`: a swing that starts now begins a new run (the signal's cause
-    /// changed since the last swing).
-    fn update(
-        &mut self,
-        t: f64,
-        x: f64,
-        band: f64,
-        swings: usize,
-        window: f64,
-        restart: bool,
-    ) -> bool {
+    /// `window`.
+    fn update(&mut self, t: f64, x: f64, band: f64, swings: usize, window: f64) -> bool {
         if band <= 0.0 || swings == 0 {
             return false;
         }
@@ -145,6 +144,7 @@ impl SwingCounter {
         if side == self.side {
             return false;
         }
+        let restart = std::mem::take(&mut self.restart);
         if restart {
             self.len = 0;
         }
@@ -179,8 +179,6 @@ pub struct TrackingMonitor {
     wheel_mean: Option<f64>,
     /// The path's bend at the vehicle in the last period: +1 left, −1 right, 0 straight.
     path_bend: i8,
-    /// The path's bend changed since the cross-track error's last swing started.
-    path_turned: bool,
     /// The line has been acquired (|XTE| below `off_line` since the line started).
     acquired: bool,
     /// Distance driven on the line while not acquired, m.
@@ -201,7 +199,6 @@ impl TrackingMonitor {
             wheel_swings: SwingCounter::new(),
             wheel_mean: None,
             path_bend: 0,
-            path_turned: false,
             acquired: false,
             unacquired: 0.0,
             off_since: None,
@@ -233,7 +230,7 @@ impl TrackingMonitor {
     ) -> TrackingVerdict {
         if path_bend != self.path_bend {
             self.path_bend = path_bend;
-            self.path_turned = true;
+            self.xte_swings.restart_at_next_swing();
         }
         let mean = match self.wheel_mean {
             Some(m) if p.wheel_mean_tau > 0.0 => {
@@ -251,7 +248,6 @@ impl TrackingMonitor {
                 p.unstable_wheel,
                 p.unstable_swings,
                 p.unstable_window,
-                false,
             )
         {
             verdict = TrackingVerdict::Unstable;
@@ -259,19 +255,10 @@ impl TrackingMonitor {
         let Some(x) = xte.filter(|x| x.is_finite()) else {
             return verdict;
         };
-        // A swing starts when the error crosses the band on the other side: then whether the
-        // path bent since the last one is consumed.
-        let side = self.xte_swings.side;
-        let starts = (x > p.unstable_xte && side != 1) || (x < -p.unstable_xte && side != -1);
-        let restart = starts && std::mem::take(&mut self.path_turned);
-        if self.xte_swings.update(
-            t,
-            x,
-            p.unstable_xte,
-            p.unstable_swings,
-            p.unstable_window,
-            restart,
-        ) {
+        if self
+            .xte_swings
+            .update(t, x, p.unstable_xte, p.unstable_swings, p.unstable_window)
+        {
             verdict = TrackingVerdict::Unstable;
         }
         if p.off_line > 0.0 {

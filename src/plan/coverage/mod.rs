@@ -545,19 +545,34 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         HeadlandOrder::Last => [false, true],
     };
     // Each region's work in the order of the phases, then the nearest region's left (see
-    // `regions`): the first region is that of the first headland pass or swath run.
-    let first = field_tracks.front().and_then(|t| t.first().copied());
-    let first = first.or_else(|| pending.first().map(|(_, a, run, l)| run_start(run, l, *a)));
-    let mut region = first.map_or(0, |q| regions.of(&q));
+    // `regions`): the first region is that of the first headland pass or swath run. Each
+    // pass's and run's region (by where it starts) is found once.
+    let region_of = |t: &Vec<Vec2>| t.first().map_or(0, |q| regions.of(q));
+    let mut field_tracks: std::collections::VecDeque<(usize, Vec<Vec2>)> = field_tracks
+        .into_iter()
+        .map(|t| (region_of(&t), t))
+        .collect();
+    let mut obstacle_tracks: Vec<(usize, Vec<Vec2>)> = obstacle_tracks
+        .into_iter()
+        .map(|t| (region_of(&t), t))
+        .collect();
+    let mut pending: Vec<(usize, Vec2, _)> = pending
+        .into_iter()
+        .map(|run| {
+            let q = run_start(&run.2, &run.3, run.1);
+            (regions.of(&q), q, run)
+        })
+        .collect();
+    let first = field_tracks.front().map(|t| t.0);
+    let mut region = first.or_else(|| pending.first().map(|r| r.0)).unwrap_or(0);
     loop {
-        let in_region = |q: Option<&Vec2>| q.is_none_or(|q| regions.of(q) == region);
         for headland_phase in phases {
             if headland_phase {
                 loop {
-                    let next = field_tracks.iter().position(|t| in_region(t.first()));
+                    let next = field_tracks.iter().position(|t| t.0 == region);
                     let ring = match next.and_then(|k| field_tracks.remove(k)) {
-                        Some(r) => r,
-                        None if obstacle_tracks.iter().any(|t| in_region(t.first())) => {
+                        Some(r) => r.1,
+                        None if obstacle_tracks.iter().any(|t| t.0 == region) => {
                             let here = at.map(|a| a.0).unwrap_or(field.boundary[0]);
                             let dist = |t: &Vec<Vec2>| {
                                 t.iter()
@@ -565,12 +580,13 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
                                     .fold(f64::INFINITY, f64::min)
                             };
                             let k = (0..obstacle_tracks.len())
-                                .filter(|&i| in_region(obstacle_tracks[i].first()))
+                                .filter(|&i| obstacle_tracks[i].0 == region)
                                 .min_by(|&i, &j| {
-                                    dist(&obstacle_tracks[i]).total_cmp(&dist(&obstacle_tracks[j]))
+                                    dist(&obstacle_tracks[i].1)
+                                        .total_cmp(&dist(&obstacle_tracks[j].1))
                                 })
                                 .unwrap_or(0);
-                            obstacle_tracks.swap_remove(k)
+                            obstacle_tracks.swap_remove(k).1
                         }
                         None => break,
                     };
@@ -672,9 +688,8 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
                     let nearest = pending
                         .iter()
                         .enumerate()
-                        .map(|(k, (_, angle, run, lines))| (k, run_start(run, lines, *angle)))
-                        .filter(|(_, q)| in_region(Some(q)))
-                        .map(|(k, q)| (k, (q - here).norm()))
+                        .filter(|(_, (r, _, _))| *r == region)
+                        .map(|(k, (_, q, _))| (k, (q - here).norm()))
                         .fold(None, |b: Option<(usize, f64)>, c| match b {
                             Some(b) if b.1 <= c.1 => Some(b),
                             _ => Some(c),
@@ -682,7 +697,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
                     let Some((k, _)) = nearest else {
                         break;
                     };
-                    let (ci, angle, run, lines) = pending.swap_remove(k);
+                    let (_, _, (ci, angle, run, lines)) = pending.swap_remove(k);
                     drive_run(
                         &run,
                         &lines,
@@ -707,9 +722,9 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         let starts = field_tracks
             .iter()
             .chain(&obstacle_tracks)
-            .filter_map(|t| t.first().copied())
-            .chain(pending.iter().map(|(_, a, run, l)| run_start(run, l, *a)));
-        match regions.next(here, starts) {
+            .filter_map(|(r, t)| Some((*r, *t.first()?)))
+            .chain(pending.iter().map(|(r, q, _)| (*r, *q)));
+        match regions::nearest(here, starts) {
             Some(next) => region = next,
             None => break,
         }

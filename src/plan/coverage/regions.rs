@@ -53,15 +53,15 @@ impl Regions {
             .min_by(|&i, &j| distance(&self.outlines[i]).total_cmp(&distance(&self.outlines[j])))
             .unwrap_or(0)
     }
+}
 
-    /// The region to work next: that of the nearest start in `starts` to `here`, `None` when
-    /// nothing is left.
-    pub(super) fn next(&self, here: Vec2, starts: impl Iterator<Item = Vec2>) -> Option<usize> {
-        starts
-            .map(|q| ((q - here).norm(), q))
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map(|(_, q)| self.of(&q))
-    }
+/// The region to work next: that of the work nearest `here` among `starts` (region, where the
+/// work starts); `None` when nothing is left.
+pub(super) fn nearest(here: Vec2, starts: impl Iterator<Item = (usize, Vec2)>) -> Option<usize> {
+    starts
+        .map(|(region, q)| ((q - here).norm(), region))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, region)| region)
 }
 
 #[cfg(test)]
@@ -90,10 +90,13 @@ mod tests {
         assert_eq!(regions.of(&v2(12.0, 5.0)), 0);
         assert_eq!(regions.of(&v2(27.0, 5.0)), 1);
         assert_eq!(
-            regions.next(v2(50.0, 0.0), [v2(5.0, 5.0), v2(33.0, 3.0)].into_iter()),
+            nearest(
+                v2(50.0, 0.0),
+                [(0, v2(5.0, 5.0)), (1, v2(33.0, 3.0))].into_iter()
+            ),
             Some(1)
         );
-        assert_eq!(regions.next(v2(50.0, 0.0), std::iter::empty()), None);
+        assert_eq!(nearest(v2(50.0, 0.0), std::iter::empty()), None);
     }
 
     #[test]

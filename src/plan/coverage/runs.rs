@@ -181,21 +181,19 @@ pub(super) fn drive_run(
             // pulled back as little as makes it clear, before the symmetric turn is pulled
             // back to the shorter end (which left a strip of the longer swath unworked).
             let far2 = if forward { a2 } else { b2 };
+            // Out along this swath, back along the next; a turn longer than this bound is not
+            // taken (ASYMMETRIC_TURN_MAX_LENGTH).
+            let (h1, h2) = (vec_heading(&d), vec_heading(&(-d)));
+            let max_length = ASYMMETRIC_TURN_MAX_LENGTH
+                * (std::f64::consts::PI * p.r_min + (y2 - y).abs() + (end2 - e).abs());
             let dubins = |t: f64| {
                 let (e_t, s2) = (e - dir * t, end2 - dir * t);
                 if (e_t - s) * dir <= 0.0 || (s2 - far2) * dir <= 0.0 {
                     return None;
                 }
-                let (h1, h2) = (vec_heading(&d), vec_heading(&(-d)));
                 let (q1, q2) = (world(e_t, y), world(s2, y2));
                 match transit::clear_transit(q1, h1, q2, h2, p.r_min, p.point_spacing, clear) {
-                    Some(pts)
-                        if crate::geo::polygon::polyline_length(&pts)
-                            <= ASYMMETRIC_TURN_MAX_LENGTH
-                                * (std::f64::consts::PI * p.r_min
-                                    + (y2 - y).abs()
-                                    + (end2 - e).abs()) =>
-                    {
+                    Some(pts) if crate::geo::polygon::polyline_length(&pts) <= max_length => {
                         Some((
                             vec![crate::plan::turns::TurnPart {
                                 direction: Direction::Forward,
@@ -211,7 +209,6 @@ pub(super) fn drive_run(
             // Backing up at the full ends (a K-turn, the implement clear throughout) where no
             // forward turn fits without pulling them back.
             let backing = || {
-                let (h1, h2) = (vec_heading(&d), vec_heading(&(-d)));
                 let (q1, q2) = (world(e, y), world(end2, y2));
                 let parts = super::reverse::transit(
                     (q1, h1),
@@ -226,9 +223,7 @@ pub(super) fn drive_run(
                     .iter()
                     .map(|(_, pts)| crate::geo::polygon::polyline_length(pts))
                     .sum();
-                let bound = ASYMMETRIC_TURN_MAX_LENGTH
-                    * (std::f64::consts::PI * p.r_min + (y2 - y).abs() + (end2 - e).abs());
-                (length <= bound).then(|| {
+                (length <= max_length).then(|| {
                     let parts = parts
                         .into_iter()
                         .map(|(direction, points)| crate::plan::turns::TurnPart {
