@@ -62,6 +62,7 @@ fn params() -> CoverageParams {
         small_obstacle_max_m: 0.0,
         max_curvature_rate: 0.0,
         headland_order: Default::default(),
+        sections: 1,
     }
 }
 
@@ -90,7 +91,15 @@ fn stages(c: &mut Criterion) {
         .map(|s| s.0)
         .unwrap_or(0.0);
     g.bench_function("swaths", |b| {
-        b.iter(|| swaths::swath_lines(black_box(&working[0]), &working, angle, 6.0))
+        b.iter(|| {
+            swaths::swath_lines(
+                black_box(&working[0]),
+                &working,
+                angle,
+                6.0,
+                swaths::BAND_WIDENING,
+            )
+        })
     });
     g.bench_function("whole_plan", |b| {
         b.iter(|| plan_field(black_box(&field), &p))

@@ -50,6 +50,10 @@ pub struct FieldConfig {
     pub origin: FieldOrigin,
     /// Headland passes "first" (before the swaths) or "last" (after them).
     pub headland_order: crate::plan::coverage::HeadlandOrder,
+    /// Sections the implement switches off on its own where they leave the working area
+    /// (section control at the headland), 1..=64; 1 = none, the whole width works wherever a
+    /// swath runs.
+    pub sections: usize,
 }
 
 impl Default for FieldConfig {
@@ -63,6 +67,7 @@ impl Default for FieldConfig {
             boundary_tolerance_m: 0.1,
             origin: FieldOrigin::Auto,
             headland_order: crate::plan::coverage::HeadlandOrder::First,
+            sections: 1,
         }
     }
 }
@@ -85,6 +90,13 @@ impl FieldConfig {
             0.0,
             1000.0,
         );
+        if !(1..=64).contains(&fc.sections) {
+            c.push(
+                "field.sections",
+                fc.sections.to_string(),
+                "must be in 1..=64",
+            );
+        }
         c.range(
             "field.boundary_tolerance_m",
             fc.boundary_tolerance_m,

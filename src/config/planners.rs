@@ -129,6 +129,7 @@ impl Config {
             small_obstacle_max_m: f.small_obstacle_max_m,
             max_curvature_rate: self.vehicle.max_curvature_rate_per_m2,
             headland_order: f.headland_order,
+            sections: f.sections,
         }
     }
 

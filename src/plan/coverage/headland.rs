@@ -653,6 +653,7 @@ mod tests {
             small_obstacle_max_m: 20.0,
             max_curvature_rate: 0.0,
             headland_order: Default::default(),
+            sections: 1,
         }
     }
 

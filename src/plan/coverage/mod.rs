@@ -497,7 +497,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
     let mut swath_total = 0;
     let mut overlap_m2 = 0.0;
     for (ci, (cell, angle)) in cells.iter().enumerate() {
-        let lines = swaths::swath_lines(cell, &safe, *angle, w);
+        let lines = swaths::swath_lines(cell, &safe, *angle, w, swaths::band_widening(p.sections));
         overlap_m2 += lines.overlap_m
             * lines
                 .intervals
@@ -740,6 +740,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         turn_shapes_solved: cache.solved,
         warnings: warnings.into_inner(),
         transit_gaps: transit_gaps.get(),
+        sections: p.sections,
     })
 }
 

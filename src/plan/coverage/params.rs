@@ -69,6 +69,9 @@ pub struct CoverageParams {
     pub max_curvature_rate: f64,
     /// Headland passes before or after the swaths.
     pub headland_order: HeadlandOrder,
+    /// Sections the implement switches off where they leave the working area (section
+    /// control); 1 = none. See [`FieldPlan::sections`].
+    pub sections: usize,
 }
 
 /// A complete field plan: segments in driving order plus the areas they were made for.
@@ -93,6 +96,11 @@ pub struct FieldPlan {
     pub warnings: Vec<String>,
     /// Places where the plan goes on with no transit inside the field (each also a warning).
     pub transit_gaps: usize,
+    /// Sections of the implement the plan was made for: above 1, each section of a swath works
+    /// only where its centre is in the working area (the implement's section control switches
+    /// it off over the headland), and the swaths run on until their whole band has reached the
+    /// headland. 0 or 1: the whole width works wherever a swath runs.
+    pub sections: usize,
 }
 
 impl CoverageParams {
@@ -100,6 +108,11 @@ impl CoverageParams {
     /// as the turns check them.
     pub(super) fn validate(&self) -> Result<(), PlanError> {
         PlanError::check("line_width", self.line_width, self.line_width > 0.0)?;
+        PlanError::check(
+            "sections",
+            self.sections as f64,
+            (1..=64).contains(&self.sections),
+        )?;
         PlanError::check(
             "small_obstacle_max_m",
             self.small_obstacle_max_m,

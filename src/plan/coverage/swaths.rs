@@ -28,14 +28,32 @@ pub struct SwathLines {
 /// overlap for 1/16 of the band's corner unworked.
 pub const BAND_WIDENING: f64 = 0.5;
 
+/// The share of a swath's band run on to the cell's extent for an implement of `sections`:
+/// [`BAND_WIDENING`] without section control; the whole band with it (the sections that leave
+/// the working area switch off, so running on lays nothing twice).
+pub fn band_widening(sections: usize) -> f64 {
+    if sections > 1 {
+        1.0
+    } else {
+        BAND_WIDENING
+    }
+}
+
 /// Lines across `cell` (local frame) along `angle` rad, `line_width` apart at most. The n =
 /// ceil(span / w) lines are spread evenly, the first and last half a spacing inside the cell,
 /// so no pass is dropped and the footprints overlap by (n·w − span) in all.
 ///
-/// Each interval is widened to the cell's extent within the middle [`BAND_WIDENING`] of the
-/// line's band (so slanted edges are covered nearly to the corner) and then cut back to `safe`
-/// (where a centre line keeps the implement inside the field and off the obstacles).
-pub fn swath_lines(cell: &Area, safe: &[Area], angle: f64, line_width: f64) -> SwathLines {
+/// Each interval is widened to the cell's extent within the middle share `widening` of the
+/// line's band ([`band_widening`]: slanted edges are covered nearly to the corner) and then cut
+/// back to `safe` (where a centre line keeps the implement inside the field and off the
+/// obstacles).
+pub fn swath_lines(
+    cell: &Area,
+    safe: &[Area],
+    angle: f64,
+    line_width: f64,
+    widening: f64,
+) -> SwathLines {
     let rot = rotate_area(cell, -angle);
     let safe_rot: Vec<Area> = safe.iter().map(|a| rotate_area(a, -angle)).collect();
     let (lo, hi) = rot
@@ -51,7 +69,7 @@ pub fn swath_lines(cell: &Area, safe: &[Area], angle: f64, line_width: f64) -> S
     let intervals = ys
         .iter()
         .map(|&y| {
-            let band = band_extent(&rot, y, BAND_WIDENING * spacing / 2.0);
+            let band = band_extent(&rot, y, widening * spacing / 2.0);
             scan_intervals(&rot, y)
                 .into_iter()
                 .filter_map(|(a, b)| {
@@ -172,7 +190,7 @@ mod tests {
     #[test]
     fn balanced_lines_cover_the_cell_and_obstacles_split_runs() {
         let cell = rect(100.0, 50.0);
-        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0);
+        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0, BAND_WIDENING);
         assert_eq!(l.ys.len(), 9, "ceil(50/6)");
         assert!((l.ys[0] - l.spacing / 2.0).abs() < 1e-9);
         assert!((l.ys[8] - (50.0 - l.spacing / 2.0)).abs() < 1e-9);
@@ -188,7 +206,13 @@ mod tests {
                 v2(40.0, 35.0),
             ]],
         );
-        let l = swath_lines(&holed, std::slice::from_ref(&holed), 0.0, 6.0);
+        let l = swath_lines(
+            &holed,
+            std::slice::from_ref(&holed),
+            0.0,
+            6.0,
+            BAND_WIDENING,
+        );
         let r = runs(&l);
         assert_eq!(r.len(), 4, "{r:?}");
         let swaths: usize = r.iter().map(|x| x.len()).sum();
@@ -216,7 +240,7 @@ mod tests {
             vec![],
         );
         // Where the implement is clear: here the rectangle without the notches.
-        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0);
+        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0, BAND_WIDENING);
         assert_eq!(
             crate::plan::coverage::geometry::scan_intervals(&cell, l.ys[0]).len(),
             3

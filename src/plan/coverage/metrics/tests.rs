@@ -185,3 +185,68 @@ fn footprints_of_a_plan_on_the_axes() {
     let m = plan_metrics(&field, &plan, 3.0);
     assert!(m.covered_fraction > 0.0 && m.covered_fraction <= 1.0);
 }
+
+/// A 10 m swath along y = 30 over a 100 × 60 m field whose 10 m headland pass runs from
+/// (`x_bottom`, 0) to (`x_top`, 60); the plan made for `sections`.
+fn swath_into_headland(x_bottom: f64, x_top: f64, sections: usize) -> (Field, FieldPlan) {
+    let field = Field {
+        boundary: rect(0.0, 0.0, 100.0, 60.0),
+        obstacles: Vec::new(),
+    };
+    let line = |a: Vec2, b: Vec2| {
+        (0..=100)
+            .map(|k| a + (b - a) * (k as f64 / 100.0))
+            .collect()
+    };
+    let plan = FieldPlan {
+        segments: vec![
+            seg(
+                SegmentKind::Headland,
+                0,
+                line(v2(x_bottom, 0.0), v2(x_top, 60.0)),
+            ),
+            seg(SegmentKind::Work, 1, line(v2(0.0, 30.0), v2(100.0, 30.0))),
+        ],
+        working_area: vec![(rect(0.0, 0.0, 90.0, 60.0), Vec::new())],
+        swaths: 1,
+        sections,
+        ..FieldPlan::default()
+    };
+    (field, plan)
+}
+
+#[test]
+fn sections_switched_off_over_the_headland_lay_nothing_twice_and_leave_nothing() {
+    // Square to the pass (x 90–100): the whole swath overlaps it by 10 × 10 m; with five
+    // sections each switches off where the pass's footprint begins.
+    let (field, whole) = swath_into_headland(95.0, 95.0, 1);
+    let m = plan_metrics(&field, &whole, 10.0);
+    let union = 600.0 + 900.0;
+    assert!(
+        (m.overlap_fraction - 100.0 / union).abs() < 1e-6,
+        "{}",
+        m.overlap_fraction
+    );
+    let (_, sectioned) = swath_into_headland(95.0, 95.0, 5);
+    let s = plan_metrics(&field, &sectioned, 10.0);
+    assert!(s.overlap_fraction.abs() < 1e-6, "{}", s.overlap_fraction);
+    assert!((s.covered_fraction - m.covered_fraction).abs() < 1e-9);
+    // Slanted 1 in 6: the whole width lays a 10 m-wide parallelogram's worth twice; five
+    // sections at most a triangle per section beyond where each switches off.
+    let (_, whole) = swath_into_headland(90.0, 100.0, 1);
+    let (_, sectioned) = swath_into_headland(90.0, 100.0, 5);
+    let (m, s) = (
+        plan_metrics(&field, &whole, 10.0),
+        plan_metrics(&field, &sectioned, 10.0),
+    );
+    assert!(s.overlap_fraction > 0.0);
+    assert!(
+        s.overlap_fraction < 0.3 * m.overlap_fraction,
+        "sectioned {} whole {}",
+        s.overlap_fraction,
+        m.overlap_fraction
+    );
+    assert!((s.covered_fraction - m.covered_fraction).abs() < 1e-9);
+    let unworked = |p: &FieldPlan| unworked_ground(&field, p, 10.0).unsigned_area();
+    assert!((unworked(&sectioned) - unworked(&whole)).abs() < 1e-6);
+}
