@@ -35,6 +35,9 @@ pub struct PlanSummary {
     pub working_area_covered_fraction: f64,
     pub unworked_area_m2: f64,
     pub overlap_fraction: f64,
+    /// Sections of the implement the plan was made for (`field.sections`): above 1 the
+    /// overlap counts each section where it is on.
+    pub sections: usize,
     pub outside_area_m2: f64,
     pub outside_length_m: f64,
     pub obstacle_intrusions: usize,
@@ -75,6 +78,7 @@ impl PlanSummary {
             working_area_covered_fraction: m.working_area_covered_fraction,
             unworked_area_m2: m.unworked_area_m2,
             overlap_fraction: m.overlap_fraction,
+            sections: plan.sections.max(1),
             outside_area_m2: m.outside_area_m2,
             outside_length_m: m.outside_length_m,
             obstacle_intrusions: m.obstacle_intrusions,
@@ -86,6 +90,16 @@ impl PlanSummary {
             metrics_time_ms: metrics_time.as_secs_f64() * 1e3,
             findings: findings.clone(),
         }
+    }
+}
+
+/// What the overlap figure counts, after it: "" for an implement without sections, " (with N
+/// sections)" otherwise ([`FieldPlan::sections`]).
+pub fn sections_note(sections: usize) -> String {
+    if sections > 1 {
+        format!(" (with {sections} sections)")
+    } else {
+        String::new()
     }
 }
 
@@ -468,13 +482,14 @@ pub fn plan_svg(
     );
     let figures = match metrics {
         Some(m) => format!(
-            "{} cells, {} swaths, field worked {:.2} % (working area {:.2} %), unworked {:.0} m², overlap {:.2} %, outside {:.3} m², total {:.0} m; origin {:.7}°, {:.7}°",
+            "{} cells, {} swaths, field worked {:.2} % (working area {:.2} %), unworked {:.0} m², overlap {:.2} %{}, outside {:.3} m², total {:.0} m; origin {:.7}°, {:.7}°",
             plan.cells,
             plan.swaths,
             100.0 * m.covered_fraction,
             100.0 * m.working_area_covered_fraction,
             m.unworked_area_m2,
             100.0 * m.overlap_fraction,
+            sections_note(plan.sections),
             m.outside_area_m2,
             m.total_length_m,
             origin.lat_deg,

@@ -197,3 +197,28 @@ fn byte_order_marks_utf16_and_unused_elements_read_with_warnings() {
         }
     }
 }
+
+/// `field.sections`: the summary line, the SVG and metrics.json say what the overlap counts,
+/// and on a real parcel whose headland edges slant to the swaths (w 12 m) the sections lay
+/// less twice and leave no more unworked.
+#[test]
+fn an_implement_with_sections_is_planned_and_measured_with_them() {
+    let field = "tools/fields/real/be_vlg_concave.geojson";
+    let (whole, mw, svg_whole, _d1) = plan(field, &[]);
+    let (sectioned, ms, svg, _d2) = plan(field, &["--set", "field.sections=8"]);
+    assert_eq!((whole.code, sectioned.code), (0, 0), "{}", sectioned.stderr);
+    assert_eq!(mw["sections"], 1);
+    assert_eq!(ms["sections"], 8);
+    let line = sectioned.stdout.lines().next().unwrap_or("");
+    assert!(line.contains("% (with 8 sections);"), "{line}");
+    assert!(svg.contains("(with 8 sections)"));
+    assert!(!svg_whole.contains("sections"));
+    let f = |m: &serde_json::Value, k: &str| m[k].as_f64().unwrap();
+    assert!(
+        f(&ms, "overlap_fraction") < f(&mw, "overlap_fraction") - 0.02,
+        "overlap {} → {}",
+        f(&mw, "overlap_fraction"),
+        f(&ms, "overlap_fraction")
+    );
+    assert!(f(&ms, "covered_fraction") >= f(&mw, "covered_fraction") - 1e-9);
+}

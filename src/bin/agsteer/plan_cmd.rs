@@ -5,7 +5,7 @@
 
 use agsteer::config::Config;
 use agsteer::field::findings::{plan_findings, unreachable, MIN_PIECE_M2};
-use agsteer::field::output::{plan_geojson, plan_svg, plan_taskdata, PlanSummary};
+use agsteer::field::output::{plan_geojson, plan_svg, plan_taskdata, sections_note, PlanSummary};
 use agsteer::field::{
     decode_text, external_partfield_files, list_fields, load_field_with, GuidanceKind, LoadedField,
 };
@@ -263,7 +263,7 @@ where
         println!("{summary_json}");
     } else {
         println!(
-            "{title}: {} cells, {} swaths, {} turns, {:.0} m total; field worked {:.2} % (working area {:.2} %), unworked {:.0} m², unreachable {:.0} m² in {} place(s), overlap {:.2} %; outside {:.3} m²; {:.0} ms; {}",
+            "{title}: {} cells, {} swaths, {} turns, {:.0} m total; field worked {:.2} % (working area {:.2} %), unworked {:.0} m², unreachable {:.0} m² in {} place(s), overlap {:.2} %{}; outside {:.3} m²; {:.0} ms; {}",
             s.cells,
             s.swaths,
             s.turns,
@@ -274,6 +274,7 @@ where
             findings.unreachable_area_m2,
             findings.unreachable_pieces,
             100.0 * s.overlap_fraction,
+            sections_note(s.sections),
             s.outside_area_m2,
             s.plan_time_ms,
             findings.summary()
