@@ -63,6 +63,8 @@ struct Case {
     size: f64,
     line_width: f64,
     r_min: f64,
+    /// Implement sections (`field.sections`; above 1 the swaths run on over their whole band).
+    sections: usize,
 }
 
 fn star(points: &[(f64, f64)], size: f64) -> Vec<Vec2> {
@@ -146,6 +148,7 @@ impl Case {
         let mut p = Config::default().coverage_params();
         p.line_width = self.line_width;
         p.r_min = self.r_min;
+        p.sections = self.sections;
         p
     }
 }
@@ -172,14 +175,20 @@ fn shape() -> impl Strategy<Value = Shape> {
 }
 
 fn case() -> impl Strategy<Value = Case> {
-    (shape(), 50.0..220.0f64, 3.0..36.0f64, 4.0..10.0f64).prop_map(
-        |(shape, size, line_width, r_min)| Case {
+    (
+        shape(),
+        50.0..220.0f64,
+        3.0..36.0f64,
+        4.0..10.0f64,
+        prop::sample::select(vec![1usize, 1, 8]),
+    )
+        .prop_map(|(shape, size, line_width, r_min, sections)| Case {
             shape,
             size,
             line_width,
             r_min,
-        },
-    )
+            sections,
+        })
 }
 
 fn ring(pts: &[Vec2]) -> LineString<f64> {
@@ -375,6 +384,7 @@ fn the_checks_catch_what_they_check() {
             size: 100.0,
             line_width: 6.0,
             r_min: 5.0,
+            sections: 1,
         }
         .field();
         assert!(agsteer::geo::polygon::signed_area(&f.boundary) > 0.0);
