@@ -510,3 +510,29 @@ fn a_headland_pass_whose_start_is_pulled_back_is_still_worked_round() {
         );
     }
 }
+
+/// A star-shaped field with a hole (w 26.5 m, r_min 5.7 m) that a fresh draw of
+/// `many_plans_keep_the_guarantees` found: the opened area of its outer pass kept two kinks
+/// (1.16 and 1.22 /m against 1/r_min = 0.18 /m) and the planner returned the pass with them
+/// (refused by the checks, exit 4). The pass is now cut where it turns tighter than r_min.
+#[test]
+fn a_kinked_headland_pass_found_at_random_keeps_the_guarantees() {
+    let c = Case {
+        shape: Shape::Holes {
+            points: vec![
+                (0.6104748219070809, 0.7),
+                (0.0, 0.7),
+                (0.5877787946485098, 0.7620806342169772),
+                (0.5123331797164642, 0.9081334361119455),
+                (0.22407924493505527, 0.8120824347898419),
+                (0.0, 0.7),
+            ],
+            holes: vec![(0.5319255796219482, 0.1706934542303401, 0.037490071511938)],
+        },
+        size: 73.97763748868036,
+        line_width: 26.45078928775462,
+        r_min: 5.659127914805385,
+        sections: 1,
+    };
+    keeps_the_guarantees(&c).unwrap();
+}

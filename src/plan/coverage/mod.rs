@@ -245,15 +245,17 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
     // Pieces of the field that no transit with the implement clear joins (see `apart`).
     let gap = p.point_spacing.max(rings.max_gap());
     let pieces = apart::Apart::new(field, tests.clearance.0, gap);
-    // A pass is worked only where its implement is clear (a guarantee): a pass that is not
-    // clear throughout is cut into its clear stretches, and the cut is reported.
+    // A pass is worked only where its implement is clear and it turns no tighter than r_min
+    // (the guarantees): a pass that is not so throughout is cut into its stretches that are,
+    // and the cut is reported.
     let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
-        headland::clear_stretches(field_passes, &clear, &warnings).into();
+        headland::clear_stretches(field_passes, &clear, p.r_min, &warnings).into();
     if p.headland_order == HeadlandOrder::Last {
         // Worked last, from the inside out: the outermost pass along the edge ends the job.
         field_tracks.make_contiguous().reverse();
     }
-    let mut obstacle_tracks = headland::clear_stretches(obstacle_passes, &clear, &warnings);
+    let mut obstacle_tracks =
+        headland::clear_stretches(obstacle_passes, &clear, p.r_min, &warnings);
 
     let tp = p.turn_params();
     let mut cache = crate::plan::turns::TurnCache::default();
