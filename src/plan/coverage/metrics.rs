@@ -106,66 +106,31 @@ pub fn footprint<'a>(
     segments: impl IntoIterator<Item = &'a PlanSegment>,
     width: f64,
 ) -> MultiPolygon<f64> {
-    worked_footprint(segments, width, None)
+    geo::algorithm::bool_ops::unary_union(&strokes(segments, width))
 }
 
-/// The sections of a plan's implement and the ground left to them ([`FieldPlan::sections`],
-/// [`section_ground`]).
-type Sectioned<'a> = Option<(usize, &'a MultiPolygon<f64>)>;
-
-/// The union of the footprints of `segments`, `width` wide (each polyline stroked on its own).
-fn worked_footprint<'a>(
+/// Each segment's footprint, `width` wide, as polygons that overlap only where two segments
+/// work the same ground (one buffer per polyline; see [`footprint`]).
+fn strokes<'a>(
     segments: impl IntoIterator<Item = &'a PlanSegment>,
     width: f64,
-    sectioned: Sectioned<'_>,
-) -> MultiPolygon<f64> {
-    geo::algorithm::bool_ops::unary_union(&worked_strokes(segments, width, sectioned))
-}
-
-/// The ground `segments` work, `width` wide, as polygons that overlap only where two segments
-/// work the same ground: each segment's whole footprint; for the swaths (`Work`) of a plan
-/// made for n > 1 sections, the ground its sections work ([`section_strokes`]).
-///
-/// The union of the sectioned strokes and the headland passes' footprints is that of the
-/// whole footprints (a section is off only where the ground under it is the passes'), so the
-/// metrics take the ground worked from the whole footprints, whose union i_overlay 4 forms in
-/// a second, and the sectioned strokes only for the sum of their areas (the overlap): united,
-/// their many near-coincident long edges kept its fragment split busy for minutes on a large
-/// field at w 3 m (bg_arable_60ha).
-fn worked_strokes<'a>(
-    segments: impl IntoIterator<Item = &'a PlanSegment>,
-    width: f64,
-    sectioned: Sectioned<'_>,
 ) -> Vec<Polygon<f64>> {
-    let rings = sectioned
-        .filter(|(n, _)| *n > 1)
-        .map(|(n, on)| (n, Rings::of(on)));
-    let mut strokes = Vec::new();
-    for s in segments {
-        let pts = merged(&s.points);
-        if pts.len() < 2 {
-            continue;
-        }
-        match &rings {
-            Some((n, rings)) if s.kind == SegmentKind::Work => {
-                strokes.extend(section_strokes(&pts, width, *n, rings))
-            }
-            _ => strokes.extend(stroke(&line(&pts), width)),
-        }
-    }
-    strokes
+    segments
+        .into_iter()
+        .map(|s| merged(&s.points))
+        .filter(|pts| pts.len() >= 2)
+        .flat_map(|pts| stroke(&pts, width))
+        .collect()
 }
 
-/// Butt-capped, round-joined stroke of `line`, `width` wide.
-fn stroke(line: &LineString<f64>, width: f64) -> Vec<Polygon<f64>> {
+/// Butt-capped, round-joined stroke of the polyline `pts`, `width` wide.
+fn stroke(pts: &[Vec2], width: f64) -> Vec<Polygon<f64>> {
     let style = BufferStyle::new(0.5 * width)
         .line_cap(LineCap::Butt)
         .line_join(LineJoin::Round(JOIN_ANGLE));
-    line.buffer_with_style(style).0
-}
-
-fn line(pts: &[Vec2]) -> LineString<f64> {
     LineString::new(pts.iter().map(coord).collect())
+        .buffer_with_style(style)
+        .0
 }
 
 /// How far inside a section's edge its edge lines are taken, m ([`section_strokes`]): an edge
@@ -173,209 +138,128 @@ fn line(pts: &[Vec2]) -> LineString<f64> {
 /// and outside are a rounding apart.
 const SECTION_EDGE_INSET_M: f64 = 0.01;
 
-/// The ground a swath along `pts` works with `n` sections, each on where `rings` (the ground
-/// left to the swaths, [`section_ground`]) holds any of it: its centre line or one of its edge
-/// lines ([`SECTION_EDGE_INSET_M`] inside) is inside. A section switches off only once nothing
+/// The ground the swaths (`Work`) of a plan made for n > 1 sections work: each section on
+/// where `ground` (the ground left to the swaths: the field less the headland passes'
+/// footprints) holds any of the ground under it, its centre line or one of its edge lines
+/// ([`SECTION_EDGE_INSET_M`] inside) lying over it. A section switches off only once nothing
 /// under it is left to work, so section control never leaves a sliver where an edge runs
-/// slanted to the swaths, and lays at most a section's width twice. A straight swath whose
-/// sections are each on over one stretch overlapping its neighbours' is one staircase polygon
-/// (stroked apart, the sections' long shared edges made the union of a large field's strips
-/// take minutes); else each section's stretches are stroked; a curved swath's sections by
-/// their centre lines alone.
-fn section_strokes(pts: &[Vec2], width: f64, n: usize, rings: &Rings) -> Vec<Polygon<f64>> {
+/// slanted to the swaths, and lays at most a section's width twice. Each straight swath's
+/// sections are found on scan lines in the swath's frame (`geometry::scan_intervals`, the
+/// ground turned once per swath direction); a swath that is not straight (none is planned so)
+/// counts its whole footprint.
+///
+/// The union of these strokes and the headland passes' footprints is that of the whole
+/// footprints (a section is off only over the passes' ground), so [`plan_metrics`] takes the
+/// ground worked from the whole footprints and these only for the sum of their areas (the
+/// overlap): united, their many near-coincident long edges kept i_overlay 4's fragment split
+/// busy for minutes on a large field at w 3 m (bg_arable_60ha).
+fn section_strokes<'a>(
+    swaths: impl IntoIterator<Item = &'a PlanSegment>,
+    width: f64,
+    n: usize,
+    ground: &MultiPolygon<f64>,
+) -> Vec<Polygon<f64>> {
+    use super::geometry::{from_geo, rotate, rotate_area, scan_intervals};
+    let ground = from_geo(ground);
+    // The ground turned into each swath direction met so far (swaths of a cell share one).
+    let mut turned: Vec<(f64, Vec<super::geometry::Area>)> = Vec::new();
     let w = width / n as f64;
     let lateral = |k: usize| (k as f64 + 0.5) * w - 0.5 * width;
-    let (a, b) = (pts[0], pts[pts.len() - 1]);
-    let t = (b - a) / (b - a).norm().max(1e-12);
-    let straight = pts.iter().all(|q| cross(&t, &(q - a)).abs() < 1e-6);
-    if !straight {
-        return (0..n)
-            .flat_map(|k| rings.inside_pieces(&offset_polyline(pts, lateral(k))))
-            .flat_map(|piece| stroke(&line(&piece), w))
-            .collect();
-    }
-    let normal = crate::geo::v2(-t.y, t.x);
-    let at = |x: f64, l: f64| a + t * x + normal * l;
-    let length = (b - a).dot(&t);
     let edge = 0.5 * w - SECTION_EDGE_INSET_M.min(0.25 * w);
-    // Each section's stretches along the swath (from `a`), merged.
-    let stretches: Vec<Vec<(f64, f64)>> = (0..n)
-        .map(|k| {
-            let mut s: Vec<(f64, f64)> = [-edge, 0.0, edge]
-                .iter()
-                .flat_map(|d| {
-                    let l = lateral(k) + d;
-                    rings.inside_pieces(&[at(0.0, l), at(length, l)])
-                })
-                .map(|p| ((p[0] - a).dot(&t), (p[p.len() - 1] - a).dot(&t)))
-                .collect();
-            s.sort_by(|x, y| x.0.total_cmp(&y.0));
-            let mut merged: Vec<(f64, f64)> = Vec::with_capacity(s.len());
-            for iv in s {
-                match merged.last_mut() {
-                    Some(m) if iv.0 <= m.1 => m.1 = m.1.max(iv.1),
-                    _ => merged.push(iv),
-                }
+    let mut out = Vec::new();
+    for pts in swaths.into_iter().map(|s| merged(&s.points)) {
+        if pts.len() < 2 {
+            continue;
+        }
+        let (a, b) = (pts[0], pts[pts.len() - 1]);
+        let t = (b - a) / (b - a).norm().max(1e-12);
+        if pts.iter().any(|q| cross(&t, &(q - a)).abs() >= 1e-6) {
+            out.extend(stroke(&pts, width));
+            continue;
+        }
+        let angle = t.y.atan2(t.x);
+        let i = match turned.iter().position(|(g, _)| (g - angle).abs() < 1e-12) {
+            Some(i) => i,
+            None => {
+                let areas = ground.iter().map(|g| rotate_area(g, -angle)).collect();
+                turned.push((angle, areas));
+                turned.len() - 1
             }
-            merged
-        })
-        .collect();
-    let one_each = stretches.iter().all(|s| s.len() == 1);
-    if one_each
+        };
+        let areas = &turned[i].1;
+        // The swath in its frame: from (x0, y) along +x for `length`; left is +y.
+        let (start, length) = (rotate(&a, -angle), (b - a).dot(&t));
+        let stretches: Vec<Vec<(f64, f64)>> = (0..n)
+            .map(|k| {
+                let lines = [-edge, 0.0, edge].map(|d| start.y + lateral(k) + d);
+                super::swaths::merge_overlapping(
+                    lines
+                        .iter()
+                        .flat_map(|&y| areas.iter().flat_map(move |g| scan_intervals(g, y)))
+                        .map(|(x0, x1)| (x0 - start.x).max(0.0)..(x1 - start.x).min(length))
+                        .filter(|r| r.end > r.start)
+                        .map(|r| (r.start, r.end))
+                        .collect(),
+                )
+            })
+            .collect();
+        let at = |x: f64, l: f64| a + t * x + crate::geo::v2(-t.y, t.x) * l;
+        out.extend(sections_polygons(&stretches, w, &lateral, &at));
+    }
+    out
+}
+
+/// The polygons of one straight swath's sections, each on over its `stretches` (along the
+/// swath, m): one staircase polygon when each section is on over one stretch overlapping its
+/// neighbours' (stroked apart, the sections' long shared edges made a large field's union
+/// take minutes), else a rectangle per stretch. `at(x, l)`: the point x along the swath and l
+/// to its left.
+fn sections_polygons(
+    stretches: &[Vec<(f64, f64)>],
+    w: f64,
+    lateral: &dyn Fn(usize) -> f64,
+    at: &dyn Fn(f64, f64) -> Vec2,
+) -> Vec<Polygon<f64>> {
+    let n = stretches.len();
+    let rectangle = |k: usize, (x0, x1): (f64, f64)| {
+        let (lo, hi) = (lateral(k) - 0.5 * w, lateral(k) + 0.5 * w);
+        to_geo_polygon(&[at(x0, lo), at(x1, lo), at(x1, hi), at(x0, hi)], &[])
+    };
+    let staircase = stretches.iter().all(|s| s.len() == 1)
         && stretches
             .windows(2)
-            .all(|s| s[0][0].0 < s[1][0].1 && s[1][0].0 < s[0][0].1)
-    {
-        // Up the far ends (right to left), back down the near ends.
-        let mut ring: Vec<Vec2> = (0..n)
-            .flat_map(|k| {
-                let x = stretches[k][0].1;
-                [at(x, lateral(k) - 0.5 * w), at(x, lateral(k) + 0.5 * w)]
-            })
+            .all(|s| s[0][0].0 < s[1][0].1 && s[1][0].0 < s[0][0].1);
+    if !staircase {
+        return (0..n)
+            .flat_map(|k| stretches[k].iter().map(move |&iv| (k, iv)))
+            .map(|(k, iv)| rectangle(k, iv))
             .collect();
-        ring.extend((0..n).rev().flat_map(|k| {
-            let x = stretches[k][0].0;
-            [at(x, lateral(k) + 0.5 * w), at(x, lateral(k) - 0.5 * w)]
-        }));
-        // Without the repeated corners where neighbouring sections end level.
-        ring.dedup_by(|q, p| (*q - *p).norm() < 1e-9);
-        let mut corners: Vec<Vec2> = Vec::with_capacity(ring.len());
-        for (i, q) in ring.iter().enumerate() {
-            let (p, r) = (
+    }
+    // Up the far ends (right to left), back down the near ends.
+    let mut ring: Vec<Vec2> = (0..n)
+        .flat_map(|k| {
+            let x = stretches[k][0].1;
+            [at(x, lateral(k) - 0.5 * w), at(x, lateral(k) + 0.5 * w)]
+        })
+        .collect();
+    ring.extend((0..n).rev().flat_map(|k| {
+        let x = stretches[k][0].0;
+        [at(x, lateral(k) + 0.5 * w), at(x, lateral(k) - 0.5 * w)]
+    }));
+    // Without the repeated corners where neighbouring sections end level.
+    ring.dedup_by(|q, p| (*q - *p).norm() < 1e-9);
+    let corners: Vec<Vec2> = (0..ring.len())
+        .filter(|&i| {
+            let (p, q, r) = (
                 ring[(i + ring.len() - 1) % ring.len()],
+                ring[i],
                 ring[(i + 1) % ring.len()],
             );
-            if cross(&(q - p), &(r - q)).abs() > 1e-9 {
-                corners.push(*q);
-            }
-        }
-        return vec![to_geo_polygon(&corners, &[])];
-    }
-    (0..n)
-        .flat_map(|k| stretches[k].iter().map(move |&(x0, x1)| (k, x0, x1)))
-        .flat_map(|(k, x0, x1)| stroke(&line(&[at(x0, lateral(k)), at(x1, lateral(k))]), w))
-        .collect()
-}
-
-/// The rings of a multipolygon with their edges' bounding boxes, to cut polylines at them.
-struct Rings {
-    /// (exterior, holes) of each polygon, closed (first point repeated last).
-    polygons: Vec<(Vec<Vec2>, Vec<Vec<Vec2>>)>,
-    /// Every ring edge: (start, end, bounding-box min, bounding-box max).
-    edges: Vec<(Vec2, Vec2, Vec2, Vec2)>,
-}
-
-impl Rings {
-    fn of(area: &MultiPolygon<f64>) -> Self {
-        let ring = |l: &LineString<f64>| -> Vec<Vec2> {
-            l.0.iter().map(|c| crate::geo::v2(c.x, c.y)).collect()
-        };
-        let polygons: Vec<(Vec<Vec2>, Vec<Vec<Vec2>>)> = area
-            .0
-            .iter()
-            .map(|p| (ring(p.exterior()), p.interiors().iter().map(ring).collect()))
-            .collect();
-        let edges = polygons
-            .iter()
-            .flat_map(|(e, hs)| std::iter::once(e).chain(hs.iter()))
-            .flat_map(|r| {
-                r.windows(2)
-                    .map(|w| (w[0], w[1], w[0].inf(&w[1]), w[0].sup(&w[1])))
-            })
-            .collect();
-        Rings { polygons, edges }
-    }
-
-    fn contains(&self, q: &Vec2) -> bool {
-        self.polygons
-            .iter()
-            .any(|(e, hs)| contains_point(e, q) && !hs.iter().any(|h| contains_point(h, q)))
-    }
-
-    /// The pieces of the polyline `line` inside the area: the line is cut where it crosses a
-    /// ring (chord by chord, edges whose bounding box misses the chord's skipped) and each
-    /// piece kept if its middle is inside. Collinear points are dropped first (a straight swath
-    /// is one chord).
-    fn inside_pieces(&self, line: &[Vec2]) -> Vec<Vec<Vec2>> {
-        let mut pts: Vec<Vec2> = Vec::with_capacity(line.len());
-        for &q in line {
-            if let [.., a, b] = pts[..] {
-                if cross(&(b - a), &(q - b)).abs() <= 1e-9 * (b - a).norm() * (q - b).norm() {
-                    pts.pop();
-                }
-            }
-            pts.push(q);
-        }
-        if pts.len() < 2 {
-            return Vec::new();
-        }
-        // Cuts as chord index + fraction along it.
-        let mut cuts = vec![0.0, (pts.len() - 1) as f64];
-        for (i, w) in pts.windows(2).enumerate() {
-            let (a, b) = (w[0], w[1]);
-            let (lo, hi) = (a.inf(&b), a.sup(&b));
-            let r = b - a;
-            for (c, d, elo, ehi) in &self.edges {
-                if elo.x > hi.x || ehi.x < lo.x || elo.y > hi.y || ehi.y < lo.y {
-                    continue;
-                }
-                let s = d - c;
-                let denom = cross(&r, &s);
-                if denom.abs() < 1e-15 {
-                    continue;
-                }
-                let t = cross(&(c - a), &s) / denom;
-                let u = cross(&(c - a), &r) / denom;
-                if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
-                    cuts.push(i as f64 + t);
-                }
-            }
-        }
-        cuts.sort_by(f64::total_cmp);
-        let at = |s: f64| {
-            let i = (s.floor() as usize).min(pts.len() - 2);
-            pts[i] + (pts[i + 1] - pts[i]) * (s - i as f64)
-        };
-        cuts.windows(2)
-            .filter(|c| c[1] - c[0] > 1e-12 && self.contains(&at(0.5 * (c[0] + c[1]))))
-            .map(|c| {
-                let mut piece = vec![at(c[0])];
-                let first = c[0].floor() as usize + 1;
-                piece.extend(
-                    (first..pts.len())
-                        .take_while(|&k| (k as f64) < c[1])
-                        .map(|k| pts[k]),
-                );
-                piece.push(at(c[1]));
-                piece
-            })
-            .collect()
-    }
-}
-
-/// The ground left to a plan's swath sections, `None` for a plan without sections
-/// ([`FieldPlan::sections`]): the field less the headland passes' footprints.
-fn section_ground(field: &Field, plan: &FieldPlan, line_width: f64) -> Option<MultiPolygon<f64>> {
-    (plan.sections > 1).then(|| {
-        let headland = plan
-            .segments
-            .iter()
-            .filter(|s| s.kind == SegmentKind::Headland);
-        field_polygon(field).difference(&footprint(headland, line_width))
-    })
-}
-
-/// `pts` moved `d` to the left of the direction of travel (each point along the normal of the
-/// chord through its neighbours), m.
-fn offset_polyline(pts: &[Vec2], d: f64) -> Vec<Vec2> {
-    let n = pts.len();
-    (0..n)
-        .map(|i| {
-            let t = pts[(i + 1).min(n - 1)] - pts[i.saturating_sub(1)];
-            let t = t / t.norm().max(1e-12);
-            pts[i] + crate::geo::v2(-t.y, t.x) * d
+            cross(&(q - p), &(r - q)).abs() > 1e-9
         })
-        .collect()
+        .map(|i| ring[i])
+        .collect();
+    vec![to_geo_polygon(&corners, &[])]
 }
 
 /// Three-point curvature at `b`: 1/radius of the circle through `a`, `b`, `c`, 1/m.
@@ -408,10 +292,21 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
     use SegmentKind::*;
     let field_poly = MultiPolygon::new(vec![to_geo_polygon(&field.boundary, &field.obstacles)]);
     let boundary_poly = MultiPolygon::new(vec![to_geo_polygon(&field.boundary, &[])]);
-    let obstacles = obstacle_polygons(field);
-    let working = working_polygon(plan, &obstacles);
-    let on_ground = section_ground(field, plan, line_width);
-    let sectioned = on_ground.as_ref().map(|g| (plan.sections, g));
+    let working = MultiPolygon::new(
+        plan.working_area
+            .iter()
+            .map(|(outer, holes)| to_geo_polygon(outer, holes))
+            .collect(),
+    );
+    // Obstacles are removed from the working area too, whatever the planner reported.
+    let obstacles = MultiPolygon::new(
+        field
+            .obstacles
+            .iter()
+            .map(|o| to_geo_polygon(o, &[]))
+            .collect(),
+    );
+    let working = working.difference(&obstacles);
     let working_area_m2 = working.unsigned_area();
     let field_area_m2 = field_poly.unsigned_area();
 
@@ -423,12 +318,11 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
             .iter()
             .filter(move |s| kinds.contains(&s.kind))
     }
-    // The whole footprints for the ground worked (see `worked_strokes`).
-    let work_strokes = worked_strokes(of(plan, &[Work, Detour]), line_width, None);
-    let mut passes_strokes = worked_strokes(of(plan, &[Headland]), line_width, None);
-    passes_strokes.extend(work_strokes.iter().cloned());
     let union = |p: &[Polygon<f64>]| geo::algorithm::bool_ops::unary_union(p);
-    let (work_fp, passes_fp) = (union(&work_strokes), union(&passes_strokes));
+    let headland_strokes = strokes(of(plan, &[Headland]), line_width);
+    let work_strokes = strokes(of(plan, &[Work, Detour]), line_width);
+    let work_fp = union(&work_strokes);
+    let passes_fp = union(&[headland_strokes.as_slice(), work_strokes.as_slice()].concat());
     let all_fp = footprint(plan.segments.iter(), line_width);
 
     let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
@@ -456,19 +350,17 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
     };
     let outside_length_m = length(&boundary_poly.clip(&paths, true));
     let obstacle_length_m = length(&obstacles.clip(&paths, false));
-    // (Strokes overlap only where two segments work the same ground.) With sections, each
-    // swath counts the ground its sections work.
-    let sectioned_strokes = sectioned.map(|_| {
-        let mut strokes = worked_strokes(of(plan, &[Work, Detour]), line_width, sectioned);
-        strokes.extend(worked_strokes(of(plan, &[Headland]), line_width, None));
-        strokes
-    });
-    let sum_single: f64 = sectioned_strokes
-        .as_ref()
-        .unwrap_or(&passes_strokes)
-        .iter()
-        .map(|p| p.unsigned_area())
-        .fold(0.0, |a, b| a + b);
+    // (Strokes overlap only where two segments work the same ground.) With sections, a swath
+    // counts the ground its sections work (`section_strokes`: the ground worked is the same).
+    let area_of = |p: &[Polygon<f64>]| p.iter().map(|q| q.unsigned_area()).fold(0.0, |a, b| a + b);
+    let work_area = if plan.sections > 1 {
+        let left = field_poly.difference(&union(&headland_strokes));
+        let swaths = section_strokes(of(plan, &[Work]), line_width, plan.sections, &left);
+        area_of(&swaths) + area_of(&strokes(of(plan, &[Detour]), line_width))
+    } else {
+        area_of(&work_strokes)
+    };
+    let sum_single = area_of(&headland_strokes) + work_area;
     let union_area = passes_fp.unsigned_area();
     let overlap_fraction = ratio((sum_single - union_area).max(0.0), union_area);
     let outside_area_m2 = all_fp.difference(&boundary_poly).unsigned_area();
@@ -547,31 +439,8 @@ pub fn field_polygon(field: &Field) -> MultiPolygon<f64> {
     MultiPolygon::new(vec![to_geo_polygon(&field.boundary, &field.obstacles)])
 }
 
-/// The field's obstacles as one multipolygon.
-fn obstacle_polygons(field: &Field) -> MultiPolygon<f64> {
-    MultiPolygon::new(
-        field
-            .obstacles
-            .iter()
-            .map(|o| to_geo_polygon(o, &[]))
-            .collect(),
-    )
-}
-
-/// The plan's working area without the field's obstacles (removed whatever the planner
-/// reported).
-fn working_polygon(plan: &FieldPlan, obstacles: &MultiPolygon<f64>) -> MultiPolygon<f64> {
-    MultiPolygon::new(
-        plan.working_area
-            .iter()
-            .map(|(outer, holes)| to_geo_polygon(outer, holes))
-            .collect(),
-    )
-    .difference(obstacles)
-}
-
 /// Ground of the field that no working footprint (work, detour, headland) covers (with
-/// sections too: see `worked_strokes`).
+/// sections too: see [`section_strokes`]).
 pub fn unworked_ground(field: &Field, plan: &FieldPlan, line_width: f64) -> MultiPolygon<f64> {
     use SegmentKind::*;
     let passes = plan

@@ -106,7 +106,7 @@ pub fn swath_lines(
 /// extent widened over the same ground (a line crossing a notched edge in several pieces, each
 /// widened to the whole band) are one swath: kept apart, each was driven over the same ground
 /// (bg_arable_60ha at w 6 m drove its outermost swath four times).
-fn merge_overlapping(mut ivs: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+pub(super) fn merge_overlapping(mut ivs: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     ivs.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut merged: Vec<(f64, f64)> = Vec::with_capacity(ivs.len());
     for iv in ivs {
