@@ -98,6 +98,7 @@ fn stages(c: &mut Criterion) {
                 angle,
                 6.0,
                 swaths::BAND_WIDENING,
+                false,
             )
         })
     });

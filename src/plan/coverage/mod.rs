@@ -499,7 +499,17 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
     let mut swath_total = 0;
     let mut overlap_m2 = 0.0;
     for (ci, (cell, angle)) in cells.iter().enumerate() {
-        let lines = swaths::swath_lines(cell, &safe, *angle, w, swaths::band_widening(p.sections));
+        // With sections and a headland to run on over, the lines are exactly w apart (see
+        // `swath_lines`).
+        let exact = p.sections > 1 && p.headland_passes > 0;
+        let lines = swaths::swath_lines(
+            cell,
+            &safe,
+            *angle,
+            w,
+            swaths::band_widening(p.sections),
+            exact,
+        );
         overlap_m2 += lines.overlap_m
             * lines
                 .intervals

@@ -97,9 +97,10 @@ pub struct FieldPlan {
     /// Places where the plan goes on with no transit inside the field (each also a warning).
     pub transit_gaps: usize,
     /// Sections of the implement the plan was made for: above 1, each section of a swath works
-    /// only where its centre is in the working area (the implement's section control switches
-    /// it off over the headland), and the swaths run on until their whole band has reached the
-    /// headland. 0 or 1: the whole width works wherever a swath runs.
+    /// only where some ground under it is not the headland passes' (the implement's section
+    /// control switches it off over the headland), the swaths run on until their whole band
+    /// has reached the headland, and they are exactly `line_width` apart (what the span leaves
+    /// over lies on a headland pass). 0 or 1: the whole width works wherever a swath runs.
     pub sections: usize,
 }
 

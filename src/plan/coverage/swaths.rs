@@ -40,8 +40,15 @@ pub fn band_widening(sections: usize) -> f64 {
 }
 
 /// Lines across `cell` (local frame) along `angle` rad, `line_width` apart at most. The n =
-/// ceil(span / w) lines are spread evenly, the first and last half a spacing inside the cell,
-/// so no pass is dropped and the footprints overlap by (n·w − span) in all.
+/// ceil(span / w) lines cover the span, so no pass is dropped and the footprints overlap by
+/// (n·w − span) in all. Spread (`exact` false), the lines are span / n apart, the first and
+/// last half a spacing inside the cell, and the overlap is shared between every pair of
+/// neighbours. Exact, they are w apart and the overlap lies beyond the cell's sides, where the
+/// outer footprints run on over the headland pass: an implement in sections switches off
+/// there what lies over the pass (strips at the sides, not a sliver between every pair of
+/// swaths that no section fits in), and the lines are where a farmer's tramlines expect them.
+/// The overlap goes beyond the high side, the low side or half to each, whichever keeps the
+/// most swath length inside `safe` (a notched edge may leave an outer line's centre outside).
 ///
 /// Each interval is widened to the cell's extent within the middle share `widening` of the
 /// line's band ([`band_widening`]: slanted edges are covered nearly to the corner) and then cut
@@ -53,6 +60,7 @@ pub fn swath_lines(
     angle: f64,
     line_width: f64,
     widening: f64,
+    exact: bool,
 ) -> SwathLines {
     let rot = rotate_area(cell, -angle);
     let safe_rot: Vec<Area> = safe.iter().map(|a| rotate_area(a, -angle)).collect();
@@ -64,42 +72,80 @@ pub fn swath_lines(
         });
     let span = (hi - lo).max(0.0);
     let n = (span / line_width - 1e-9).ceil().max(1.0) as usize;
-    let spacing = span / n as f64;
-    let ys: Vec<f64> = (0..n).map(|k| lo + spacing * (k as f64 + 0.5)).collect();
-    let intervals = ys
-        .iter()
-        .map(|&y| {
-            let band = band_extent(&rot, y, widening * spacing / 2.0);
-            scan_intervals(&rot, y)
-                .into_iter()
-                .filter_map(|(a, b)| {
-                    // Widen to the band's extent over this piece, then keep inside `safe`.
-                    let (mut x0, mut x1) = (a, b);
-                    for &(c, d) in &band {
-                        if c <= b && d >= a {
-                            x0 = x0.min(c);
-                            x1 = x1.max(d);
-                        }
-                    }
-                    let mid = 0.5 * (a + b);
-                    let s = safe_rot
-                        .iter()
-                        .flat_map(|s| scan_intervals(s, y))
-                        .find(|&(c, d)| c <= mid && mid <= d)?;
-                    let (x0, x1) = (x0.max(s.0), x1.min(s.1));
-                    (x1 - x0 > 1e-3).then_some((x0, x1))
-                })
-                .collect::<Vec<_>>()
-        })
-        .map(merge_overlapping)
-        .collect();
-    SwathLines {
-        angle,
-        spacing,
-        ys,
-        intervals,
-        overlap_m: (n as f64 * line_width - span).max(0.0),
+    let overlap_m = (n as f64 * line_width - span).max(0.0);
+    let lines_from = |base: f64, spacing: f64| {
+        let ys: Vec<f64> = (0..n).map(|k| base + spacing * (k as f64 + 0.5)).collect();
+        let intervals = ys
+            .iter()
+            .map(|&y| line_intervals(&rot, &safe_rot, y, spacing, (lo, hi), widening))
+            .collect();
+        SwathLines {
+            angle,
+            spacing,
+            ys,
+            intervals,
+            overlap_m,
+        }
+    };
+    if !exact {
+        let spacing = span / n as f64;
+        return lines_from(lo, spacing);
     }
+    let length = |l: &SwathLines| -> f64 { l.intervals.iter().flatten().map(|(a, b)| b - a).sum() };
+    [0.0, overlap_m, overlap_m / 2.0]
+        .into_iter()
+        .map(|shift| lines_from(lo - shift, line_width))
+        .fold(None::<(f64, SwathLines)>, |best, l| {
+            let len = length(&l);
+            match best {
+                Some((b, _)) if b >= len - 1e-6 => best,
+                _ => Some((len, l)),
+            }
+        })
+        .map(|(_, l)| l)
+        .unwrap_or_else(|| lines_from(lo, line_width))
+}
+
+/// The x-intervals of the line at `y`, `spacing` from its neighbours, across the rotated cell
+/// `rot` spanning `lo_hi` in y (see [`swath_lines`]): the cell is scanned at the middle of the
+/// part of the line's band it holds (an exact outer line's band runs on beyond the cell).
+fn line_intervals(
+    rot: &Area,
+    safe_rot: &[Area],
+    y: f64,
+    spacing: f64,
+    (lo, hi): (f64, f64),
+    widening: f64,
+) -> Vec<(f64, f64)> {
+    let (b0, b1) = (y - spacing / 2.0, y + spacing / 2.0);
+    let (at, half) = if b0 >= lo - 1e-9 && b1 <= hi + 1e-9 {
+        (y, spacing / 2.0)
+    } else {
+        let (b0, b1) = (b0.max(lo), b1.min(hi));
+        (0.5 * (b0 + b1), 0.5 * (b1 - b0).max(0.0))
+    };
+    let band = band_extent(rot, at, widening * half);
+    let ivs = scan_intervals(rot, at)
+        .into_iter()
+        .filter_map(|(a, b)| {
+            // Widen to the band's extent over this piece, then keep inside `safe`.
+            let (mut x0, mut x1) = (a, b);
+            for &(c, d) in &band {
+                if c <= b && d >= a {
+                    x0 = x0.min(c);
+                    x1 = x1.max(d);
+                }
+            }
+            let mid = 0.5 * (a + b);
+            let s = safe_rot
+                .iter()
+                .flat_map(|s| scan_intervals(s, y))
+                .find(|&(c, d)| c <= mid && mid <= d)?;
+            let (x0, x1) = (x0.max(s.0), x1.min(s.1));
+            (x1 - x0 > 1e-3).then_some((x0, x1))
+        })
+        .collect();
+    merge_overlapping(ivs)
 }
 
 /// Intervals sorted and merged where they overlap or touch. Pieces of one line that the band's
@@ -190,7 +236,7 @@ mod tests {
     #[test]
     fn balanced_lines_cover_the_cell_and_obstacles_split_runs() {
         let cell = rect(100.0, 50.0);
-        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0, BAND_WIDENING);
+        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0, BAND_WIDENING, false);
         assert_eq!(l.ys.len(), 9, "ceil(50/6)");
         assert!((l.ys[0] - l.spacing / 2.0).abs() < 1e-9);
         assert!((l.ys[8] - (50.0 - l.spacing / 2.0)).abs() < 1e-9);
@@ -212,6 +258,7 @@ mod tests {
             0.0,
             6.0,
             BAND_WIDENING,
+            false,
         );
         let r = runs(&l);
         assert_eq!(r.len(), 4, "{r:?}");
@@ -240,7 +287,7 @@ mod tests {
             vec![],
         );
         // Where the implement is clear: here the rectangle without the notches.
-        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0, BAND_WIDENING);
+        let l = swath_lines(&cell, &[rect(100.0, 50.0)], 0.0, 6.0, BAND_WIDENING, false);
         assert_eq!(
             crate::plan::coverage::geometry::scan_intervals(&cell, l.ys[0]).len(),
             3
@@ -251,5 +298,43 @@ mod tests {
         for ivs in &l.intervals {
             assert!(ivs.windows(2).all(|p| p[0].1 < p[1].0), "{ivs:?}");
         }
+    }
+
+    #[test]
+    fn exact_lines_are_w_apart_and_lay_the_overlap_where_the_safe_ground_reaches() {
+        // 50 m at w 6 m: 9 lines, 4 m of overlap. Exact, the lines are 6 m apart and the
+        // whole overlap lies beyond one side, not 0.44 m between every pair.
+        let cell = rect(100.0, 50.0);
+        let safe = |y0: f64, y1: f64| {
+            let r = rect(100.0, y1 - y0);
+            let ring = r.0.iter().map(|p| v2(p.x, p.y + y0)).collect();
+            vec![(ring, vec![])]
+        };
+        let l = swath_lines(&cell, &safe(-10.0, 60.0), 0.0, 6.0, 1.0, true);
+        assert_eq!(l.ys.len(), 9);
+        assert!((l.spacing - 6.0).abs() < 1e-12);
+        assert!(l.ys.windows(2).all(|p| (p[1] - p[0] - 6.0).abs() < 1e-9));
+        // With room on both sides the overlap goes beyond the high side: the first footprint
+        // starts at the low side, the last ends 4 m beyond the high side.
+        assert!((l.ys[0] - 3.0).abs() < 1e-9, "{:?}", l.ys);
+        assert!((l.ys[8] + 3.0 - 54.0).abs() < 1e-9, "{:?}", l.ys);
+        // Every line, the outer ones too, spans the cell (the outer ones scanned inside it).
+        for ivs in &l.intervals {
+            assert_eq!(ivs.len(), 1, "{ivs:?}");
+            assert!(
+                ivs[0].0.abs() < 1e-6 && (ivs[0].1 - 100.0).abs() < 1e-6,
+                "{ivs:?}"
+            );
+        }
+        // Where the safe ground ends 0.5 m beyond the high side (a line there would lose its
+        // swath), the overlap goes beyond the low side instead.
+        let l = swath_lines(&cell, &safe(-10.0, 50.5), 0.0, 6.0, 1.0, true);
+        assert!((l.ys[0] + 1.0).abs() < 1e-9, "{:?}", l.ys);
+        assert_eq!(l.intervals.iter().flatten().count(), 9);
+        // Room for neither outer line's centre 1 m beyond a side, but for both on it: half
+        // the overlap to each side.
+        let l = swath_lines(&cell, &safe(-0.5, 50.5), 0.0, 6.0, 1.0, true);
+        assert!((l.ys[0] - 1.0).abs() < 1e-9, "{:?}", l.ys);
+        assert_eq!(l.intervals.iter().flatten().count(), 9);
     }
 }

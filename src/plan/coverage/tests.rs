@@ -392,3 +392,42 @@ fn with_sections_the_swaths_reach_the_slanted_headland_and_lay_less_twice() {
         ms.overlap_fraction
     );
 }
+
+#[test]
+fn with_sections_the_swaths_are_w_apart_and_the_overlap_is_switched_off_over_the_headland() {
+    // 97 m across with two 12 m passes: 49 m of working area, 5 swaths for 60 m of footprint.
+    // Spread, 11 m lie twice in 2.75 m slivers between the swaths; exact, the 11 m lie over a
+    // headland pass where 7 of the 8 sections switch off.
+    let field = Field {
+        boundary: vec![v2(0.0, 0.0), v2(200.0, 0.0), v2(200.0, 97.0), v2(0.0, 97.0)],
+        obstacles: Vec::new(),
+    };
+    let mut p = params(12.0, 6.0, 2);
+    p.swath_angle = SwathAngle::Fixed { angle: 0.0 };
+    let whole = check(&field, &p);
+    p.sections = 8;
+    let sectioned = check(&field, &p);
+    let mut ys: Vec<f64> = sectioned
+        .segments
+        .iter()
+        .filter(|s| s.kind == SegmentKind::Work)
+        .map(|s| s.points[s.points.len() / 2].y)
+        .collect();
+    ys.sort_by(f64::total_cmp);
+    assert_eq!(ys.len(), 5, "{ys:?}");
+    assert!(
+        ys.windows(2).all(|y| (y[1] - y[0] - 12.0).abs() < 0.05),
+        "{ys:?}"
+    );
+    let (mw, ms) = (
+        metrics::plan_metrics(&field, &whole, 12.0),
+        metrics::plan_metrics(&field, &sectioned, 12.0),
+    );
+    assert!(ms.covered_fraction >= mw.covered_fraction - 1e-4);
+    assert!(
+        ms.overlap_fraction < 0.25 * mw.overlap_fraction,
+        "overlap {} → {}",
+        mw.overlap_fraction,
+        ms.overlap_fraction
+    );
+}
