@@ -499,9 +499,10 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
     let mut swath_total = 0;
     let mut overlap_m2 = 0.0;
     for (ci, (cell, angle)) in cells.iter().enumerate() {
-        // With sections and a headland to run on over, the lines are exactly w apart (see
+        // With sections and a headland to run on over (configured or the turns' own), the lines
+        // are exactly w apart (see
         // `swath_lines`).
-        let exact = p.sections > 1 && p.headland_passes > 0;
+        let exact = p.sections > 1 && headland::passes(p) > 0;
         let lines = swaths::swath_lines(
             cell,
             &safe,

@@ -406,7 +406,36 @@ fn with_sections_the_swaths_are_w_apart_and_the_overlap_is_switched_off_over_the
     p.swath_angle = SwathAngle::Fixed { angle: 0.0 };
     let whole = check(&field, &p);
     p.sections = 8;
+    // Configured with no headland passes, the turns still need them (`headland::passes`), and
+    // the swaths run on over them as over configured ones.
+    let fewest = check(
+        &field,
+        &CoverageParams {
+            headland_passes: 0,
+            ..p.clone()
+        },
+    );
+    assert!(
+        headland::passes(&CoverageParams {
+            headland_passes: 0,
+            ..p.clone()
+        }) > 0
+    );
     let sectioned = check(&field, &p);
+    for plan in [&sectioned, &fewest] {
+        let mut ys: Vec<f64> = plan
+            .segments
+            .iter()
+            .filter(|s| s.kind == SegmentKind::Work)
+            .map(|s| s.points[s.points.len() / 2].y)
+            .collect();
+        ys.sort_by(f64::total_cmp);
+        assert!(ys.len() >= 5, "{ys:?}");
+        assert!(
+            ys.windows(2).all(|y| (y[1] - y[0] - 12.0).abs() < 0.05),
+            "{ys:?}"
+        );
+    }
     let mut ys: Vec<f64> = sectioned
         .segments
         .iter()
