@@ -500,8 +500,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
     let mut overlap_m2 = 0.0;
     for (ci, (cell, angle)) in cells.iter().enumerate() {
         // With sections and a headland to run on over (configured or the turns' own), the lines
-        // are exactly w apart (see
-        // `swath_lines`).
+        // are exactly w apart (see `swath_lines`).
         let exact = p.sections > 1 && headland::passes(p) > 0;
         let lines = swaths::swath_lines(
             cell,
