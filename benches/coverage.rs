@@ -63,6 +63,7 @@ fn params() -> CoverageParams {
         max_curvature_rate: 0.0,
         headland_order: Default::default(),
         sections: 1,
+        overlap: 0.0,
     }
 }
 

@@ -54,6 +54,11 @@ pub struct FieldConfig {
     /// (section control at the headland), 1..=64; 1 = none, the whole width works wherever a
     /// swath runs.
     pub sections: usize,
+    /// Overlap of neighbouring passes' footprints (swath to swath, ring to ring, the outermost
+    /// swaths onto the inner headland pass), m, 0 ≤ overlap < line_width_m / 2: the passes are
+    /// `job.line_width_m − overlap_m` apart, so a steering error of up to half of it leaves no
+    /// strip unworked. 0 = the footprints meet exactly.
+    pub overlap_m: f64,
 }
 
 impl Default for FieldConfig {
@@ -68,14 +73,24 @@ impl Default for FieldConfig {
             origin: FieldOrigin::Auto,
             headland_order: crate::plan::coverage::HeadlandOrder::First,
             sections: 1,
+            overlap_m: 0.0,
         }
     }
 }
 
 impl FieldConfig {
-    /// Range checks of `[field]`.
-    pub(crate) fn validate(&self, c: &mut Checker) {
+    /// Range checks of `[field]`; `line_width_m` is `job.line_width_m`.
+    pub(crate) fn validate(&self, line_width_m: f64, c: &mut Checker) {
         let fc = self;
+        if !(fc.overlap_m >= 0.0 && fc.overlap_m < line_width_m / 2.0) {
+            c.push(
+                "field.overlap_m",
+                fc.overlap_m.to_string(),
+                &format!(
+                    "must be at least 0 and less than half of job.line_width_m ({line_width_m} m)"
+                ),
+            );
+        }
         if fc.headland_passes > 50 {
             c.push(
                 "field.headland_passes",

@@ -285,7 +285,7 @@ impl Config {
     pub fn validate(&self) -> Vec<Problem> {
         let mut c = Checker::default();
         self.job.validate(&mut c);
-        self.field.validate(&mut c);
+        self.field.validate(self.job.line_width_m, &mut c);
         self.guidance.validate(&mut c);
         self.vehicle.validate_steering(&mut c);
         self.control.validate(&mut c);

@@ -130,6 +130,7 @@ impl Config {
             max_curvature_rate: self.vehicle.max_curvature_rate_per_m2,
             headland_order: f.headland_order,
             sections: f.sections,
+            overlap: f.overlap_m,
         }
     }
 

@@ -178,6 +178,21 @@ fn field_section_parses_validates_and_builds_params() {
         .iter()
         .any(|p| p.key == "field.boundary_tolerance_m"));
     assert!(Config::parse_with("[field]\nswath_angle = \"diagonal\"\n", &[]).is_err());
+    // The overlap is checked against the job's implement: half of it or more is refused.
+    let overlap = |o: &str, w: &str| {
+        let cfg = Config::parse_with(
+            &format!("[job]\nline_width_m = {w}\n[field]\noverlap_m = {o}\n"),
+            &[],
+        )
+        .unwrap();
+        let bad = cfg.validate().iter().any(|p| p.key == "field.overlap_m");
+        (bad, cfg.coverage_params().overlap)
+    };
+    assert_eq!(overlap("0.1", "6"), (false, 0.1));
+    assert!(overlap("3", "6").0);
+    assert!(overlap("2", "3").0);
+    assert!(overlap("-0.1", "6").0);
+    assert!(!overlap("1.4", "3").0);
 }
 
 #[test]

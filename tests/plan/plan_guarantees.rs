@@ -65,6 +65,8 @@ struct Case {
     r_min: f64,
     /// Implement sections (`field.sections`; above 1 the swaths run on over their whole band).
     sections: usize,
+    /// Overlap of neighbouring passes (`field.overlap_m`), m.
+    overlap: f64,
 }
 
 fn star(points: &[(f64, f64)], size: f64) -> Vec<Vec2> {
@@ -149,6 +151,7 @@ impl Case {
         p.line_width = self.line_width;
         p.r_min = self.r_min;
         p.sections = self.sections;
+        p.overlap = self.overlap;
         p
     }
 }
@@ -181,13 +184,15 @@ fn case() -> impl Strategy<Value = Case> {
         3.0..36.0f64,
         4.0..10.0f64,
         prop::sample::select(vec![1usize, 1, 8]),
+        prop::sample::select(vec![0.0, 0.0, 0.3]),
     )
-        .prop_map(|(shape, size, line_width, r_min, sections)| Case {
+        .prop_map(|(shape, size, line_width, r_min, sections, overlap)| Case {
             shape,
             size,
             line_width,
             r_min,
             sections,
+            overlap,
         })
 }
 
@@ -385,6 +390,7 @@ fn the_checks_catch_what_they_check() {
             line_width: 6.0,
             r_min: 5.0,
             sections: 1,
+            overlap: 0.0,
         }
         .field();
         assert!(agsteer::geo::polygon::signed_area(&f.boundary) > 0.0);
@@ -533,6 +539,7 @@ fn a_kinked_headland_pass_found_at_random_keeps_the_guarantees() {
         line_width: 26.45078928775462,
         r_min: 5.659127914805385,
         sections: 1,
+        overlap: 0.0,
     };
     keeps_the_guarantees(&c).unwrap();
 }

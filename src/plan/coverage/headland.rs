@@ -65,7 +65,7 @@ pub fn turn_room(p: &CoverageParams) -> f64 {
 /// turns at the swath ends need ([`turn_room`]); without that room the swaths would stop short
 /// of the headland and leave a strip unworked.
 pub fn passes(p: &CoverageParams) -> usize {
-    let needed = (turn_room(p) / p.line_width - 1e-9).ceil().max(0.0) as usize;
+    let needed = (turn_room(p) / p.pass_spacing() - 1e-9).ceil().max(0.0) as usize;
     p.headland_passes.max(needed)
 }
 
@@ -107,14 +107,14 @@ impl std::fmt::Display for NoSwathFits {
 
 /// `Some` when the field is too narrow for any swath inside the headland at these parameters.
 pub fn no_swath_fits(field_width: f64, p: &CoverageParams) -> Option<NoSwathFits> {
-    let room = |q: &CoverageParams| field_width > 2.0 * passes(q) as f64 * q.line_width + 1e-6;
+    let room = |q: &CoverageParams| field_width > 2.0 * passes(q) as f64 * q.pass_spacing() + 1e-6;
     if room(p) {
         return None;
     }
     let mut q = p.clone();
     let mut largest = None;
     let mut w = (p.line_width * 2.0).floor() / 2.0;
-    while w >= 0.5 {
+    while w >= 0.5 && w > 2.0 * p.overlap {
         q.line_width = w;
         if room(&q) && w <= field_width {
             largest = Some(w);
@@ -127,22 +127,23 @@ pub fn no_swath_fits(field_width: f64, p: &CoverageParams) -> Option<NoSwathFits
         line_width: p.line_width,
         turn_diameter: 2.0 * p.r_min,
         passes: passes(p),
-        headland_width: passes(p) as f64 * p.line_width,
+        headland_width: passes(p) as f64 * p.pass_spacing(),
         largest_width: largest,
     })
 }
 
-/// Offset of headland pass `k` from the field edge (or an obstacle's), m: w/2 + k·w plus the
-/// chord margin.
+/// Offset of headland pass `k` from the field edge (or an obstacle's), m: w/2 + k·s (s the
+/// [pass spacing](CoverageParams::pass_spacing)) plus the chord margin.
 pub fn pass_offset(p: &CoverageParams, k: usize) -> f64 {
-    p.line_width / 2.0 + k as f64 * p.line_width + chord_margin(p)
+    p.line_width / 2.0 + k as f64 * p.pass_spacing() + chord_margin(p)
 }
 
 /// The area inside which the swaths' footprints lie (the working area): the boundary shrunk
-/// by passes·w, minus the obstacles with their own headland ([`obstacle_headland_width`],
-/// smoothed by a closing of radius r_min).
+/// by passes·s (s the [pass spacing](CoverageParams::pass_spacing): the outermost swaths lay
+/// the overlap onto the inner pass), minus the obstacles with their own headland
+/// ([`obstacle_headland_width`], smoothed by a closing of radius r_min).
 pub fn working_area(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Vec<Area> {
-    let inset = passes(p) as f64 * p.line_width;
+    let inset = passes(p) as f64 * p.pass_spacing();
     let outer = offset(&[(boundary.to_vec(), vec![])], -inset);
     if obstacles.is_empty() {
         return outer;
@@ -154,11 +155,11 @@ pub fn working_area(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoveragePara
 }
 
 /// Width of the headland around every obstacle, m: out to the outer edge of the outermost
-/// obstacle pass (w/2 when there are no headland passes).
+/// obstacle pass less the overlap (w/2 when there are no headland passes).
 pub fn obstacle_headland_width(p: &CoverageParams) -> f64 {
     match passes(p) {
         0 => p.line_width / 2.0,
-        n => n as f64 * p.line_width,
+        n => n as f64 * p.pass_spacing(),
     }
 }
 
@@ -671,6 +672,7 @@ mod tests {
             max_curvature_rate: 0.0,
             headland_order: Default::default(),
             sections: 1,
+            overlap: 0.0,
         }
     }
 

@@ -216,7 +216,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
                         geometry::from_geo(&g)
                     })
                     .collect();
-                for c in decompose::merge_cells(pieces, w) {
+                for c in decompose::merge_cells(pieces, p.pass_spacing()) {
                     let a = swath_angle::min_span(&c.0).map(|s| s.0).unwrap_or(0.0);
                     cells.push((c, a));
                 }
@@ -506,11 +506,12 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
             cell,
             &safe,
             *angle,
-            w,
+            p.pass_spacing(),
             swaths::band_widening(p.sections),
             exact,
         );
-        overlap_m2 += lines.overlap_m
+        // The lines' n·s − span plus the overlap each of the n footprints lays beyond s.
+        overlap_m2 += (lines.overlap_m + lines.ys.len() as f64 * p.overlap)
             * lines
                 .intervals
                 .iter()

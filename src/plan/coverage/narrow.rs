@@ -44,7 +44,7 @@ pub fn plan_field(
         .unwrap_or((crate::geo::v2(0.0, 0.0), crate::geo::v2(0.0, 0.0)));
     let half_width = 0.5 * (hi - lo).x.min((hi - lo).y);
     let fill_passes =
-        ((half_width / p.line_width).ceil() as usize + 1).clamp(configured, MAX_FILL_PASSES);
+        ((half_width / p.pass_spacing()).ceil() as usize + 1).clamp(configured, MAX_FILL_PASSES);
     let fill = CoverageParams {
         headland_passes: fill_passes,
         ..p.clone()

@@ -72,6 +72,10 @@ pub struct CoverageParams {
     /// Sections the implement switches off where they leave the working area (section
     /// control); 1 = none. See [`FieldPlan::sections`].
     pub sections: usize,
+    /// Overlap of neighbouring passes' footprints, m (0 ≤ overlap < line_width / 2): swaths,
+    /// headland passes and the outermost swaths against the inner pass lie
+    /// [`pass_spacing`](Self::pass_spacing) apart.
+    pub overlap: f64,
 }
 
 /// A complete field plan: segments in driving order plus the areas they were made for.
@@ -110,6 +114,11 @@ impl CoverageParams {
     pub(super) fn validate(&self) -> Result<(), PlanError> {
         PlanError::check("line_width", self.line_width, self.line_width > 0.0)?;
         PlanError::check(
+            "overlap",
+            self.overlap,
+            self.overlap >= 0.0 && self.overlap < self.line_width / 2.0,
+        )?;
+        PlanError::check(
             "sections",
             self.sections as f64,
             (1..=64).contains(&self.sections),
@@ -120,6 +129,11 @@ impl CoverageParams {
             self.small_obstacle_max_m >= 0.0,
         )?;
         self.turn_params().validate()
+    }
+
+    /// Distance between neighbouring passes, m: the line width less the overlap.
+    pub fn pass_spacing(&self) -> f64 {
+        self.line_width - self.overlap
     }
 
     pub(super) fn turn_params(&self) -> crate::plan::turns::TurnParams {

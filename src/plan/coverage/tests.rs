@@ -12,6 +12,7 @@ pub(crate) fn params(w: f64, r: f64, passes: usize) -> CoverageParams {
         max_curvature_rate: 0.0,
         headland_order: Default::default(),
         sections: 1,
+        overlap: 0.0,
     }
 }
 
@@ -459,4 +460,67 @@ fn with_sections_the_swaths_are_w_apart_and_the_overlap_is_switched_off_over_the
         mw.overlap_fraction,
         ms.overlap_fraction
     );
+}
+
+#[test]
+fn an_overlap_brings_every_pass_that_much_closer_to_its_neighbour() {
+    // 200 × 96 m at w 6 m with two headland passes; each pass lies 0.25 m closer to the one
+    // before than without overlap: headland passes, swaths and the outermost swaths against
+    // the inner pass. Without overlap the 72 m between the passes take 12 swaths exactly.
+    let field = Field {
+        boundary: vec![v2(0.0, 0.0), v2(200.0, 0.0), v2(200.0, 96.0), v2(0.0, 96.0)],
+        obstacles: Vec::new(),
+    };
+    let mut p = params(6.0, 5.0, 2);
+    p.swath_angle = SwathAngle::Fixed { angle: 0.0 };
+    let exact = check(&field, &p);
+    p.overlap = 0.25;
+    let overlapped = check(&field, &p);
+    let lowest = |plan: &FieldPlan, kind: SegmentKind| -> Vec<f64> {
+        let mut ys: Vec<f64> = plan
+            .segments
+            .iter()
+            .filter(|s| s.kind == kind)
+            .map(|s| s.points.iter().map(|q| q.y).fold(f64::INFINITY, f64::min))
+            .collect();
+        ys.sort_by(f64::total_cmp);
+        ys
+    };
+    let margin = headland::chord_margin(&p);
+    for (plan, s) in [(&exact, 6.0), (&overlapped, 5.75)] {
+        let rings = lowest(plan, SegmentKind::Headland);
+        assert_eq!(rings.len(), 2, "{rings:?}");
+        for (k, y) in rings.iter().enumerate() {
+            let want = 3.0 + k as f64 * s + margin;
+            assert!((y - want).abs() < 0.02, "pass {k} at {y}, want {want}");
+        }
+        let swaths = lowest(plan, SegmentKind::Work);
+        assert!(
+            swaths.windows(2).all(|y| y[1] - y[0] <= s + 1e-6),
+            "{swaths:?}"
+        );
+        // The first swath's centre at most s from the inner pass's: footprints overlap by at
+        // least w − s.
+        assert!(swaths[0] - rings[1] <= s + 1e-6, "{swaths:?} {rings:?}");
+    }
+    assert!(
+        lowest(&overlapped, SegmentKind::Work).len() > lowest(&exact, SegmentKind::Work).len()
+            || lowest(&overlapped, SegmentKind::Work)[0] < lowest(&exact, SegmentKind::Work)[0]
+    );
+    let (me, mo) = (
+        metrics::plan_metrics(&field, &exact, 6.0),
+        metrics::plan_metrics(&field, &overlapped, 6.0),
+    );
+    assert!(mo.covered_fraction >= me.covered_fraction - 1e-4);
+    assert!(
+        mo.overlap_fraction > me.overlap_fraction + 0.01,
+        "{} {} {} {}",
+        me.overlap_fraction,
+        mo.overlap_fraction,
+        me.covered_fraction,
+        mo.covered_fraction
+    );
+    // Half the implement or more is refused.
+    p.overlap = 3.0;
+    assert!(plan_field(&field, &p).is_err());
 }
