@@ -38,6 +38,8 @@ pub struct PlanSummary {
     /// Sections of the implement the plan was made for (`field.sections`): above 1 the
     /// overlap counts each section where it is on.
     pub sections: usize,
+    /// Overlap of neighbouring passes the plan was made with (`field.overlap_m`), m.
+    pub pass_overlap_m: f64,
     pub outside_area_m2: f64,
     pub outside_length_m: f64,
     pub obstacle_intrusions: usize,
@@ -79,6 +81,7 @@ impl PlanSummary {
             unworked_area_m2: m.unworked_area_m2,
             overlap_fraction: m.overlap_fraction,
             sections: plan.sections.max(1),
+            pass_overlap_m: plan.pass_overlap_m,
             outside_area_m2: m.outside_area_m2,
             outside_length_m: m.outside_length_m,
             obstacle_intrusions: m.obstacle_intrusions,
@@ -93,13 +96,24 @@ impl PlanSummary {
     }
 }
 
-/// What the overlap figure counts, after it: "" for an implement without sections, " (with N
-/// sections)" otherwise ([`FieldPlan::sections`]).
-pub fn sections_note(sections: usize) -> String {
-    if sections > 1 {
-        format!(" (with {sections} sections)")
-    } else {
+/// What the overlap figure counts, after it: "" for an implement without sections whose passes
+/// meet exactly, else " (with N sections, passes X m over each other)" or either part
+/// ([`FieldPlan::sections`], [`FieldPlan::pass_overlap_m`]).
+pub fn overlap_note(plan: &FieldPlan) -> String {
+    let mut parts = Vec::new();
+    if plan.sections > 1 {
+        parts.push(format!("with {} sections", plan.sections));
+    }
+    if plan.pass_overlap_m > 0.0 {
+        parts.push(format!(
+            "passes {:.2} m over each other",
+            plan.pass_overlap_m
+        ));
+    }
+    if parts.is_empty() {
         String::new()
+    } else {
+        format!(" ({})", parts.join(", "))
     }
 }
 
@@ -489,7 +503,7 @@ pub fn plan_svg(
             100.0 * m.working_area_covered_fraction,
             m.unworked_area_m2,
             100.0 * m.overlap_fraction,
-            sections_note(plan.sections),
+            overlap_note(plan),
             m.outside_area_m2,
             m.total_length_m,
             origin.lat_deg,

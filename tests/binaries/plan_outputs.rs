@@ -221,4 +221,19 @@ fn an_implement_with_sections_is_planned_and_measured_with_them() {
         f(&ms, "overlap_fraction")
     );
     assert!(f(&ms, "covered_fraction") >= f(&mw, "covered_fraction") - 1e-9);
+    assert_eq!(f(&ms, "pass_overlap_m"), 0.0);
+    // With passes over each other too, both are named and the overlap is the larger.
+    let (both, mb, svg_both, _d3) = plan(
+        field,
+        &["--set", "field.sections=8", "--set", "field.overlap_m=0.2"],
+    );
+    assert_eq!(both.code, 0, "{}", both.stderr);
+    assert_eq!(f(&mb, "pass_overlap_m"), 0.2);
+    let line = both.stdout.lines().next().unwrap_or("");
+    assert!(
+        line.contains("% (with 8 sections, passes 0.20 m over each other);"),
+        "{line}"
+    );
+    assert!(svg_both.contains("passes 0.20 m over each other"));
+    assert!(f(&mb, "overlap_fraction") > f(&ms, "overlap_fraction"));
 }

@@ -5,7 +5,7 @@
 
 use agsteer::config::Config;
 use agsteer::field::findings::{plan_findings, unreachable, MIN_PIECE_M2};
-use agsteer::field::output::{plan_geojson, plan_svg, plan_taskdata, sections_note, PlanSummary};
+use agsteer::field::output::{overlap_note, plan_geojson, plan_svg, plan_taskdata, PlanSummary};
 use agsteer::field::{
     decode_text, external_partfield_files, list_fields, load_field_with, GuidanceKind, LoadedField,
 };
@@ -274,7 +274,7 @@ where
             findings.unreachable_area_m2,
             findings.unreachable_pieces,
             100.0 * s.overlap_fraction,
-            sections_note(s.sections),
+            overlap_note(&plan),
             s.outside_area_m2,
             s.plan_time_ms,
             findings.summary()

@@ -754,6 +754,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         warnings: warnings.into_inner(),
         transit_gaps: transit_gaps.get(),
         sections: p.sections,
+        pass_overlap_m: p.overlap,
     })
 }
 

@@ -106,6 +106,8 @@ pub struct FieldPlan {
     /// has reached the headland, and they are exactly `line_width` apart (what the span leaves
     /// over lies on a headland pass). 0 or 1: the whole width works wherever a swath runs.
     pub sections: usize,
+    /// Overlap of neighbouring passes the plan was made with ([`CoverageParams::overlap`]), m.
+    pub pass_overlap_m: f64,
 }
 
 impl CoverageParams {
