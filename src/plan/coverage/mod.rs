@@ -78,7 +78,10 @@ const BYPASS_SLACK_M: f64 = 0.05;
 /// When no swath fits inside the configured headland, the field is planned with the fewest
 /// passes the turns need, or else worked by headland passes alone as far in as they go
 /// ([`narrow`]); each says so in [`FieldPlan::warnings`]. A plan with no working pass at all is
-/// the caller's to refuse ([`headland::no_swath_fits`] gives the numbers).
+/// the caller's to refuse ([`headland::no_swath_fits`] gives the numbers). With sections, a
+/// plan that goes on somewhere without a transit is tried again with the swaths stopped where
+/// an implement without sections stops them, and that plan is kept if it has fewer such
+/// places (said in the warnings).
 pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanError> {
     p.validate()?;
     // The clearance tests and waypoint grids depend on the field, the width, r_min and the
@@ -103,7 +106,22 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         grid: &grid,
         loose_grid: &loose_grid,
     };
-    narrow::plan_field(field, p, |f, q| plan_once(f, q, &tests))
+    let plan_with =
+        |widening| narrow::plan_field(field, p, |f, q| plan_once(f, q, &tests, widening));
+    let plan = plan_with(swaths::band_widening(p.sections))?;
+    if p.sections > 1 && plan.transit_gaps > 0 {
+        // Swaths run on over their whole band can end too deep in a corner for any way on:
+        // stopped where an implement without sections stops, they may leave room.
+        let mut shorter = plan_with(swaths::BAND_WIDENING)?;
+        if shorter.transit_gaps < plan.transit_gaps {
+            shorter.warnings.push(format!(
+                "the swaths stop where an implement without sections would ({} place(s) had no way on with them run on to the headland)",
+                plan.transit_gaps
+            ));
+            return Ok(shorter);
+        }
+    }
+    Ok(plan)
 }
 
 /// The clearance tests of one field, width, r_min and point spacing, and their waypoint grids
@@ -123,8 +141,14 @@ struct Tests<'a> {
     loose_grid: &'a std::cell::OnceCell<transit::WaypointGrid<'a>>,
 }
 
-/// [`plan_field`] with the configured headland passes as they are, with the field's `tests`.
-fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPlan, PlanError> {
+/// [`plan_field`] with the configured headland passes as they are, with the field's `tests`, the
+/// swaths run on over the share `widening` of their band ([`swaths::band_widening`]).
+fn plan_once(
+    field: &Field,
+    p: &CoverageParams,
+    tests: &Tests,
+    widening: f64,
+) -> Result<FieldPlan, PlanError> {
     p.validate()?;
     if field.boundary.len() < 3 || crate::geo::polygon::signed_area(&field.boundary) <= 0.0 {
         return Err(PlanError::Invalid {
@@ -502,14 +526,7 @@ fn plan_once(field: &Field, p: &CoverageParams, tests: &Tests) -> Result<FieldPl
         // With sections and a headland to run on over (configured or the turns' own), the lines
         // are exactly w apart (see `swath_lines`).
         let exact = p.sections > 1 && headland::passes(p) > 0;
-        let lines = swaths::swath_lines(
-            cell,
-            &safe,
-            *angle,
-            p.pass_spacing(),
-            swaths::band_widening(p.sections),
-            exact,
-        );
+        let lines = swaths::swath_lines(cell, &safe, *angle, p.pass_spacing(), widening, exact);
         // The lines' n·s − span plus the overlap each of the n footprints lays beyond s.
         overlap_m2 += (lines.overlap_m + lines.ys.len() as f64 * p.overlap)
             * lines
