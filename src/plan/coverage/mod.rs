@@ -522,10 +522,10 @@ fn plan_once(
     let mut pending: Vec<(usize, f64, Vec<swaths::RunSwath>, swaths::SwathLines)> = Vec::new();
     let mut swath_total = 0;
     let mut overlap_m2 = 0.0;
+    // With sections and a headland to run on over (configured or the turns' own), the lines are
+    // exactly w apart (see `swath_lines`).
+    let exact = p.sections > 1 && headland::passes(p) > 0;
     for (ci, (cell, angle)) in cells.iter().enumerate() {
-        // With sections and a headland to run on over (configured or the turns' own), the lines
-        // are exactly w apart (see `swath_lines`).
-        let exact = p.sections > 1 && headland::passes(p) > 0;
         let lines = swaths::swath_lines(cell, &safe, *angle, p.pass_spacing(), widening, exact);
         // The lines' n·s − span plus the overlap each of the n footprints lays beyond s.
         overlap_m2 += (lines.overlap_m + lines.ys.len() as f64 * p.overlap)

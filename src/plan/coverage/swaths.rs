@@ -92,18 +92,19 @@ pub fn swath_lines(
         return lines_from(lo, spacing);
     }
     let length = |l: &SwathLines| -> f64 { l.intervals.iter().flatten().map(|(a, b)| b - a).sum() };
-    [0.0, overlap_m, overlap_m / 2.0]
-        .into_iter()
-        .map(|shift| lines_from(lo - shift, line_width))
-        .fold(None::<(f64, SwathLines)>, |best, l| {
+    // The overlap beyond the high side first; the low side or half each only if longer.
+    let mut best = lines_from(lo, line_width);
+    if overlap_m > 1e-9 {
+        let mut best_length = length(&best);
+        for shift in [overlap_m, overlap_m / 2.0] {
+            let l = lines_from(lo - shift, line_width);
             let len = length(&l);
-            match best {
-                Some((b, _)) if b >= len - 1e-6 => best,
-                _ => Some((len, l)),
+            if len > best_length + 1e-6 {
+                (best, best_length) = (l, len);
             }
-        })
-        .map(|(_, l)| l)
-        .unwrap_or_else(|| lines_from(lo, line_width))
+        }
+    }
+    best
 }
 
 /// The x-intervals of the line at `y`, `spacing` from its neighbours, across the rotated cell
