@@ -233,7 +233,16 @@ pub struct VehicleEstimate {
     pub fix_age: f64,
 }
 
-const RING: usize = 128;
+/// The wheel-angle history: 2.56 s at 100 Hz, as long as [`Estimator::estimate`] predicts
+/// over (a fix's age and latency, at most 2 s), so a 1 Hz receiver's dead reckoning is made
+/// of measured angles, not the oldest one held.
+const RING: usize = 256;
+/// The longest interval between two fixes that the innovation is taken over (the observer's
+/// learning, the jumps and coasting), s: a 1 Hz receiver's with its jitter. Longer (a lost
+/// fix of a 1 Hz receiver) the dead reckoning's model error would be learnt as drift; the
+/// estimator takes the fix as it is. (It was 0.5 s for learning: a 1 Hz receiver's drift and
+/// offset were never learnt, and a 2° slope stood every pass 8 cm downhill.)
+const LONGEST_FIX_INTERVAL: f64 = 1.5;
 /// Integration step of the prediction, s.
 const PREDICT_STEP: f64 = 0.005;
 /// Course from successive fixes is used only after this much movement, m.
@@ -424,7 +433,7 @@ impl Estimator {
         if steps > 0 {
             let h = span / steps as f64;
             // The steps' times only grow: the first sample they need is found once, by
-            // bisection, not by a scan of the whole ring (1.28 s of samples at 100 Hz).
+            // bisection, not by a scan of the whole ring (2.56 s of samples at 100 Hz).
             let mut cursor = self.first_wheel_sample_at(t0 + 0.5 * h);
             // The heading's sine and cosine are carried from step to step by rotations through
             // each half step's small angle, not taken afresh: a sin/cos per step is most of
@@ -452,7 +461,7 @@ impl Estimator {
         let prev = self.fix_pose?;
         let t_prev = self.fix_time - self.latency(self.fix_latency);
         let dt = t_new - t_prev;
-        if !(dt > 0.0 && dt <= 1.0) {
+        if !(dt > 0.0 && dt <= LONGEST_FIX_INTERVAL) {
             return None;
         }
         let predicted = self.propagate(prev, self.fix_speed, t_prev, dt);
@@ -472,7 +481,7 @@ impl Estimator {
         let o = self.params.observer;
         let v = self.fix_speed;
         if !self.learn
-            || i.dt > 0.5
+            || i.dt > LONGEST_FIX_INTERVAL
             || v.abs() < o.min_speed
             || v_new.abs() < o.min_speed
             || i.heading.abs() > GATE_HEADING
