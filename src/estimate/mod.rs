@@ -170,6 +170,11 @@ const GATE_SIGMAS: f64 = 3.5;
 /// The noise estimate's time constant, in fixes, and its starting value, m.
 const NOISE_FIXES: f64 = 50.0;
 const NOISE_START: f64 = 0.01;
+/// The starting value's weight, in fixes: the position noise is the mean of the samples so far
+/// and this many of the starting value until there are [`NOISE_FIXES`] of them, so a receiver
+/// noisier than the start is known within a second or two at 10 Hz, not after 50 fixes
+/// while its fixes are taken for jumps and coasted through.
+const NOISE_PRIOR_FIXES: f64 = 10.0;
 /// The heading noise's starting value, rad (0.1°, a dual-antenna receiver's).
 const HEADING_NOISE_START: f64 = 0.1 * std::f64::consts::PI / 180.0;
 
@@ -177,8 +182,13 @@ const HEADING_NOISE_START: f64 = 0.1 * std::f64::consts::PI / 180.0;
 /// (variance 2σ²): over [`NOISE_FIXES`] samples, each clipped at 4 σ so that a jump's onset
 /// barely moves it.
 fn learn_variance(var: f64, sample: f64) -> f64 {
+    learn_variance_over(var, sample, NOISE_FIXES)
+}
+
+/// [`learn_variance`] as a mean over the last `fixes` samples.
+fn learn_variance_over(var: f64, sample: f64, fixes: f64) -> f64 {
     let s = (sample * sample).min(16.0 * 2.0 * var) / 2.0;
-    var + (s - var) / NOISE_FIXES
+    var + (s - var) / fixes
 }
 
 /// Why the estimator is dead-reckoning instead of taking the fix positions.
@@ -291,6 +301,8 @@ pub struct Estimator {
     coast_state: Coast,
     /// Estimated variance of a fix's position noise per axis, m² ([`ObserverParams::robust`]).
     noise_var: f64,
+    /// Position noise samples learnt from so far (up to [`NOISE_FIXES`]).
+    noise_samples: f64,
     /// Estimated variance of a fix's heading noise, rad², from the heading innovations the
     /// offset learns from (half their mean square: each is the difference of two fixes' noise).
     heading_noise_var: f64,
@@ -333,6 +345,7 @@ impl Estimator {
             coast: false,
             coast_state: Coast::Off,
             noise_var: NOISE_START * NOISE_START,
+            noise_samples: 0.0,
             heading_noise_var: HEADING_NOISE_START * HEADING_NOISE_START,
             offset_noise: 0.0,
             prev_lateral: None,
@@ -369,7 +382,9 @@ impl Estimator {
         } else {
             lateral
         };
-        self.noise_var = learn_variance(self.noise_var, sample);
+        self.noise_samples = (self.noise_samples + 1.0).min(NOISE_FIXES);
+        let fixes = (self.noise_samples + NOISE_PRIOR_FIXES).min(NOISE_FIXES);
+        self.noise_var = learn_variance_over(self.noise_var, sample, fixes);
     }
 
     /// Whether the next fixes are RTK float (coast through them, see

@@ -566,6 +566,21 @@ fn the_robust_observer_learns_the_receiver_s_noise_and_does_not_coast_on_it() {
 }
 
 #[test]
+fn a_noisier_receiver_is_known_within_two_seconds() {
+    // The noise estimate starts at 1 cm: a 3 or 5 cm receiver's first fixes stand out of
+    // its 3.5 σ gate as jumps and are coasted through (a 2° slope's slip then ran a job's
+    // first pass 19 cm off). The starting value weighs as 10 fixes, not 50 (with 50: 1.9 cm
+    // after 2 s of a 3 cm receiver).
+    for sigma in [0.03, 0.05] {
+        let mut e = Estimator::new(robust_params(0.0));
+        let (_, coasted) = noisy_drive(&mut e, 2.0, sigma, None);
+        let got = e.position_noise();
+        assert!(got > 0.7 * sigma, "σ {sigma}: estimated {got} after 2 s");
+        assert!(coasted <= 3, "σ {sigma}: coasted {coasted} of 20 fixes");
+    }
+}
+
+#[test]
 fn position_smoothing_takes_the_receiver_s_noise_out_of_the_pose() {
     let mut raw = Estimator::new(robust_params(0.0));
     let (raw_worst, _) = noisy_drive(&mut raw, 120.0, 0.05, None);
