@@ -170,25 +170,44 @@ const GATE_SIGMAS: f64 = 3.5;
 /// The noise estimate's time constant, in fixes, and its starting value, m.
 const NOISE_FIXES: f64 = 50.0;
 const NOISE_START: f64 = 0.01;
-/// The starting value's weight, in fixes: the position noise is the mean of the samples so far
-/// and this many of the starting value until there are [`NOISE_FIXES`] of them, so a receiver
-/// noisier than the start is known within a second or two at 10 Hz, not after 50 fixes
-/// while its fixes are taken for jumps and coasted through.
+/// The starting value's weight, in fixes: a noise is the mean of the samples so far and this
+/// many of the starting value until there are [`NOISE_FIXES`] of them, so a receiver noisier
+/// than the start is known within a second or two at 10 Hz, not after 50 fixes while its fixes
+/// are taken for jumps and coasted through.
 const NOISE_PRIOR_FIXES: f64 = 10.0;
 /// The heading noise's starting value, rad (0.1°, a dual-antenna receiver's).
 const HEADING_NOISE_START: f64 = 0.1 * std::f64::consts::PI / 180.0;
 
-/// A noise's variance `var` after one `sample` that is the difference of two of its draws
-/// (variance 2σ²): over [`NOISE_FIXES`] samples, each clipped at 4 σ so that a jump's onset
+/// A noise's variance learnt from samples that are each the difference of two of its draws
+/// (variance 2σ²): the mean of the samples and [`NOISE_PRIOR_FIXES`] of the starting value,
+/// then over the last [`NOISE_FIXES`]; each sample clipped at 4 σ so that a jump's onset
 /// barely moves it.
-fn learn_variance(var: f64, sample: f64) -> f64 {
-    learn_variance_over(var, sample, NOISE_FIXES)
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Noise {
+    /// Variance of one draw.
+    var: f64,
+    /// Samples learnt from (up to [`NOISE_FIXES`]).
+    samples: f64,
 }
 
-/// [`learn_variance`] as a mean over the last `fixes` samples.
-fn learn_variance_over(var: f64, sample: f64, fixes: f64) -> f64 {
-    let s = (sample * sample).min(16.0 * 2.0 * var) / 2.0;
-    var + (s - var) / fixes
+impl Noise {
+    fn new(sigma: f64) -> Self {
+        Noise {
+            var: sigma * sigma,
+            samples: 0.0,
+        }
+    }
+
+    fn learn(&mut self, sample: f64) {
+        self.samples = (self.samples + 1.0).min(NOISE_FIXES);
+        let fixes = (self.samples + NOISE_PRIOR_FIXES).min(NOISE_FIXES);
+        let s = (sample * sample).min(16.0 * 2.0 * self.var) / 2.0;
+        self.var += (s - self.var) / fixes;
+    }
+
+    fn sigma(&self) -> f64 {
+        self.var.sqrt()
+    }
 }
 
 /// Why the estimator is dead-reckoning instead of taking the fix positions.
@@ -299,13 +318,11 @@ pub struct Estimator {
     coast: bool,
     /// Dead reckoning through an RTK float or a position jump.
     coast_state: Coast,
-    /// Estimated variance of a fix's position noise per axis, m² ([`ObserverParams::robust`]).
-    noise_var: f64,
-    /// Position noise samples learnt from so far (up to [`NOISE_FIXES`]).
-    noise_samples: f64,
-    /// Estimated variance of a fix's heading noise, rad², from the heading innovations the
+    /// Estimated noise of a fix's position per axis, m ([`ObserverParams::robust`]).
+    noise: Noise,
+    /// Estimated noise of a fix's heading, rad, from the heading innovations the
     /// offset learns from (half their mean square: each is the difference of two fixes' noise).
-    heading_noise_var: f64,
+    heading_noise: Noise,
     /// The offset estimate's error from the heading noise, rad, as of its latest update
     /// ([`significance`]).
     offset_noise: f64,
@@ -344,9 +361,8 @@ impl Estimator {
             learn: true,
             coast: false,
             coast_state: Coast::Off,
-            noise_var: NOISE_START * NOISE_START,
-            noise_samples: 0.0,
-            heading_noise_var: HEADING_NOISE_START * HEADING_NOISE_START,
+            noise: Noise::new(NOISE_START),
+            heading_noise: Noise::new(HEADING_NOISE_START),
             offset_noise: 0.0,
             prev_lateral: None,
             jump_onset: 0.0,
@@ -357,7 +373,7 @@ impl Estimator {
     /// The lateral gate for innovations, m: fixed, or widened with the estimated noise.
     fn gate_lateral(&self) -> f64 {
         if self.params.observer.robust {
-            GATE_LATERAL.max(GATE_SIGMAS * (2.0 * self.noise_var).sqrt())
+            GATE_LATERAL.max(GATE_SIGMAS * std::f64::consts::SQRT_2 * self.noise.sigma())
         } else {
             GATE_LATERAL
         }
@@ -365,7 +381,7 @@ impl Estimator {
 
     /// The estimated noise of the fixes' position, σ per axis, m.
     pub fn position_noise(&self) -> f64 {
-        self.noise_var.sqrt()
+        self.noise.sigma()
     }
 
     /// Learn the fixes' noise from a lateral innovation `lateral` (m). Against a pose taken
@@ -382,9 +398,7 @@ impl Estimator {
         } else {
             lateral
         };
-        self.noise_samples = (self.noise_samples + 1.0).min(NOISE_FIXES);
-        let fixes = (self.noise_samples + NOISE_PRIOR_FIXES).min(NOISE_FIXES);
-        self.noise_var = learn_variance_over(self.noise_var, sample, fixes);
+        self.noise.learn(sample);
     }
 
     /// Whether the next fixes are RTK float (coast through them, see
@@ -432,7 +446,7 @@ impl Estimator {
         let whole = self.drift - n * (self.slip * sin_roll);
         let across = whole.dot(&n);
         let h = Vector3::new(n.x, n.y, -sin_roll);
-        let error = significance::drift_error(self.noise_var.sqrt(), h.dot(&(self.lateral.p * h)));
+        let error = significance::drift_error(self.noise.sigma(), h.dot(&(self.lateral.p * h)));
         whole + n * (significance::steered(across, error) - across)
     }
 
@@ -517,8 +531,8 @@ impl Estimator {
             self.bias = (self.bias - d_heading * gain).clamp(-o.bias_limit, o.bias_limit);
             // The heading innovations telescope like the lateral ones: the estimate carries
             // the noise of two headings through its gain.
-            self.heading_noise_var = learn_variance(self.heading_noise_var, d_heading);
-            self.offset_noise = significance::offset_error(self.heading_noise_var.sqrt(), gain);
+            self.heading_noise.learn(d_heading);
+            self.offset_noise = significance::offset_error(self.heading_noise.sigma(), gain);
         }
         // The lateral rate error e = Δl/Δt measures h·(θ − θ̂) with θ = (drift, slip) and
         // h = (n, −sin roll): one Kalman update of the three together.
@@ -692,7 +706,7 @@ impl Estimator {
         // Random walk of q per step against a noise of r: P⁻ = (q + √(q² + 4qr)) / 2,
         // K = P⁻ / (P⁻ + r).
         let q = o.position_process * o.position_process * (i.dt / 0.1);
-        let r = self.noise_var;
+        let r = self.noise.var;
         let p = 0.5 * (q + (q * q + 4.0 * q * r).sqrt());
         let k = if p + r > 0.0 { p / (p + r) } else { 1.0 };
         let innovation = pose.pos - i.predicted.pos;
