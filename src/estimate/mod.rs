@@ -16,9 +16,11 @@ use nalgebra::Vector3;
 
 mod drift_memory;
 mod lateral_filter;
+mod noise;
 mod significance;
 use drift_memory::DriftMemory;
 use lateral_filter::LateralFilter;
+use noise::{Noise, HEADING_NOISE_START, NOISE_START};
 
 /// GNSS antenna position relative to the rear-axle centre, m.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -167,49 +169,6 @@ const GATE_HEADING: f64 = 0.02;
 /// With [`ObserverParams::robust`]: the lateral gate is this many standard deviations of the
 /// innovation (σ·√2 for two fixes of noise σ each).
 const GATE_SIGMAS: f64 = 3.5;
-/// The noise estimate's time constant, in fixes, and its starting value, m.
-const NOISE_FIXES: f64 = 50.0;
-const NOISE_START: f64 = 0.01;
-/// The starting value's weight, in fixes: a noise is the mean of the samples so far and this
-/// many of the starting value until there are [`NOISE_FIXES`] of them, so a receiver noisier
-/// than the start is known within a second or two at 10 Hz, not after 50 fixes while its fixes
-/// are taken for jumps and coasted through.
-const NOISE_PRIOR_FIXES: f64 = 10.0;
-/// The heading noise's starting value, rad (0.1°, a dual-antenna receiver's).
-const HEADING_NOISE_START: f64 = 0.1 * std::f64::consts::PI / 180.0;
-
-/// A noise's variance learnt from samples that are each the difference of two of its draws
-/// (variance 2σ²): the mean of the samples and [`NOISE_PRIOR_FIXES`] of the starting value,
-/// then over the last [`NOISE_FIXES`]; each sample clipped at 4 σ so that a jump's onset
-/// barely moves it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Noise {
-    /// Variance of one draw.
-    var: f64,
-    /// Samples learnt from (up to [`NOISE_FIXES`]).
-    samples: f64,
-}
-
-impl Noise {
-    fn new(sigma: f64) -> Self {
-        Noise {
-            var: sigma * sigma,
-            samples: 0.0,
-        }
-    }
-
-    fn learn(&mut self, sample: f64) {
-        self.samples = (self.samples + 1.0).min(NOISE_FIXES);
-        let fixes = (self.samples + NOISE_PRIOR_FIXES).min(NOISE_FIXES);
-        let s = (sample * sample).min(16.0 * 2.0 * self.var) / 2.0;
-        self.var += (s - self.var) / fixes;
-    }
-
-    fn sigma(&self) -> f64 {
-        self.var.sqrt()
-    }
-}
-
 /// Why the estimator is dead-reckoning instead of taking the fix positions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Coast {
@@ -826,5 +785,7 @@ impl Estimator {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_noise;
 #[cfg(test)]
 mod tests_start_up;

@@ -2,7 +2,8 @@
 //! what of that the tracker steers for, and how soon a true drift is steered for
 //! ([`super::significance`]).
 
-use super::tests::{antenna_of, robust_params};
+use super::tests::antenna_of;
+use super::tests_noise::robust_params;
 use super::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
