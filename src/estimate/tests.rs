@@ -231,17 +231,23 @@ fn drive_with_fixes_every(
             }
             e.set_learning(!in_float);
             e.set_coasting(in_float);
-            e.on_fix(&GnssFix {
-                t_received: t + e.params().gnss_latency,
-                antenna,
-                heading: Some(th),
-                speed: v,
-                roll: None,
-                latency: None,
-            });
+            e.on_fix(&fix_without_roll(e, t, antenna, th, v));
         }
     }
     Pose::new(x, y, th)
+}
+
+/// A fix of `antenna` measured at `t` (received the configured latency later), with the
+/// heading `th` and speed `v`, without roll or a latency of its own.
+pub(super) fn fix_without_roll(e: &Estimator, t: f64, antenna: Vec2, th: f64, v: f64) -> GnssFix {
+    GnssFix {
+        t_received: t + e.params().gnss_latency,
+        antenna,
+        heading: Some(th),
+        speed: v,
+        roll: None,
+        latency: None,
+    }
 }
 
 fn observer_params() -> EstimatorParams {

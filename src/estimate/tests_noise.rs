@@ -1,7 +1,7 @@
 //! The robust observer: the receiver's noise learnt from the innovations, the gates it widens,
 //! the position smoothing, and a jump told from a dead reckoning going wrong.
 
-use super::tests::{antenna_of, params};
+use super::tests::{antenna_of, fix_without_roll, params};
 use super::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -41,14 +41,7 @@ fn noisy_drive(
                     antenna += j;
                 }
             }
-            e.on_fix(&GnssFix {
-                t_received: t + e.params().gnss_latency,
-                antenna,
-                heading: Some(th),
-                speed: v,
-                roll: None,
-                latency: None,
-            });
+            e.on_fix(&fix_without_roll(e, t, antenna, th, v));
             coasted += usize::from(e.is_coasting());
             if t > seconds / 2.0 {
                 let est = e.estimate(t).expect("an estimate").pose;
