@@ -494,6 +494,15 @@ fn an_overlap_brings_every_pass_that_much_closer_to_its_neighbour() {
         // least w − s.
         assert!(swaths[0] - rings[1] <= s + 1e-6, "{swaths:?} {rings:?}");
     }
+    // The closer passes show: more swaths, or the first one nearer the edge.
+    let (exact_swaths, overlapped_swaths) = (
+        lowest_ys(&exact, SegmentKind::Work),
+        lowest_ys(&overlapped, SegmentKind::Work),
+    );
+    assert!(
+        overlapped_swaths.len() > exact_swaths.len() || overlapped_swaths[0] < exact_swaths[0],
+        "{exact_swaths:?} {overlapped_swaths:?}"
+    );
     let (me, mo) = (
         metrics::plan_metrics(&field, &exact, 6.0),
         metrics::plan_metrics(&field, &overlapped, 6.0),
