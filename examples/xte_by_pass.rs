@@ -6,7 +6,7 @@
 //!     cargo run --release --example xte_by_pass -- VARIATION tools/scenarios/S.toml [KEY=VALUE...]
 //!
 //! VARIATION is a row of `agsteer accuracy --envelope` (`nominal`, `lag_0.6`, …); KEY=VALUE
-//! overrides apply to the default tracker only, for A/B runs against the references.
+//! overrides apply to the default tracker and the LQR only, for A/B runs against the references.
 
 use agsteer::config::TrackerChoice;
 use agsteer::demo::envelope::{cell_config, Calibration, MATRIX};
@@ -92,8 +92,9 @@ fn main() -> anyhow::Result<()> {
         TrackerChoice::Predictive,
         TrackerChoice::PurePursuit,
         TrackerChoice::Stanley,
+        TrackerChoice::Lqr,
     ] {
-        let set = if tracker == TrackerChoice::Predictive {
+        let set = if matches!(tracker, TrackerChoice::Predictive | TrackerChoice::Lqr) {
             extra
         } else {
             &[]

@@ -13,6 +13,7 @@ use crate::estimate::{Estimator, GnssFix, VehicleEstimate};
 use crate::geo::{heading_vec, left_normal, Direction, Pose, Vec2};
 use crate::guidance::progress::{JobDefinition, Progress};
 use crate::guidance::{Guidance, GuidanceError, JobPlan};
+use crate::track::lag_lead::LagLead;
 use crate::track::law::SteeringLaw;
 use crate::track::lost_motion::LostMotion;
 use crate::track::{
@@ -84,6 +85,8 @@ pub struct Controller {
     approach: Option<ApproachSettings>,
     /// The steering's lost-motion compensation.
     lost_motion: LostMotion,
+    /// The lead on the steering's lag (laws that ask for it; `track::lag_lead`).
+    lag_lead: LagLead,
     /// Whether the supervisor engaged the previous command (the compensation learns only
     /// from commands the actuator followed).
     engaged: bool,
@@ -131,6 +134,7 @@ impl Controller {
                 clear: None,
             }),
             lost_motion: LostMotion::new(params.lost_motion_for(needs), params.lost_motion.initial),
+            lag_lead: params.lag_lead_for(needs),
             engaged: false,
             law,
             params: params.clone(),
@@ -355,6 +359,14 @@ impl Controller {
             tr.wheel_angle = (tr.wheel_angle + offset).clamp(-max, max);
         }
         if tr.valid {
+            // Turn the wheels when the law asks despite the steering's lag (the filter passes
+            // the demand through where the law does not ask or the steering is quick).
+            let max = self.params.tracker.max_wheel_angle;
+            tr.wheel_angle = self.lag_lead.command(tr.wheel_angle, dt).clamp(-max, max);
+        } else {
+            self.lag_lead.reset();
+        }
+        if tr.valid {
             // Put the wheels where the command says despite the steering's play; learn the
             // play on work lines from commands the actuator followed.
             let measured = self.estimator.latest_wheel_angle().unwrap_or(f64::NAN);
@@ -393,6 +405,7 @@ impl Controller {
             self.curvature.scale,
         );
         self.lost_motion.set_params(params.lost_motion_for(needs));
+        self.lag_lead = params.lag_lead_for(needs);
         self.estimator.set_params(params.estimator_for(needs));
         self.params = ControlParams {
             approach: self.params.approach,

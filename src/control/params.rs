@@ -8,6 +8,7 @@
 use crate::estimate::{EstimatorParams, ObserverParams};
 use crate::guidance::GuidanceParams;
 use crate::plan::maneuver::path::CurveParams;
+use crate::track::lag_lead::LagLead;
 use crate::track::law::{LawNeeds, LawParams};
 use crate::track::lost_motion::LostMotionParams;
 use crate::track::registry::TrackerKind;
@@ -107,6 +108,16 @@ impl ControlParams {
             min_speed: i.min_speed,
             offset: learnt.clamp(-i.limit, i.limit),
         }
+    }
+
+    /// The lead on the steering's calibrated lag for a law with `needs` (off when it does not
+    /// use it).
+    pub fn lag_lead_for(&self, needs: LawNeeds) -> LagLead {
+        LagLead::new(if needs.lag_lead {
+            self.tracker.steering.lag
+        } else {
+            0.0
+        })
     }
 
     /// The lost-motion compensation for a law with `needs` (off when it does not use it).

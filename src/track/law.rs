@@ -25,6 +25,9 @@ pub struct LawNeeds {
     pub integral: bool,
     /// The steering's lost-motion compensation.
     pub lost_motion: bool,
+    /// The steering's lag beyond [`super::lag_lead::RESIDUAL_LAG`] cancelled by a lead on the
+    /// command ([`super::lag_lead`]); the law then schedules on the residual lag.
+    pub lag_lead: bool,
 }
 
 /// The laws' own gains (`[track]`), SI.

@@ -211,6 +211,7 @@ impl SteeringLaw for Lqr {
             observer: true,
             integral: true,
             lost_motion: true,
+            lag_lead: false,
         }
     }
 

@@ -15,6 +15,7 @@
 //! Contract: pure functions of the local path, the pose and the speed; nothing allocates or
 //! logs per call. Uses [`crate::geo`] and [`crate::estimate`] only.
 
+pub mod lag_lead;
 pub mod law;
 pub mod local_path;
 pub mod lost_motion;

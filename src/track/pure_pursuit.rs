@@ -32,6 +32,7 @@ impl PurePursuit {
                 observer: true,
                 integral: true,
                 lost_motion: true,
+                lag_lead: true,
             },
             scheduled: Some(ld_max),
         }
@@ -45,6 +46,7 @@ impl PurePursuit {
                 observer: false,
                 integral: false,
                 lost_motion: false,
+                lag_lead: false,
             },
             scheduled: None,
         }
@@ -68,12 +70,22 @@ impl SteeringLaw for PurePursuit {
             return pure_pursuit_at(local, pose, lookahead(params, speed), params);
         };
         let growth = (params.ld_gain * speed.abs()).min(ld_max);
+        // With the lead, the look-ahead covers only the lag it leaves.
+        let mut steering = params.steering;
+        if self.needs.lag_lead {
+            steering.lag = super::lag_lead::residual(steering.lag);
+        }
+        let response_time = TrackerParams {
+            steering,
+            ..*params
+        }
+        .response_time();
         let ld = scheduled_lookahead(
             &TrackerParams {
                 ld_gain: 0.0,
                 ..*params
             },
-            params.response_time(),
+            response_time,
             speed,
         )
         .max(growth);

@@ -32,6 +32,7 @@ impl SteeringLaw for Stanley {
             observer: false,
             integral: true,
             lost_motion: false,
+            lag_lead: false,
         }
     }
 
