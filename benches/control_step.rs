@@ -25,19 +25,17 @@ struct Rig {
 }
 
 impl Rig {
-    fn new(kind: &str) -> Rig {
+    fn new(kind: &str, extra: &[&str]) -> Rig {
         // A side slope with the IMU, so that roll correction and the slip estimate run too.
-        let cfg = Config::parse_with(
-            "",
-            &[
-                format!("track.kind={kind}"),
-                "job.line_num=0".into(),
-                "sim.imu_rate_hz=100".into(),
-                "sim.terrain_slope_deg=2".into(),
-                "sim.slip_per_roll_mps_per_deg=0.015".into(),
-            ],
-        )
-        .expect("config");
+        let mut set = vec![
+            format!("track.kind={kind}"),
+            "job.line_num=0".into(),
+            "sim.imu_rate_hz=100".into(),
+            "sim.terrain_slope_deg=2".into(),
+            "sim.slip_per_roll_mps_per_deg=0.015".into(),
+        ];
+        set.extend(extra.iter().map(|s| s.to_string()));
+        let cfg = Config::parse_with("", &set).expect("config");
         let job = agsteer::job::prepare_config(&cfg).expect("job");
         let ctrl = Controller::new(&cfg.control_params(), job.plan, job.definition, None)
             .expect("controller");
@@ -87,8 +85,8 @@ impl Rig {
     }
 }
 
-fn percentiles(kind: &str) {
-    let mut rig = Rig::new(kind);
+fn percentiles(kind: &str, extra: &[&str]) {
+    let mut rig = Rig::new(kind, extra);
     for _ in 0..500 {
         let t = rig.feed();
         rig.step(t);
@@ -105,7 +103,12 @@ fn percentiles(kind: &str) {
         samples[((samples.len() as f64 * p) as usize).min(samples.len() - 1)] as f64 / 1000.0
     };
     eprintln!(
-        "control_step/{kind}: median {:.2} µs, p99 {:.2} µs, max {:.1} µs over {} steps",
+        "control_step/{kind}{}: median {:.2} µs, p99 {:.2} µs, max {:.1} µs over {} steps",
+        if extra.is_empty() {
+            ""
+        } else {
+            " (with a 0.6 s steering lag: the lag lead on)"
+        },
         q(0.5),
         q(0.99),
         q(1.0),
@@ -114,9 +117,15 @@ fn percentiles(kind: &str) {
 }
 
 fn bench(c: &mut Criterion) {
+    // The default tracker with a slow steering, whose lag the controller leads
+    // (track::lag_lead): percentiles only.
+    percentiles(
+        "predictive",
+        &["sim.actuator_tau_s=0.6", "safety.actuator_tau_s=0.6"],
+    );
     for kind in ["predictive", "pure_pursuit"] {
-        percentiles(kind);
-        let mut rig = Rig::new(kind);
+        percentiles(kind, &[]);
+        let mut rig = Rig::new(kind, &[]);
         c.bench_function(&format!("control_step/{kind}"), |b| {
             b.iter_custom(|iters| {
                 let mut total = std::time::Duration::ZERO;
