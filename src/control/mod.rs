@@ -79,6 +79,11 @@ pub struct Controller {
     integral: IntegralAction,
     /// The learnt error of the wheel angle curves need (`track::CurvatureScale`).
     curvature: CurvatureScale,
+    /// The same error learnt on the turns (paths other than work lines, driven forward while
+    /// engaged) and added there on top of `curvature`: a turn at the job's speed with dynamic
+    /// tyres slips more than the work lines' curves do (or the work lines are straight and
+    /// teach `curvature` nothing), and ran wide into the next line.
+    turn_curvature: CurvatureScale,
     /// Time of the previous tick, s.
     last_tick: Option<f64>,
     /// Approach paths (`guidance.approach_paths`), `None` when off.
@@ -124,6 +129,11 @@ impl Controller {
             guidance,
             integral: params.integral_for(needs, 0.0),
             curvature: CurvatureScale::new(
+                params.law.curvature.for_needs(needs),
+                params.tracker.wheelbase,
+                0.0,
+            ),
+            turn_curvature: CurvatureScale::new(
                 params.law.curvature.for_needs(needs),
                 params.tracker.wheelbase,
                 0.0,
@@ -350,6 +360,24 @@ impl Controller {
             dt,
             learning,
         );
+        {
+            // Turns: their own share beyond the work lines' scale, learnt and added only there.
+            let turning =
+                direction == Direction::Forward && self.guidance.tag() != crate::geo::Tag::Work;
+            let add = self.turn_curvature.update(
+                (
+                    out.xte.unwrap_or(f64::NAN),
+                    out.heading_error.unwrap_or(f64::NAN),
+                ),
+                tr.path_curvature,
+                est.speed,
+                dt,
+                turning && self.engaged,
+            );
+            if turning {
+                offset += add;
+            }
+        }
         // The steering controller servos the sensed angle to the command, so a sensor reading
         // `sensor_offset` more than the wheels leaves them short by as much: command the
         // estimated offset on top (0 without the observer).
@@ -403,6 +431,11 @@ impl Controller {
             params.law.curvature.for_needs(needs),
             params.tracker.wheelbase,
             self.curvature.scale,
+        );
+        self.turn_curvature = CurvatureScale::new(
+            params.law.curvature.for_needs(needs),
+            params.tracker.wheelbase,
+            self.turn_curvature.scale,
         );
         self.lost_motion.set_params(params.lost_motion_for(needs));
         self.lag_lead = params.lag_lead_for(needs);

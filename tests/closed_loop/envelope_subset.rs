@@ -88,3 +88,30 @@ fn sampled_envelope_cells_stay_within_twice_their_figures() {
     }
     eprintln!("{}", out.join("\n"));
 }
+
+/// Session 25: the turns learn their own share of the curvature scale. On straight lines the
+/// work lines teach the scale nothing, so a 15 km/h turn (2 m/s²) on soft tyres ran wide and
+/// started the next line up to 1.1 m off (2.43 cm RMS over the cell, max 29.8); on R 15 m at
+/// 20 km/h the turns between the arcs did the same (5.08 cm, over its 5 cm bound).
+#[test]
+fn the_turns_learn_what_dynamic_tyres_need_beyond_the_model() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (var, scenario, bound_cm) in [
+        ("tyre_slip_soft", "straight_15kmh", 2.0),
+        ("speed_20", "curve_r15", 5.0),
+    ] {
+        let v = MATRIX
+            .iter()
+            .find(|m| m.name == var)
+            .unwrap_or_else(|| panic!("variation {var}"));
+        let path = root.join(format!("tools/scenarios/{scenario}.toml"));
+        let cfg = cell_config(&path, v, &[], Calibration::Truth).expect("valid cell");
+        let cell = run_cell(var, scenario, &cfg, &[TrackerChoice::Predictive]);
+        let r = cell.default_result().expect("ran");
+        let got = 100.0 * r.xte_rms_m;
+        assert!(
+            r.finished && got <= bound_cm,
+            "{var}/{scenario}: {got:.2} cm, bound {bound_cm}"
+        );
+    }
+}
