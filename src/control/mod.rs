@@ -128,16 +128,8 @@ impl Controller {
             estimator: Estimator::new(params.estimator_for(needs)),
             guidance,
             integral: params.integral_for(needs, 0.0),
-            curvature: CurvatureScale::new(
-                params.law.curvature.for_needs(needs),
-                params.tracker.wheelbase,
-                0.0,
-            ),
-            turn_curvature: CurvatureScale::new(
-                params.law.curvature.for_needs(needs),
-                params.tracker.wheelbase,
-                0.0,
-            ),
+            curvature: params.curvature_scale_for(needs, 0.0),
+            turn_curvature: params.curvature_scale_for(needs, 0.0),
             last_tick: None,
             approach: params.approach.map(|params| ApproachSettings {
                 params,
@@ -387,25 +379,22 @@ impl Controller {
             tr.wheel_angle = (tr.wheel_angle + offset).clamp(-max, max);
         }
         if tr.valid {
+            let max = self.params.tracker.max_wheel_angle;
             // Turn the wheels when the law asks despite the steering's lag (the filter passes
             // the demand through where the law does not ask or the steering is quick).
-            let max = self.params.tracker.max_wheel_angle;
             tr.wheel_angle = self.lag_lead.command(tr.wheel_angle, dt).clamp(-max, max);
-        } else {
-            self.lag_lead.reset();
-        }
-        if tr.valid {
             // Put the wheels where the command says despite the steering's play; learn the
             // play on work lines from commands the actuator followed.
             let measured = self.estimator.latest_wheel_angle().unwrap_or(f64::NAN);
             let learn = learning
                 && self.engaged
                 && est.speed.abs() >= self.estimator.params().observer.min_speed;
-            let max = self.params.tracker.max_wheel_angle;
             tr.wheel_angle = self
                 .lost_motion
                 .command(tr.wheel_angle, measured, dt, learn)
                 .clamp(-max, max);
+        } else {
+            self.lag_lead.reset();
         }
         if tr.wheel_angle.is_finite() {
             out.wheel_angle = Some(tr.wheel_angle);
@@ -427,16 +416,8 @@ impl Controller {
         }
         let needs = self.law.needs();
         self.integral = params.integral_for(needs, self.integral.offset);
-        self.curvature = CurvatureScale::new(
-            params.law.curvature.for_needs(needs),
-            params.tracker.wheelbase,
-            self.curvature.scale,
-        );
-        self.turn_curvature = CurvatureScale::new(
-            params.law.curvature.for_needs(needs),
-            params.tracker.wheelbase,
-            self.turn_curvature.scale,
-        );
+        self.curvature = params.curvature_scale_for(needs, self.curvature.scale);
+        self.turn_curvature = params.curvature_scale_for(needs, self.turn_curvature.scale);
         self.lost_motion.set_params(params.lost_motion_for(needs));
         self.lag_lead = params.lag_lead_for(needs);
         self.estimator.set_params(params.estimator_for(needs));

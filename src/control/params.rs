@@ -12,6 +12,7 @@ use crate::track::lag_lead::LagLead;
 use crate::track::law::{LawNeeds, LawParams};
 use crate::track::lost_motion::LostMotionParams;
 use crate::track::registry::TrackerKind;
+use crate::track::CurvatureScale;
 use crate::track::{IntegralAction, TrackerParams};
 use serde::{Deserialize, Serialize};
 
@@ -108,6 +109,16 @@ impl ControlParams {
             min_speed: i.min_speed,
             offset: learnt.clamp(-i.limit, i.limit),
         }
+    }
+
+    /// A curvature scale for a law with `needs` (learning nothing when it has no integral
+    /// action), keeping a scale already `learnt` (clamped to the limit).
+    pub fn curvature_scale_for(&self, needs: LawNeeds, learnt: f64) -> CurvatureScale {
+        CurvatureScale::new(
+            self.law.curvature.for_needs(needs),
+            self.tracker.wheelbase,
+            learnt,
+        )
     }
 
     /// The lead on the steering's calibrated lag for a law with `needs` (off when it does not

@@ -7,10 +7,10 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::FRAC_PI_2;
 
-/// Drive north at 3 m/s for `seconds` with white GNSS noise σ `sigma` per axis and a lateral
-/// error of `dr_error` m/s in the wheel angles' dead reckoning (the wheels read 0, the vehicle
-/// drifts East at that rate: an unmodelled slip). Returns (the largest |error| of the
-/// estimate's East position from the truth over the last half, fixes coasted through).
+/// Drive north at 3 m/s for `seconds` with white GNSS noise σ `sigma` per axis and, with
+/// `jump` = (from, until, offset), the fixes moved by `offset` m from `from` until `until` s
+/// (multipath). Returns (the largest |error| of the estimate's East position from the truth
+/// over the last half, fixes coasted through).
 fn noisy_drive(
     e: &mut Estimator,
     seconds: f64,

@@ -69,7 +69,7 @@ pub struct SteeringResponse {
 /// weaves (11 cm RMS, 3 m max), 2.66 holds 2.9 cm, 3.5 and 4.5 converge slower (3.0, 10.9).
 pub const LAG_PHASE_BUDGET: f64 = 2.66;
 
-impl TrackerParams {
+impl SteeringResponse {
     /// The look-ahead time the steering needs, s: the larger of
     /// - [`LAG_PHASE_BUDGET`] × (lag + the dead time not predicted): pure pursuit's loop is
     ///   second order with ωn = √2·v/Ld (linearised about a straight line), so a look-ahead of
@@ -79,10 +79,10 @@ impl TrackerParams {
     ///   driven cannot follow the command, and the loop turns into a limit cycle (the
     ///   rate-limit weave of a 20°/s motor, issue 15).
     ///
-    /// The default law's look-ahead is at least v·T ([`scheduled_lookahead`]). Computed once at
-    /// configuration.
+    /// The default law's look-ahead is at least v·T ([`scheduled_lookahead`]); it asks every
+    /// period (a few operations), with the lag its lead leaves ([`lag_lead::residual`]).
     pub fn response_time(&self) -> f64 {
-        let s = &self.steering;
+        let s = self;
         let delay = s.lag.max(0.0) + s.dead_time.max(0.0);
         let slew = if s.rate > 0.0 && s.rate.is_finite() {
             s.sweep.max(0.0) / s.rate
@@ -95,6 +95,13 @@ impl TrackerParams {
         } else {
             0.0
         }
+    }
+}
+
+impl TrackerParams {
+    /// The steering's [`SteeringResponse::response_time`], s.
+    pub fn response_time(&self) -> f64 {
+        self.steering.response_time()
     }
 }
 

@@ -75,11 +75,7 @@ impl SteeringLaw for PurePursuit {
         if self.needs.lag_lead {
             steering.lag = super::lag_lead::residual(steering.lag);
         }
-        let response_time = TrackerParams {
-            steering,
-            ..*params
-        }
-        .response_time();
+        let response_time = steering.response_time();
         let ld = scheduled_lookahead(
             &TrackerParams {
                 ld_gain: 0.0,
