@@ -33,11 +33,13 @@ fn report(tracker: &str, passes: &[WorkPass]) {
         let start = pass.samples.first().map_or(0.0, |s| s.xte_m);
         let worst = scored.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let sum_sq: f64 = scored.iter().map(|x| x * x).sum();
+        let mean = scored.iter().sum::<f64>() / scored.len().max(1) as f64;
         println!(
-            "{tracker:<13} pass {i:>2}: starts {:>7.2} cm, scored RMS {:>6.2} max {:>6.2} cm",
+            "{tracker:<13} pass {i:>2}: starts {:>7.2} cm, scored RMS {:>6.2} max {:>6.2} mean {:>6.2} cm",
             100.0 * start,
             100.0 * rms(sum_sq, scored.len()),
-            100.0 * worst
+            100.0 * worst,
+            100.0 * mean
         );
         for s in pass
             .samples

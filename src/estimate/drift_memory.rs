@@ -77,7 +77,13 @@ pub const NEW_DIRECTION_SECTORS: usize = 3;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Slot {
-    drift: Vec2,
+    /// The drift across the heading it was kept at (the vehicle's lateral velocity: positive
+    /// to its left), m/s. Kept as the vehicle saw it, not as a world vector taken across the
+    /// heading at the restore: a restore made on a turn's last straight, a few degrees off the
+    /// line, took a share of the unobservable drift along the heading with it (the side
+    /// draft's 15 km/h lines started 0.02–0.03 m/s short of their crab and kept a 2–3 cm
+    /// standing error for a pass).
+    across: f64,
     /// Time learnt in this sector, s.
     learnt: f64,
 }
@@ -87,9 +93,9 @@ struct Slot {
 pub enum Entered {
     /// Still the same sector: as it is.
     Same,
-    /// A sector learnt before: its drift (the estimator takes the component across the
-    /// heading from it; along the heading a pass does not observe it).
-    Learnt(Vec2),
+    /// A sector learnt before: its drift across the heading, m/s (positive left; along the
+    /// heading a pass does not observe it).
+    Learnt(f64),
     /// A sector not learnt yet, [`NEW_DIRECTION_SECTORS`] or more from the last pass: the
     /// drift as it is, learnt afresh (a new direction's drift is as uncertain as the first one
     /// was). Any other sector not learnt yet goes on as it is ([`Entered::Same`]).
@@ -115,7 +121,7 @@ impl Default for DriftMemory {
     fn default() -> Self {
         DriftMemory {
             slots: [Slot {
-                drift: Vec2::zeros(),
+                across: 0.0,
                 learnt: 0.0,
             }; SECTORS],
             current: None,
@@ -154,11 +160,12 @@ impl DriftMemory {
         }
     }
 
-    /// The drift kept driving straight the other way (the sector of `heading` + π, rad), if
-    /// learnt there for [`MIN_LEARNT_S`].
-    pub fn opposite(&self, heading: f64) -> Option<Vec2> {
+    /// The drift across the heading kept driving straight the other way (the sector of
+    /// `heading` + π, rad; m/s, positive to that way's left), if learnt there for
+    /// [`MIN_LEARNT_S`].
+    pub fn opposite(&self, heading: f64) -> Option<f64> {
         let slot = &self.slots[sector_of(heading + std::f64::consts::PI)];
-        (slot.learnt >= MIN_LEARNT_S).then_some(slot.drift)
+        (slot.learnt >= MIN_LEARNT_S).then_some(slot.across)
     }
 
     /// The vehicle now heads `heading` (rad), driving straight or not (`straight`), with the
@@ -192,14 +199,14 @@ impl DriftMemory {
         }
         if self.active {
             // The sector keeps the drift of its straight driving (not of a turn's start).
-            self.slots[sector].drift = drift;
+            self.slots[sector].across = left_normal(&heading_vec(heading)).dot(&drift);
             return Entered::Same;
         }
         self.active = true;
         self.stay = 0.0;
         let slot = &self.slots[sector];
         if slot.learnt >= MIN_LEARNT_S {
-            Entered::Learnt(slot.drift)
+            Entered::Learnt(slot.across)
         } else if self
             .last_pass
             .is_some_and(|p| sector_distance(p, sector) >= NEW_DIRECTION_SECTORS)
@@ -289,11 +296,12 @@ impl Estimator {
     }
 
     /// Whether the drift across `heading` (rad) is known to be the vehicle's: the way back
-    /// (the opposite direction, learnt) kept it on the other side of the field.
+    /// (the opposite direction, learnt) kept it on the other side of the field, so on the same
+    /// side of the vehicle.
     fn crab_known(&self, heading: f64) -> bool {
         let n = left_normal(&heading_vec(heading));
         let (here, there) = (n.dot(&self.drift), self.drift_memory.opposite(heading));
-        there.is_some_and(|d| n.dot(&d) * here < 0.0)
+        there.is_some_and(|across| across * here > 0.0)
     }
 
     /// In a headland turn that carries the last line's drift as the vehicle's: the drift is
@@ -347,13 +355,12 @@ impl Estimator {
         let min_drift = (MIN_CRAB * self.fix_speed.abs()).max(MIN_DRIFT);
         match entered {
             Entered::Same => {}
-            Entered::Learnt(drift) => {
+            Entered::Learnt(stored) => {
                 // The sector's own drift where the carried one points the other way across the
                 // heading: a drift of the vehicle, not of the ground (a ground drift that grows
                 // keeps its side, and its newest value is the right one). After a turn that
                 // carried the drift as the vehicle's, the sector's own: the carried one is
                 // right only in its vehicle part.
-                let stored = n.dot(&drift);
                 let swapped =
                     stored * carried < 0.0 && stored.abs().min(carried.abs()) > 0.5 * min_drift;
                 if swapped || self.curve.turn_carries_crab {
@@ -374,6 +381,11 @@ mod tests {
     use super::*;
     use crate::geo::v2;
     use std::f64::consts::PI;
+
+    /// The drift `d` (world, m/s) across `heading` (rad), positive left.
+    fn across(heading: f64, d: Vec2) -> f64 {
+        left_normal(&heading_vec(heading)).dot(&d)
+    }
 
     #[test]
     fn sectors_cover_the_circle() {
@@ -399,11 +411,36 @@ mod tests {
         m.learnt(30.0, true);
         assert_eq!(m.on_heading(-north, true, b), Entered::Same);
         // Northwards again: a, whatever the drift now is; southwards: b.
-        assert_eq!(m.on_heading(north, true, b), Entered::Learnt(a));
+        assert_eq!(
+            m.on_heading(north, true, b),
+            Entered::Learnt(across(north, a))
+        );
         assert_eq!(
             m.on_heading(-north, true, v2(0.01, 0.0)),
-            Entered::Learnt(b)
+            Entered::Learnt(across(-north, b))
         );
+    }
+
+    #[test]
+    fn a_sector_gives_back_the_crab_it_kept_whatever_the_heading_it_is_entered_at() {
+        let mut m = DriftMemory::default();
+        let north = PI / 2.0;
+        // Kept driving north: 0.1 m/s to the right, and 0.2 m/s along the heading that a
+        // straight pass does not observe.
+        let kept = v2(0.1, 0.2);
+        m.on_heading(north, true, Vec2::zeros());
+        m.learnt(30.0, true);
+        m.on_heading(north, true, kept);
+        m.on_heading(-north, true, kept);
+        m.learnt(30.0, true);
+        // Back north on a turn's last straight 20° off the line: the crab kept, not the world
+        // vector taken across this heading (−0.03 m/s, the along part leaking in).
+        let off = north + 20f64.to_radians();
+        let Entered::Learnt(across_kept) = m.on_heading(off, true, Vec2::zeros()) else {
+            panic!("the sector was learnt");
+        };
+        assert!((across_kept - -0.1).abs() < 1e-12, "{across_kept}");
+        assert!((across(off, kept) - across_kept).abs() > 0.05);
     }
 
     #[test]
@@ -438,7 +475,10 @@ mod tests {
             assert_eq!(m.on_heading(heading, false, v2(0.05, 0.0)), Entered::Same);
         }
         // Straight again, east: what was learnt there before the curve.
-        assert_eq!(m.on_heading(0.0, true, v2(0.05, 0.0)), Entered::Learnt(a));
+        assert_eq!(
+            m.on_heading(0.0, true, v2(0.05, 0.0)),
+            Entered::Learnt(across(0.0, a))
+        );
         // West, curving: learning there does not count, and it is a new direction once
         // straight.
         m.on_heading(PI, false, a);
