@@ -43,6 +43,16 @@
 //!   takes its sector's drift across the heading, if learnt, as the way back does above (the
 //!   carried one is right only in its vehicle part; a slope adds a ground part).
 //!
+//! **Speed.** A lateral force on the tyres (an implement's side draft) makes a slip *angle*: the
+//! crab's velocity is proportional to the speed. Where both directions of the pass are learnt,
+//! their drifts across the heading are the vehicle's crab (on the same side of the vehicle)
+//! plus the ground's drift (on opposite sides), so their sum gives the crab's angle
+//! ([`DriftMemory::crab_angle`]); the drift's vehicle part then follows the speed fix to fix,
+//! and a sector's drift restored at another speed than it was kept at is moved by the crab's
+//! share of the difference. The ground's part stays a velocity. A sector keeps its drift across
+//! the heading as the vehicle saw it, not as a world vector: a restore on a turn's last
+//! straight, a few degrees off the line, took in a share of the unobservable drift along it.
+//!
 //! A ground drift goes through a turn as a world vector, as before. One not yet known (the first
 //! turn: no way back learnt) is as likely the vehicle's as the ground's, so the next line starts
 //! its drift across the heading from zero and learns it afresh (the expected value; half the
@@ -84,6 +94,8 @@ struct Slot {
     /// draft's 15 km/h lines started 0.02–0.03 m/s short of their crab and kept a 2–3 cm
     /// standing error for a pass).
     across: f64,
+    /// The speed it was kept at, m/s (≥ 0).
+    speed: f64,
     /// Time learnt in this sector, s.
     learnt: f64,
 }
@@ -94,8 +106,8 @@ pub enum Entered {
     /// Still the same sector: as it is.
     Same,
     /// A sector learnt before: its drift across the heading, m/s (positive left; along the
-    /// heading a pass does not observe it).
-    Learnt(f64),
+    /// heading a pass does not observe it), and the speed it was kept at, m/s.
+    Learnt { across: f64, speed: f64 },
     /// A sector not learnt yet, [`NEW_DIRECTION_SECTORS`] or more from the last pass: the
     /// drift as it is, learnt afresh (a new direction's drift is as uncertain as the first one
     /// was). Any other sector not learnt yet goes on as it is ([`Entered::Same`]).
@@ -122,6 +134,7 @@ impl Default for DriftMemory {
         DriftMemory {
             slots: [Slot {
                 across: 0.0,
+                speed: 0.0,
                 learnt: 0.0,
             }; SECTORS],
             current: None,
@@ -168,11 +181,32 @@ impl DriftMemory {
         (slot.learnt >= MIN_LEARNT_S).then_some(slot.across)
     }
 
-    /// The vehicle now heads `heading` (rad), driving straight or not (`straight`), with the
-    /// observer's drift `drift` (world, m/s): what to go on with.
+    /// The vehicle's own crab as an angle, rad (positive to its left), where the two
+    /// directions of the current pass (or, between passes, the last one) are both learnt:
+    /// each direction's drift across the heading is the vehicle's crab (the same side of the
+    /// vehicle, its velocity the angle times the speed) plus the ground's drift (the other
+    /// side of the vehicle on the way back), so their sum is the crab's alone:
+    /// `across_a + across_b = angle · (speed_a + speed_b)`. `None` below [`MIN_CRAB`].
+    pub fn crab_angle(&self) -> Option<f64> {
+        let sector = self.current.filter(|_| self.active).or(self.last_pass)?;
+        let (a, b) = (
+            &self.slots[sector],
+            &self.slots[(sector + SECTORS / 2) % SECTORS],
+        );
+        let learnt = a.learnt >= MIN_LEARNT_S && b.learnt >= MIN_LEARNT_S;
+        let speeds = a.speed + b.speed;
+        // A crab smaller than MIN_CRAB is a residue of the other errors, as for the memory's
+        // own restores (a soft tyre's slope and wheel-angle-sensor bias left ±0.2°, whose
+        // change with the speed moved a 20 s RTK float's dead reckoning 20 cm).
+        let angle = (a.across + b.across) / speeds;
+        (learnt && speeds > 0.0 && angle.abs() >= MIN_CRAB).then_some(angle)
+    }
+
+    /// The vehicle now heads `heading` (rad) at `speed` (m/s), driving straight or not
+    /// (`straight`), with the observer's drift `drift` (world, m/s): what to go on with.
     /// Only straight driving takes a sector's drift: a curve sweeps through the sectors and
     /// its drift is the curve's (tyre slip, a curvature bias), not a direction's.
-    pub fn on_heading(&mut self, heading: f64, straight: bool, drift: Vec2) -> Entered {
+    pub fn on_heading(&mut self, heading: f64, straight: bool, drift: Vec2, speed: f64) -> Entered {
         if !heading.is_finite() {
             return Entered::Same;
         }
@@ -200,13 +234,17 @@ impl DriftMemory {
         if self.active {
             // The sector keeps the drift of its straight driving (not of a turn's start).
             self.slots[sector].across = left_normal(&heading_vec(heading)).dot(&drift);
+            self.slots[sector].speed = speed.abs();
             return Entered::Same;
         }
         self.active = true;
         self.stay = 0.0;
         let slot = &self.slots[sector];
         if slot.learnt >= MIN_LEARNT_S {
-            Entered::Learnt(slot.across)
+            Entered::Learnt {
+                across: slot.across,
+                speed: slot.speed,
+            }
         } else if self
             .last_pass
             .is_some_and(|p| sector_distance(p, sector) >= NEW_DIRECTION_SECTORS)
@@ -334,6 +372,23 @@ impl Estimator {
         }
     }
 
+    /// The vehicle's part of the drift follows the speed from `v_prev` to `v_now` (m/s, both
+    /// above the observer's least speed) at the fix heading `heading` (rad), where the memory
+    /// knows the vehicle's crab angle ([`DriftMemory::crab_angle`]): a lateral force on the
+    /// tyres (an implement's side draft) makes a slip *angle*, so its crab's velocity is
+    /// proportional to the speed, and the velocity learnt at 15 km/h is almost four times the
+    /// crab of the 4 km/h turn after it. The ground's part (a slope's slip) is left as it is.
+    pub(super) fn drift_with_speed(&mut self, heading: f64, v_prev: f64, v_now: f64) {
+        let min = self.params.observer.min_speed;
+        if v_prev.abs() < min || v_now.abs() < min {
+            return;
+        }
+        if let Some(angle) = self.drift_memory.crab_angle() {
+            let n = left_normal(&heading_vec(heading));
+            self.add_drift(n * (angle * (v_now.abs() - v_prev.abs())));
+        }
+    }
+
     /// Move the drift estimate by `step` (world, m/s), within the observer's drift limit.
     pub(super) fn add_drift(&mut self, step: Vec2) {
         self.drift += step;
@@ -345,17 +400,28 @@ impl Estimator {
 
     /// The drift per direction of straight driving ([the module](self)) at a fix heading
     /// `heading` (rad).
-    pub(super) fn drift_by_direction(&mut self, heading: f64) {
+    pub(super) fn drift_by_direction(&mut self, heading: f64, speed: f64) {
         let entered = self
             .drift_memory
-            .on_heading(heading, self.straight, self.drift);
+            .on_heading(heading, self.straight, self.drift, speed);
         // Only the drift across the heading is a direction's: a pass does not observe the rest.
         let n = left_normal(&heading_vec(heading));
         let carried = n.dot(&self.drift);
         let min_drift = (MIN_CRAB * self.fix_speed.abs()).max(MIN_DRIFT);
         match entered {
             Entered::Same => {}
-            Entered::Learnt(stored) => {
+            Entered::Learnt {
+                across,
+                speed: kept,
+            } => {
+                // Its vehicle part at this speed (see `drift_with_speed`).
+                let min = self.params.observer.min_speed;
+                let stored = match self.drift_memory.crab_angle() {
+                    Some(angle) if kept >= min && speed.abs() >= min => {
+                        across + angle * (speed.abs() - kept)
+                    }
+                    _ => across,
+                };
                 // The sector's own drift where the carried one points the other way across the
                 // heading: a drift of the vehicle, not of the ground (a ground drift that grows
                 // keeps its side, and its newest value is the right one). After a turn that
@@ -403,21 +469,27 @@ mod tests {
         let north = PI / 2.0;
         let (a, b) = (v2(0.03, 0.0), v2(-0.03, 0.0));
         // Northwards: learns a (each straight fix keeps the current drift).
-        assert_eq!(m.on_heading(north, true, Vec2::zeros()), Entered::Same);
+        assert_eq!(m.on_heading(north, true, Vec2::zeros(), 1.0), Entered::Same);
         m.learnt(30.0, true);
-        assert_eq!(m.on_heading(north, true, a), Entered::Same);
+        assert_eq!(m.on_heading(north, true, a, 1.0), Entered::Same);
         // Southwards for the first time: learns afresh, b.
-        assert_eq!(m.on_heading(-north, true, a), Entered::New);
+        assert_eq!(m.on_heading(-north, true, a, 1.0), Entered::New);
         m.learnt(30.0, true);
-        assert_eq!(m.on_heading(-north, true, b), Entered::Same);
+        assert_eq!(m.on_heading(-north, true, b, 1.0), Entered::Same);
         // Northwards again: a, whatever the drift now is; southwards: b.
         assert_eq!(
-            m.on_heading(north, true, b),
-            Entered::Learnt(across(north, a))
+            m.on_heading(north, true, b, 1.0),
+            Entered::Learnt {
+                across: across(north, a),
+                speed: 1.0
+            }
         );
         assert_eq!(
-            m.on_heading(-north, true, v2(0.01, 0.0)),
-            Entered::Learnt(across(-north, b))
+            m.on_heading(-north, true, v2(0.01, 0.0), 1.0),
+            Entered::Learnt {
+                across: across(-north, b),
+                speed: 1.0
+            }
         );
     }
 
@@ -428,15 +500,19 @@ mod tests {
         // Kept driving north: 0.1 m/s to the right, and 0.2 m/s along the heading that a
         // straight pass does not observe.
         let kept = v2(0.1, 0.2);
-        m.on_heading(north, true, Vec2::zeros());
+        m.on_heading(north, true, Vec2::zeros(), 1.0);
         m.learnt(30.0, true);
-        m.on_heading(north, true, kept);
-        m.on_heading(-north, true, kept);
+        m.on_heading(north, true, kept, 1.0);
+        m.on_heading(-north, true, kept, 1.0);
         m.learnt(30.0, true);
         // Back north on a turn's last straight 20° off the line: the crab kept, not the world
         // vector taken across this heading (−0.03 m/s, the along part leaking in).
         let off = north + 20f64.to_radians();
-        let Entered::Learnt(across_kept) = m.on_heading(off, true, Vec2::zeros()) else {
+        let Entered::Learnt {
+            across: across_kept,
+            ..
+        } = m.on_heading(off, true, Vec2::zeros(), 1.0)
+        else {
             panic!("the sector was learnt");
         };
         assert!((across_kept - -0.1).abs() < 1e-12, "{across_kept}");
@@ -444,50 +520,89 @@ mod tests {
     }
 
     #[test]
+    fn the_crab_angle_is_the_part_both_directions_share() {
+        let north = PI / 2.0;
+        // Northwards at 4 m/s, then southwards at 2 m/s, each learnt 30 s; `north_left` and
+        // `south_left` the drifts across the heading, m/s.
+        let memory = |north_left: f64, south_left: f64| {
+            let mut m = DriftMemory::default();
+            let world = |heading: f64, left: f64| left_normal(&heading_vec(heading)) * left;
+            m.on_heading(north, true, Vec2::zeros(), 4.0);
+            m.learnt(30.0, true);
+            m.on_heading(north, true, world(north, north_left), 4.0);
+            m.on_heading(-north, true, Vec2::zeros(), 2.0);
+            m.learnt(30.0, true);
+            m.on_heading(-north, true, world(-north, south_left), 2.0);
+            m
+        };
+        // A crab of 0.03 rad to the right: 0.12 m/s at 4 m/s, 0.06 at 2.
+        let crab = memory(-0.12, -0.06).crab_angle().expect("learnt both ways");
+        assert!((crab - -0.03).abs() < 1e-12, "{crab}");
+        // The same with a ground drift of 0.05 m/s to the east on top (left going south).
+        let crab = memory(-0.17, -0.01).crab_angle().expect("learnt both ways");
+        assert!((crab - -0.03).abs() < 1e-12, "{crab}");
+        // A ground drift alone, and a crab below MIN_CRAB: none.
+        assert_eq!(memory(-0.05, 0.05).crab_angle(), None);
+        let small = 0.5 * MIN_CRAB;
+        assert_eq!(memory(4.0 * small, 2.0 * small).crab_angle(), None);
+        // One way only: none.
+        let mut m = DriftMemory::default();
+        m.on_heading(north, true, Vec2::zeros(), 4.0);
+        m.learnt(30.0, true);
+        assert_eq!(m.crab_angle(), None);
+    }
+
+    #[test]
     fn a_sector_learnt_briefly_and_the_edge_keep_the_drift() {
         let mut m = DriftMemory::default();
         let d = v2(0.02, 0.01);
-        m.on_heading(0.0, true, Vec2::zeros());
+        m.on_heading(0.0, true, Vec2::zeros(), 1.0);
         m.learnt(MIN_LEARNT_S - 1.0, true);
         // West after a short stay east (not a pass): as it is.
-        assert_eq!(m.on_heading(PI, true, d), Entered::Same);
+        assert_eq!(m.on_heading(PI, true, d, 1.0), Entered::Same);
         // Back east: its sector was learnt too briefly to be restored.
-        assert_eq!(m.on_heading(0.0, true, d * 2.0), Entered::Same);
+        assert_eq!(m.on_heading(0.0, true, d * 2.0, 1.0), Entered::Same);
         m.learnt(MIN_LEARNT_S, true);
         // Just past the edge of sector 0 (22.5°) but within the hysteresis: no swap.
-        assert_eq!(m.on_heading(0.5, true, d * 3.0), Entered::Same);
-        assert_eq!(m.on_heading(-0.5, true, d * 3.0), Entered::Same);
+        assert_eq!(m.on_heading(0.5, true, d * 3.0, 1.0), Entered::Same);
+        assert_eq!(m.on_heading(-0.5, true, d * 3.0, 1.0), Entered::Same);
         // Not finite: as it is.
-        assert_eq!(m.on_heading(f64::NAN, true, d), Entered::Same);
+        assert_eq!(m.on_heading(f64::NAN, true, d, 1.0), Entered::Same);
     }
 
     #[test]
     fn a_curve_takes_no_sector_drift_until_it_runs_straight() {
         let mut m = DriftMemory::default();
         let a = v2(0.0, 0.03);
-        m.on_heading(0.0, true, Vec2::zeros());
+        m.on_heading(0.0, true, Vec2::zeros(), 1.0);
         m.learnt(30.0, true);
-        m.on_heading(0.0, true, a);
+        m.on_heading(0.0, true, a, 1.0);
         // Round a curve through the sectors and back east: nothing swapped, nothing stored
         // from the curve.
         for i in 1..=16 {
             let heading = i as f64 * PI / 8.0;
-            assert_eq!(m.on_heading(heading, false, v2(0.05, 0.0)), Entered::Same);
+            assert_eq!(
+                m.on_heading(heading, false, v2(0.05, 0.0), 1.0),
+                Entered::Same
+            );
         }
         // Straight again, east: what was learnt there before the curve.
         assert_eq!(
-            m.on_heading(0.0, true, v2(0.05, 0.0)),
-            Entered::Learnt(across(0.0, a))
+            m.on_heading(0.0, true, v2(0.05, 0.0), 1.0),
+            Entered::Learnt {
+                across: across(0.0, a),
+                speed: 1.0
+            }
         );
         // West, curving: learning there does not count, and it is a new direction once
         // straight.
-        m.on_heading(PI, false, a);
+        m.on_heading(PI, false, a, 1.0);
         m.learnt(30.0, false);
-        assert_eq!(m.on_heading(PI, true, a), Entered::New);
+        assert_eq!(m.on_heading(PI, true, a, 1.0), Entered::New);
         // A quarter turn from the last pass (east, learnt 30 s) is not the way back.
         let mut m = DriftMemory::default();
-        m.on_heading(0.0, true, a);
+        m.on_heading(0.0, true, a, 1.0);
         m.learnt(30.0, true);
-        assert_eq!(m.on_heading(PI / 2.0, true, a), Entered::Same);
+        assert_eq!(m.on_heading(PI / 2.0, true, a, 1.0), Entered::Same);
     }
 }

@@ -642,9 +642,10 @@ impl Estimator {
         }
         if o.drift_tau > 0.0 {
             if let Some(previous) = self.fix_pose {
+                self.drift_with_speed(previous.heading, self.fix_speed, fix.speed);
                 self.drift_through_curve(previous.heading, heading);
             }
-            self.drift_by_direction(heading);
+            self.drift_by_direction(heading, fix.speed);
         }
         self.fix_pose = Some(pose);
         self.fix_time = fix.t_received;
