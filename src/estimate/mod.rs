@@ -18,6 +18,7 @@ mod drift_memory;
 mod lateral_filter;
 mod noise;
 mod significance;
+mod yaw_lag;
 use drift_memory::DriftMemory;
 use lateral_filter::LateralFilter;
 use noise::{Noise, HEADING_NOISE_START, NOISE_START};
@@ -258,6 +259,8 @@ pub struct Estimator {
     slip: f64,
     /// The drift per direction of straight driving, and whether the path is straight.
     drift_memory: DriftMemory,
+    /// The vehicle's lag behind the wheels ([`yaw_lag`]).
+    yaw_lag: yaw_lag::YawLag,
     straight: bool,
     /// The drift on curves: work path or not, and what a headland turn carries.
     curve: drift_memory::CurveDrift,
@@ -311,6 +314,7 @@ impl Estimator {
             drift: Vec2::zeros(),
             slip: 0.0,
             drift_memory: DriftMemory::default(),
+            yaw_lag: Default::default(),
             straight: false,
             curve: Default::default(),
             lateral: LateralFilter::new(),
@@ -635,6 +639,7 @@ impl Estimator {
                 pose = Pose::new(i.predicted.pos.x, i.predicted.pos.y, heading);
             }
             (_, Some(i)) => {
+                self.learn_yaw_lag(&i, fix.speed);
                 self.observe(&i, fix.speed);
                 self.smooth_towards(&i, &pose);
             }

@@ -27,8 +27,12 @@ pub const RESIDUAL_LAG: f64 = 0.15;
 /// The filter's state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LagLead {
-    /// The steering's lag τ, s (≤ [`RESIDUAL_LAG`]: the filter passes the demand through).
+    /// The steering's lag, s.
     lag: f64,
+    /// The vehicle's own lag behind its wheels (tyres, yaw inertia; `estimate::yaw_lag`),
+    /// s: led on with the steering's, τ their sum (≤ [`RESIDUAL_LAG`]: the filter passes the
+    /// demand through).
+    vehicle: f64,
     /// The demand low-passed over [`RESIDUAL_LAG`], rad (NaN before the first demand).
     filtered: f64,
 }
@@ -38,13 +42,19 @@ impl LagLead {
     pub fn new(lag: f64) -> Self {
         LagLead {
             lag: if lag.is_finite() { lag } else { 0.0 },
+            vehicle: 0.0,
             filtered: f64::NAN,
         }
     }
 
     /// Whether the filter changes anything (the lag exceeds [`RESIDUAL_LAG`]).
     pub fn active(&self) -> bool {
-        self.lag > RESIDUAL_LAG
+        self.lag + self.vehicle > RESIDUAL_LAG
+    }
+
+    /// The vehicle's lag as learnt now, s (a non-finite or negative one counts as none).
+    pub fn set_vehicle_lag(&mut self, lag: f64) {
+        self.vehicle = if lag.is_finite() { lag.max(0.0) } else { 0.0 };
     }
 
     /// The command (rad) for the `demand`ed wheel angle (rad), one control period `dt` (s)
@@ -62,7 +72,7 @@ impl LagLead {
         }
         // Backward Euler: stable for any period.
         self.filtered += (demand - self.filtered) * dt / (RESIDUAL_LAG + dt);
-        self.filtered + self.lag / RESIDUAL_LAG * (demand - self.filtered)
+        self.filtered + (self.lag + self.vehicle) / RESIDUAL_LAG * (demand - self.filtered)
     }
 
     /// Forget the demand's history (the next command is the demand).
@@ -79,6 +89,21 @@ pub fn residual(lag: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_vehicles_lag_is_led_on_with_the_steerings() {
+        // A quick steering on a vehicle that lags 0.3 s: the filter leads their sum.
+        let mut lead = LagLead::new(0.1);
+        assert!(!lead.active());
+        lead.set_vehicle_lag(0.3);
+        assert!(lead.active());
+        let _ = lead.command(0.0, 0.01);
+        let first = lead.command(0.1, 0.01);
+        // u = x + (τ/τ_r)·(δ − x) with τ = 0.4 s: the step led by about 0.4/0.15.
+        assert!(first > 0.25 && first < 0.27, "{first}");
+        lead.set_vehicle_lag(f64::NAN);
+        assert!(!lead.active());
+    }
 
     /// The wheels of a first-order lag `tau` (s) driven by `command` from rest, sampled every
     /// `dt` for `n` periods (exact discretisation of the lag under a held command).
