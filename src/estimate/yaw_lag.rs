@@ -69,7 +69,7 @@ impl YawLag {
         mut rate: impl FnMut(usize) -> f64,
         measured: f64,
     ) {
-        if steps == 0 || !(h > 0.0) || !measured.is_finite() {
+        if steps == 0 || h.is_nan() || h <= 0.0 || !measured.is_finite() {
             return;
         }
         let mut x = [0.0; LAGS];
@@ -79,7 +79,9 @@ impl YawLag {
                 self.t_end = f64::NAN;
                 return;
             }
-            if i == 0 && !((t_start - self.t_end).abs() < 0.5 * h) {
+            // (NaN: no interval before.)
+            let continues = (t_start - self.t_end).abs() < 0.5 * h;
+            if i == 0 && !continues {
                 self.rates = [r; LAGS];
             }
             for (k, (y, x)) in self.rates.iter_mut().zip(x.iter_mut()).enumerate() {
