@@ -6,7 +6,8 @@
 //! soft tyres that lag is a few tenths of a second, as much as a slow steering's, and it is
 //! not the steering's (the wheel-angle sensor sees the wheels at `δ` already), so calibration,
 //! which measures the steering, does not see it. Left out, the default law's turns exit late
-//! and every line after a 15 km/h turn starts 0.6–1 m off (docs/envelope.md, session 26).
+//! and every line after a 15 km/h turn starts 0.6–1 m off (docs/envelope.md, Session 26: a
+//! side draft's crab as the vehicle keeps it, the vehicle's own lag led on).
 //!
 //! It is measured here, on every fix interval the observer learns from: a bank of first-order
 //! lags `τ_k = k · LAG_STEP_S` (k = 0 … `LAGS` − 1) filters the kinematic yaw rate of the
@@ -73,14 +74,14 @@ impl YawLag {
             return;
         }
         let mut x = [0.0; LAGS];
+        // (False after no interval: `t_end` NaN.)
+        let continues = (t_start - self.t_end).abs() < 0.5 * h;
         for i in 0..steps {
             let r = rate(i);
             if !r.is_finite() {
                 self.t_end = f64::NAN;
                 return;
             }
-            // (NaN: no interval before.)
-            let continues = (t_start - self.t_end).abs() < 0.5 * h;
             if i == 0 && !continues {
                 self.rates = [r; LAGS];
             }
@@ -150,7 +151,8 @@ impl super::Estimator {
         let h = i.dt / steps.max(1) as f64;
         let mut cursor = self.first_wheel_sample_at(i.t_prev + 0.5 * h);
         let (l, bias) = (self.params.wheelbase, self.bias);
-        let mut bank = self.yaw_lag;
+        // (Taken out while the closure below borrows the estimator.)
+        let mut bank = std::mem::take(&mut self.yaw_lag);
         bank.interval(
             i.t_prev,
             steps,
