@@ -43,6 +43,8 @@ pub struct YawLag {
     sxm: [f64; LAGS],
     /// Σ m², forgotten.
     smm: f64,
+    /// The lag the sums give, found once per interval (the control period asks for it).
+    lag: Option<f64>,
 }
 
 impl Default for YawLag {
@@ -53,6 +55,7 @@ impl Default for YawLag {
             sxx: [0.0; LAGS],
             sxm: [0.0; LAGS],
             smm: 0.0,
+            lag: None,
         }
     }
 }
@@ -98,11 +101,17 @@ impl YawLag {
             self.sxm[k] = keep * self.sxm[k] + x * measured;
         }
         self.smm = keep * self.smm + measured * measured;
+        self.lag = self.fit();
     }
 
     /// The vehicle's lag, s: the bank's best, refined between its neighbours by a parabola;
     /// `None` until the turns have moved the heading enough.
     pub fn lag(&self) -> Option<f64> {
+        self.lag
+    }
+
+    /// [`YawLag::lag`] from the sums.
+    fn fit(&self) -> Option<f64> {
         if self.smm < MIN_EXCITATION_RAD2 {
             return None;
         }
