@@ -382,9 +382,7 @@ impl Controller {
             let max = self.params.tracker.max_wheel_angle;
             // Turn the wheels when the law asks despite the steering's lag (the filter passes
             // the demand through where the law does not ask or the steering is quick).
-            if needs.lag_lead {
-                self.lag_lead.set_vehicle_lag(self.estimator.vehicle_lag());
-            }
+            self.lag_lead.set_vehicle_lag(self.estimator.vehicle_lag());
             tr.wheel_angle = self.lag_lead.command(tr.wheel_angle, dt).clamp(-max, max);
             // Put the wheels where the command says despite the steering's play; learn the
             // play on work lines from commands the actuator followed.

@@ -121,14 +121,14 @@ impl ControlParams {
         )
     }
 
-    /// The lead on the steering's calibrated lag for a law with `needs` (off when it does not
-    /// use it).
+    /// The lead on the steering's calibrated lag (and the vehicle's learnt one) for a law with
+    /// `needs` (off when it does not use it).
     pub fn lag_lead_for(&self, needs: LawNeeds) -> LagLead {
-        LagLead::new(if needs.lag_lead {
-            self.tracker.steering.lag
+        if needs.lag_lead {
+            LagLead::new(self.tracker.steering.lag)
         } else {
-            0.0
-        })
+            LagLead::off()
+        }
     }
 
     /// The lost-motion compensation for a law with `needs` (off when it does not use it).

@@ -1,8 +1,10 @@
 //! Lag lead: the part of the steering's first-order lag beyond [`RESIDUAL_LAG`] cancelled by
 //! a lead-lag filter on the command.
 //!
-//! The wheels follow the command through a lag τ (`safety.actuator_tau_s`, which
-//! `agsteer calibrate` measures). Pure pursuit's loop can only be made as fast as that lag
+//! The wheels follow the command through a lag (`safety.actuator_tau_s`, which
+//! `agsteer calibrate` measures), and the vehicle's heading follows its wheels through a lag
+//! of its own (tyres, yaw inertia) that the estimator learns while driving
+//! (`estimate::yaw_lag`); τ is their sum. Pure pursuit's loop can only be made as fast as that lag
 //! allows ([`super::TrackerParams::response_time`] lengthens the look-ahead to keep the lag's
 //! phase in budget): at τ = 0.6 s and 15 km/h the look-ahead grew to 7 m and a line start's
 //! 10 cm entry error took 20 m to go (the envelope's lag_0.6 row, docs/envelope.md). The
@@ -27,6 +29,9 @@ pub const RESIDUAL_LAG: f64 = 0.15;
 /// The filter's state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LagLead {
+    /// The law asks for the lead: without it the demand always passes through, whatever the
+    /// lags.
+    on: bool,
     /// The steering's lag, s.
     lag: f64,
     /// The vehicle's own lag behind its wheels (tyres, yaw inertia; `estimate::yaw_lag`),
@@ -38,18 +43,28 @@ pub struct LagLead {
 }
 
 impl LagLead {
-    /// The filter for a steering lag `lag` (s); a non-finite or small one leaves it off.
+    /// The filter for a steering lag `lag` (s); a non-finite or small one leaves it off until
+    /// a vehicle lag makes the sum exceed [`RESIDUAL_LAG`].
     pub fn new(lag: f64) -> Self {
         LagLead {
+            on: true,
             lag: if lag.is_finite() { lag } else { 0.0 },
             vehicle: 0.0,
             filtered: f64::NAN,
         }
     }
 
-    /// Whether the filter changes anything (the lag exceeds [`RESIDUAL_LAG`]).
+    /// No lead, whatever the lags (a law that does not ask for it).
+    pub fn off() -> Self {
+        LagLead {
+            on: false,
+            ..LagLead::new(0.0)
+        }
+    }
+
+    /// Whether the filter changes anything (on, and the lags exceed [`RESIDUAL_LAG`]).
     pub fn active(&self) -> bool {
-        self.lag + self.vehicle > RESIDUAL_LAG
+        self.on && self.lag + self.vehicle > RESIDUAL_LAG
     }
 
     /// The vehicle's lag as learnt now, s (a non-finite or negative one counts as none).
@@ -103,6 +118,11 @@ mod tests {
         assert!(first > 0.25 && first < 0.27, "{first}");
         lead.set_vehicle_lag(f64::NAN);
         assert!(!lead.active());
+        // A law without the lead: nothing, whatever the vehicle's lag.
+        let mut off = LagLead::off();
+        off.set_vehicle_lag(0.5);
+        assert!(!off.active());
+        assert_eq!(off.command(0.3, 0.01), 0.3);
     }
 
     /// The wheels of a first-order lag `tau` (s) driven by `command` from rest, sampled every
