@@ -14,6 +14,7 @@
 
 use super::geometry::{offset, simplified, Area};
 use super::CoverageParams;
+use crate::geo::polygon::contains_point;
 pub use crate::geo::polygon::resample;
 use crate::geo::{cross, v2, Vec2};
 use geo::BooleanOps;
@@ -420,14 +421,32 @@ const LEFTOVER_SIMPLIFY_M: f64 = 0.05;
 /// found, m ([`with_leftover`]).
 const LEFTOVER_SLACK_M: f64 = 0.05;
 
+/// The ground a plan works by swaths ([`with_leftover`]).
+#[derive(Debug, Clone, Default)]
+pub struct Worked {
+    /// The working area with the leftover ground wide enough for it: swaths at the field's
+    /// swath angle.
+    pub working: Vec<Area>,
+    /// Leftover pieces too narrow for a disc an implement wide, each worked by its own swaths
+    /// along it (its own minimum-span angle): a strip between the passes' footprints in an arm
+    /// the inner passes do not reach, which swaths across it at the field's angle would only
+    /// cross for a few metres.
+    pub narrow: Vec<Area>,
+}
+
 /// The working area with the ground inside the outermost pass that neither the passes'
-/// footprints nor `working` cover, where a disc an implement wide fits (an opening of radius
-/// w/2) and the piece is larger than 4·w²: in an arm narrower than the inner passes need (each
-/// pass is opened at r_min and vanishes there) that ground was never worked; as working area it
-/// gets swaths, with turns on the passes' ground where they fit.
-pub fn with_leftover(working: Vec<Area>, passes: &Passes, p: &CoverageParams) -> Vec<Area> {
+/// footprints nor `working` cover, larger than 4·w² and a mean w/2 thick at least: in an arm
+/// narrower than the inner passes need (each pass is opened at r_min and vanishes there) that
+/// ground was never worked. Where a disc an implement wide fits (an opening of radius w/2) it
+/// joins the working area and gets swaths, with turns on the passes' ground where they fit;
+/// a piece where none fits is a strip narrower than the implement ([`Worked::narrow`]), worked
+/// along its length.
+pub fn with_leftover(working: Vec<Area>, passes: &Passes, p: &CoverageParams) -> Worked {
     if passes.areas.is_empty() {
-        return working;
+        return Worked {
+            working,
+            narrow: Vec::new(),
+        };
     }
     let half = p.line_width / 2.0;
     let min_area = 4.0 * p.line_width * p.line_width;
@@ -455,14 +474,33 @@ pub fn with_leftover(working: Vec<Area>, passes: &Passes, p: &CoverageParams) ->
         })
         .collect();
     let eroded = offset(&simplified(&left, LEFTOVER_SIMPLIFY_M), -half);
-    let left: Vec<Area> = offset(&simplified(&eroded, LEFTOVER_SIMPLIFY_M), half)
+    let wide: Vec<Area> = offset(&simplified(&eroded, LEFTOVER_SIMPLIFY_M), half)
         .into_iter()
         .filter(|a| super::geometry::area_m2(a) > min_area)
         .collect();
-    if left.is_empty() {
-        return working;
-    }
-    union(&working, &left)
+    // The pieces the opening kept nothing of: strips narrower than the implement (a kept
+    // piece's vertices lie in or on the pieces it came from, within the simplification).
+    let near = |q: &Vec2, (outer, holes): &Area| {
+        std::iter::once(outer)
+            .chain(holes)
+            .any(|ring| ring_distance(std::slice::from_ref(q), ring) < 2.0 * LEFTOVER_SIMPLIFY_M)
+            || (contains_point(outer, q) && !holes.iter().any(|h| contains_point(h, q)))
+    };
+    // (Sixteen of each kept piece's vertices, spread round it, stand for it.)
+    let samples: Vec<Vec2> = wide
+        .iter()
+        .flat_map(|w| w.0.iter().step_by(w.0.len().div_ceil(16).max(1)).copied())
+        .collect();
+    let narrow: Vec<Area> = left
+        .into_iter()
+        .filter(|piece| !samples.iter().any(|q| near(q, piece)))
+        .collect();
+    let working = if wide.is_empty() {
+        working
+    } else {
+        union(&working, &wide)
+    };
+    Worked { working, narrow }
 }
 
 /// The area of pass centres at offset `d` (boundary shrunk by `d`, obstacles grown by `d`, the

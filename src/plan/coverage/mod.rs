@@ -185,7 +185,7 @@ fn plan_once(
         margin,
     );
     let passes = headland::passes_around(&field.boundary, &large, p);
-    let working = headland::with_leftover(
+    let headland::Worked { working, narrow } = headland::with_leftover(
         headland::working_area(&field.boundary, &large, p),
         &passes,
         p,
@@ -246,6 +246,12 @@ fn plan_once(
                 }
             }
         }
+    }
+    // Leftover strips narrower than the implement: worked along their length, whatever angle.
+    let (mut working, worked_cells) = (working, cells.len());
+    for piece in narrow {
+        let a = swath_angle::min_span(&piece.0).map_or(0.0, |s| s.0);
+        cells.push((piece, a));
     }
 
     // The pieces of the outermost pass's area, worked one after the other.
@@ -526,6 +532,10 @@ fn plan_once(
     // exactly w apart (see `swath_lines`).
     let exact = p.sections > 1 && headland::passes(p) > 0;
     for (ci, (cell, angle)) in cells.iter().enumerate() {
+        if ci == worked_cells && swath_total == 0 {
+            // Strips alone are no plan: `narrow::plan_field` tries fewer passes first.
+            break;
+        }
         let lines = swaths::swath_lines(cell, &safe, *angle, p.pass_spacing(), widening, exact);
         // The lines' n·s − span plus the overlap each of the n footprints lays beyond s.
         overlap_m2 += (lines.overlap_m + lines.ys.len() as f64 * p.overlap)
@@ -541,6 +551,10 @@ fn plan_once(
             pending.push((ci, *angle, run, lines.clone()));
         }
     }
+    if swath_total == 0 {
+        cells.truncate(worked_cells);
+    }
+    working.extend(cells[worked_cells..].iter().map(|c| c.0.clone()));
     // A field in parts a tractor cannot drive between inside the boundary: the largest part
     // is planned, the others are dropped and named (each can be planned as a field of its own).
     let parts = narrow::parts(field);

@@ -274,6 +274,52 @@ fn an_arm_narrower_than_the_inner_passes_is_worked() {
     assert_eq!(plan.transit_gaps, 0);
 }
 
+/// An L whose arm (34 m wide) holds the outer pass at w 12 m but not the inner one: between the
+/// outer pass's footprints a strip 10 m wide is left, too narrow for a disc an implement wide,
+/// and swaths at the field's angle (East) cross it for a few metres at most. Worked along its
+/// length (`headland::Worked::narrow`): a swath runs North up the arm over the strip's middle,
+/// within the guarantees. Before, the strip was left (10 × 90 m unworked).
+#[test]
+fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
+    let field = Field {
+        boundary: vec![
+            v2(0.0, 0.0),
+            v2(120.0, 0.0),
+            v2(120.0, 100.0),
+            v2(34.0, 100.0),
+            v2(34.0, 220.0),
+            v2(0.0, 220.0),
+        ],
+        obstacles: vec![],
+    };
+    let p = CoverageParams {
+        swath_angle: SwathAngle::Fixed { angle: 0.0 },
+        ..params(12.0, 8.0, 2)
+    };
+    let plan = plan_field(&field, &p).unwrap();
+    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
+    assert!(violations.is_empty(), "{violations:?}");
+    for pair in plan.segments.windows(2) {
+        assert!((pair[1].points[0] - *pair[0].points.last().unwrap()).norm() < 1e-6);
+    }
+    // Work up the arm, along it, whose footprint holds the strip's middle.
+    let middle = v2(17.0, 165.0);
+    let up_the_arm = plan
+        .segments
+        .iter()
+        .filter(|s| s.kind == SegmentKind::Work)
+        .any(|s| {
+            let (a, b) = (s.points[0], s.points[s.points.len() - 1]);
+            let along = (b - a).y.abs() > 10.0 * (b - a).x.abs() && (b - a).norm() > 40.0;
+            let over = s.points.windows(2).any(|w| {
+                crate::geo::polygon::point_segment_distance(&middle, &w[0], &w[1])
+                    < p.line_width / 2.0
+            });
+            along && over
+        });
+    assert!(up_the_arm, "no swath up the arm over {middle:?}");
+}
+
 /// Two blocks joined by a neck 12 m wide (w 3 m, r_min 8 m, 3 passes): the outermost pass's
 /// area is two pieces, one per block, and the neck is tight to drive through. Each block is
 /// worked whole (its headland passes and swaths) before the other: the work crosses the neck
