@@ -254,6 +254,10 @@ pub(super) fn drive_run(
                 } else {
                     end2.max(apex)
                 };
+                if (e_new - s) * dir <= 0.0 || (start2 - far2) * dir <= 0.0 {
+                    // Pulled back past a swath's other end: no swath is left to turn from.
+                    break;
+                }
                 let mut parts = cache.turn(world(apex, y), d, world(apex, y2), tp)?;
                 let lead_in = world(e_new, y);
                 // A lead-in or tail shorter than SNAP_M moves the turn's end point instead:
