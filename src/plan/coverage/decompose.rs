@@ -8,6 +8,42 @@ use super::swath_angle::min_span;
 use crate::geo::{cross, Vec2};
 use geo::BooleanOps;
 
+/// The cells of the working area `working` with their swath angles (rad): every area at the
+/// field's angle (`field.swath_angle` fixed, or the minimum span of the whole working area),
+/// or cut into convex cells merged where single swaths still sweep them, each at its own
+/// minimum span (`min_turns`); then each piece of `own` ([`super::headland::Worked::own`]) at
+/// its own minimum span, last.
+pub fn cells(working: &[Area], own: &[Area], p: &super::CoverageParams) -> Vec<(Area, f64)> {
+    use super::SwathAngle;
+    let own_angle = |a: &Area| min_span(&a.0).map_or(0.0, |s| s.0);
+    let global_angle = match p.swath_angle {
+        SwathAngle::Fixed { angle } => Some(angle),
+        SwathAngle::MinSpan => {
+            let pts: Vec<Vec2> = working.iter().flat_map(|a| a.0.iter().copied()).collect();
+            min_span(&pts).map(|s| s.0)
+        }
+        SwathAngle::MinTurns => None,
+    };
+    let mut cells: Vec<(Area, f64)> = Vec::new();
+    for area in working {
+        match global_angle {
+            Some(a) => cells.push((area.clone(), a)),
+            None => {
+                let pieces: Vec<Area> = convex_cells(&area.0)
+                    .into_iter()
+                    .flat_map(|c| from_geo(&to_geo(&(c, vec![])).intersection(&to_geo(area))))
+                    .collect();
+                for c in merge_cells(pieces, p.pass_spacing()) {
+                    let a = own_angle(&c);
+                    cells.push((c, a));
+                }
+            }
+        }
+    }
+    cells.extend(own.iter().map(|a| (a.clone(), own_angle(a))));
+    cells
+}
+
 /// Largest number of cuts made (a guard against degenerate input).
 const MAX_CUTS: usize = 256;
 

@@ -427,11 +427,11 @@ pub struct Worked {
     /// The working area with the leftover ground wide enough for it: swaths at the field's
     /// swath angle.
     pub working: Vec<Area>,
-    /// Leftover pieces too narrow for a disc an implement wide, each worked by its own swaths
-    /// along it (its own minimum-span angle): a strip between the passes' footprints in an arm
-    /// the inner passes do not reach, which swaths across it at the field's angle would only
-    /// cross for a few metres.
-    pub narrow: Vec<Area>,
+    /// Pieces worked as cells of their own, each at its own minimum-span angle: leftover strips
+    /// too narrow for a disc an implement wide (between the passes' footprints in an arm the
+    /// inner passes do not reach, which swaths at the field's angle would only cross for a few
+    /// metres), and the ground outside the outermost pass where it splits at a neck.
+    pub own: Vec<Area>,
 }
 
 /// The working area with the ground inside the outermost pass that neither the passes'
@@ -439,13 +439,18 @@ pub struct Worked {
 /// narrower than the inner passes need (each pass is opened at r_min and vanishes there) that
 /// ground was never worked. Where a disc an implement wide fits (an opening of radius w/2) it
 /// joins the working area and gets swaths, with turns on the passes' ground where they fit;
-/// a piece where none fits is a strip narrower than the implement ([`Worked::narrow`]), worked
-/// along its length.
-pub fn with_leftover(working: Vec<Area>, passes: &Passes, p: &CoverageParams) -> Worked {
+/// a piece where none fits is a strip narrower than the implement, worked along its length
+/// ([`Worked::own`]), and so is the ground a neck leaves outside the outermost pass.
+pub fn with_leftover(
+    working: Vec<Area>,
+    (boundary, obstacles): (&[Vec2], &[Vec<Vec2>]),
+    passes: &Passes,
+    p: &CoverageParams,
+) -> Worked {
     if passes.areas.is_empty() {
         return Worked {
             working,
-            narrow: Vec::new(),
+            own: Vec::new(),
         };
     }
     let half = p.line_width / 2.0;
@@ -473,6 +478,20 @@ pub fn with_leftover(working: Vec<Area>, passes: &Passes, p: &CoverageParams) ->
             area > min_area && 2.0 * area >= half * super::geometry::perimeter(a)
         })
         .collect();
+    // Outside the outermost pass's footprint: where the field narrows to a neck, the outermost
+    // pass (opened at r_min) splits into rings round each side and leaves the neck's ground;
+    // kept where a disc of the turns' radius (and the implement's width) fits, which the
+    // corners that the pass rounds off (the unreachable ground) do not hold.
+    let junctions = {
+        let reach0 = pass_offset(p, 0) + LEFTOVER_SLACK_M;
+        let around = difference(
+            &[(boundary.to_vec(), obstacles.to_vec())],
+            &offset(&areas[0], reach0),
+        );
+        let r = (p.r_min * SMOOTHING_RADIUS_FACTOR).max(half);
+        let eroded = offset(&simplified(&around, LEFTOVER_SIMPLIFY_M), -r);
+        offset(&simplified(&eroded, LEFTOVER_SIMPLIFY_M), r)
+    };
     let eroded = offset(&simplified(&left, LEFTOVER_SIMPLIFY_M), -half);
     let wide: Vec<Area> = offset(&simplified(&eroded, LEFTOVER_SIMPLIFY_M), half)
         .into_iter()
@@ -495,12 +514,20 @@ pub fn with_leftover(working: Vec<Area>, passes: &Passes, p: &CoverageParams) ->
         .into_iter()
         .filter(|piece| !samples.iter().any(|q| near(q, piece)))
         .collect();
+    let own = narrow
+        .into_iter()
+        .chain(
+            junctions
+                .into_iter()
+                .filter(|a| super::geometry::area_m2(a) > min_area),
+        )
+        .collect();
     let working = if wide.is_empty() {
         working
     } else {
         union(&working, &wide)
     };
-    Worked { working, narrow }
+    Worked { working, own }
 }
 
 /// The area of pass centres at offset `d` (boundary shrunk by `d`, obstacles grown by `d`, the

@@ -185,8 +185,9 @@ fn plan_once(
         margin,
     );
     let passes = headland::passes_around(&field.boundary, &large, p);
-    let headland::Worked { working, narrow } = headland::with_leftover(
+    let headland::Worked { working, own } = headland::with_leftover(
         headland::working_area(&field.boundary, &large, p),
+        (&field.boundary, &large),
         &passes,
         p,
     );
@@ -215,44 +216,12 @@ fn plan_once(
             .get_or_init(|| grid_of(loose, tests.clearance.1))
     };
     let warnings = std::cell::RefCell::new(Vec::<String>::new());
+    let warnings_len = || warnings.borrow().len();
     let transit_gaps = std::cell::Cell::new(0);
 
-    // Cells and their swath directions.
-    let global_angle = match p.swath_angle {
-        SwathAngle::Fixed { angle } => Some(angle),
-        SwathAngle::MinSpan => {
-            let pts: Vec<Vec2> = working.iter().flat_map(|a| a.0.iter().copied()).collect();
-            swath_angle::min_span(&pts).map(|s| s.0)
-        }
-        SwathAngle::MinTurns => None,
-    };
-    let mut cells: Vec<(geometry::Area, f64)> = Vec::new();
-    for area in &working {
-        match global_angle {
-            Some(a) => cells.push((area.clone(), a)),
-            None => {
-                let pieces: Vec<geometry::Area> = decompose::convex_cells(&area.0)
-                    .into_iter()
-                    .flat_map(|c| {
-                        use geo::BooleanOps;
-                        let g =
-                            geometry::to_geo(&(c, vec![])).intersection(&geometry::to_geo(area));
-                        geometry::from_geo(&g)
-                    })
-                    .collect();
-                for c in decompose::merge_cells(pieces, p.pass_spacing()) {
-                    let a = swath_angle::min_span(&c.0).map(|s| s.0).unwrap_or(0.0);
-                    cells.push((c, a));
-                }
-            }
-        }
-    }
-    // Leftover strips narrower than the implement: worked along their length, whatever angle.
-    let (mut working, worked_cells) = (working, cells.len());
-    for piece in narrow {
-        let a = swath_angle::min_span(&piece.0).map_or(0.0, |s| s.0);
-        cells.push((piece, a));
-    }
+    // Cells and their swath directions; the pieces worked on their own after the others.
+    let mut cells = decompose::cells(&working, &own, p);
+    let (mut working, worked_cells) = (working, cells.len() - own.len());
 
     // The pieces of the outermost pass's area, worked one after the other.
     let regions = regions::Regions::new(passes.areas.first());
@@ -742,6 +711,11 @@ fn plan_once(
                         break;
                     };
                     let (_, _, (ci, angle, run, lines)) = pending.swap_remove(k);
+                    // A run of those cells that no transit reaches, or leaves for where it was
+                    // entered from, is left (not driven to by hand): what it held is put back.
+                    let gaps = transit_gaps.get();
+                    let undo = (ci >= worked_cells)
+                        .then(|| (segments.len(), segments.last().cloned(), at, warnings_len()));
                     drive_run(
                         &run,
                         &lines,
@@ -759,6 +733,21 @@ fn plan_once(
                         &detour,
                         &small_discs,
                     )?;
+                    if let Some((_, _, Some((q, h)), _)) =
+                        undo.as_ref().filter(|_| transit_gaps.get() == gaps)
+                    {
+                        let back = [*q, q + crate::geo::heading_vec(*h)];
+                        go_to(&mut Vec::new(), &mut at.clone(), &back, ci);
+                    }
+                    if let Some(u) = undo.filter(|_| transit_gaps.get() > gaps) {
+                        segments.truncate(u.0);
+                        if let (Some(last), Some(kept)) = (segments.last_mut(), u.1) {
+                            *last = kept;
+                        }
+                        (at, swath_total) = (u.2, swath_total - run.len());
+                        warnings.borrow_mut().truncate(u.3);
+                        transit_gaps.set(gaps);
+                    }
                 }
             }
         }

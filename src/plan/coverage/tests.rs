@@ -320,6 +320,51 @@ fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
     assert!(up_the_arm, "no swath up the arm over {middle:?}");
 }
 
+/// Two blocks joined by a neck 22 m wide and 60 m long (w 6 m, r_min 8 m): the outermost
+/// pass, opened at r_min, cannot run through the neck and splits into a ring round each block,
+/// leaving the neck's ground outside both. Worked as a cell of its own (`headland::Worked::own`):
+/// some work's footprint holds the neck's middle, within the guarantees and with no gap.
+#[test]
+fn the_ground_a_neck_leaves_outside_the_outer_pass_is_worked() {
+    let field = Field {
+        boundary: vec![
+            v2(0.0, 0.0),
+            v2(80.0, 0.0),
+            v2(80.0, 29.0),
+            v2(140.0, 29.0),
+            v2(140.0, 0.0),
+            v2(220.0, 0.0),
+            v2(220.0, 80.0),
+            v2(140.0, 80.0),
+            v2(140.0, 51.0),
+            v2(80.0, 51.0),
+            v2(80.0, 80.0),
+            v2(0.0, 80.0),
+        ],
+        obstacles: vec![],
+    };
+    let p = CoverageParams {
+        swath_angle: SwathAngle::MinSpan,
+        ..params(6.0, 8.0, 2)
+    };
+    let plan = plan_field(&field, &p).unwrap();
+    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
+    assert!(violations.is_empty(), "{violations:?}");
+    assert_eq!(plan.transit_gaps, 0, "{:?}", plan.warnings);
+    let middle = v2(110.0, 40.0);
+    let over = plan
+        .segments
+        .iter()
+        .filter(|s| s.kind == SegmentKind::Work)
+        .any(|s| {
+            s.points.windows(2).any(|w| {
+                crate::geo::polygon::point_segment_distance(&middle, &w[0], &w[1])
+                    < p.line_width / 2.0
+            })
+        });
+    assert!(over, "no work over the neck's middle {middle:?}");
+}
+
 /// Two blocks joined by a neck 12 m wide (w 3 m, r_min 8 m, 3 passes): the outermost pass's
 /// area is two pieces, one per block, and the neck is tight to drive through. Each block is
 /// worked whole (its headland passes and swaths) before the other: the work crosses the neck
