@@ -481,8 +481,11 @@ pub fn with_leftover(
     // Outside the outermost pass's footprint: where the field narrows to a neck, the outermost
     // pass (opened at r_min) splits into rings round each side and leaves the neck's ground;
     // kept where a disc of the turns' radius (and the implement's width) fits, which the
-    // corners that the pass rounds off (the unreachable ground) do not hold.
-    let junctions = {
+    // corners that the pass rounds off (the unreachable ground) do not hold. (A pass that did
+    // not split runs through every neck: nothing to find, and the clips are skipped.)
+    let junctions = if areas[0].len() < 2 {
+        Vec::new()
+    } else {
         let reach0 = pass_offset(p, 0) + LEFTOVER_SLACK_M;
         let around = difference(
             &[(boundary.to_vec(), obstacles.to_vec())],

@@ -348,6 +348,10 @@ fn plan_once(
         attempts.extend(
             (1..REVERSE_CUTS).map(|i| (i * max_cut / (REVERSE_CUTS - 1), Way::Reverse, true)),
         );
+        if cell >= worked_cells {
+            // (To a cell of its own, left when not reached: no waypoint search, the dearest.)
+            attempts.retain(|a| !matches!(a.1, Way::Waypoints));
+        }
         let mut found = None;
         // The relaxed headland attempt without shortening, made first (once) where the tests
         // differ and one of this plan's relaxed headland attempts found no way before: its
