@@ -277,7 +277,7 @@ fn an_arm_narrower_than_the_inner_passes_is_worked() {
 /// An L whose arm (34 m wide) holds the outer pass at w 12 m but not the inner one: between the
 /// outer pass's footprints a strip 10 m wide is left, too narrow for a disc an implement wide,
 /// and swaths at the field's angle (East) cross it for a few metres at most. Worked along its
-/// length (`headland::Worked::narrow`): a swath runs North up the arm over the strip's middle,
+/// length (`headland::Worked::own`): a swath runs North up the arm over the strip's middle,
 /// within the guarantees. Before, the strip was left (10 × 90 m unworked).
 #[test]
 fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
@@ -304,20 +304,27 @@ fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
     }
     // Work up the arm, along it, whose footprint holds the strip's middle.
     let middle = v2(17.0, 165.0);
-    let up_the_arm = plan
-        .segments
+    let up_the_arm = work_over(&plan, &middle, p.line_width / 2.0).any(|s| {
+        let (a, b) = (s.points[0], s.points[s.points.len() - 1]);
+        (b - a).y.abs() > 10.0 * (b - a).x.abs() && (b - a).norm() > 40.0
+    });
+    assert!(up_the_arm, "no swath up the arm over {middle:?}");
+}
+
+/// The work segments of `plan` whose footprint (`half` m either side) holds `q`.
+fn work_over<'a>(
+    plan: &'a FieldPlan,
+    q: &'a Vec2,
+    half: f64,
+) -> impl Iterator<Item = &'a PlanSegment> + 'a {
+    plan.segments
         .iter()
         .filter(|s| s.kind == SegmentKind::Work)
-        .any(|s| {
-            let (a, b) = (s.points[0], s.points[s.points.len() - 1]);
-            let along = (b - a).y.abs() > 10.0 * (b - a).x.abs() && (b - a).norm() > 40.0;
-            let over = s.points.windows(2).any(|w| {
-                crate::geo::polygon::point_segment_distance(&middle, &w[0], &w[1])
-                    < p.line_width / 2.0
-            });
-            along && over
-        });
-    assert!(up_the_arm, "no swath up the arm over {middle:?}");
+        .filter(move |s| {
+            s.points
+                .windows(2)
+                .any(|w| crate::geo::polygon::point_segment_distance(q, &w[0], &w[1]) < half)
+        })
 }
 
 /// Two blocks joined by a neck 22 m wide and 60 m long (w 6 m, r_min 8 m): the outermost
@@ -352,16 +359,9 @@ fn the_ground_a_neck_leaves_outside_the_outer_pass_is_worked() {
     assert!(violations.is_empty(), "{violations:?}");
     assert_eq!(plan.transit_gaps, 0, "{:?}", plan.warnings);
     let middle = v2(110.0, 40.0);
-    let over = plan
-        .segments
-        .iter()
-        .filter(|s| s.kind == SegmentKind::Work)
-        .any(|s| {
-            s.points.windows(2).any(|w| {
-                crate::geo::polygon::point_segment_distance(&middle, &w[0], &w[1])
-                    < p.line_width / 2.0
-            })
-        });
+    let over = work_over(&plan, &middle, p.line_width / 2.0)
+        .next()
+        .is_some();
     assert!(over, "no work over the neck's middle {middle:?}");
 }
 
