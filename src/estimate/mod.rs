@@ -416,25 +416,19 @@ impl Estimator {
     /// Integrate the bicycle model from `pose` at `t0` over `span` s at speed `v`, with the
     /// measured wheel angles less the estimated offset and the estimated drift.
     fn propagate(&self, pose: Pose, v: f64, t0: f64, span: f64) -> Pose {
-        let steps = (span / PREDICT_STEP).ceil() as usize;
+        let (steps, h, mut yaw_rate) = self.model_yaw_rates(v, t0, span);
         let (mut x, mut y, mut th) = (pose.pos.x, pose.pos.y, pose.heading);
-        let l = self.params.wheelbase;
         // The slope slip's speed to the left is fixed over the span (the latest roll), so it
         // is worked out once, not per step (see [`Estimator::drift_velocity`]).
         let slip_left = self.slip * self.roll.sin();
         if steps > 0 {
-            let h = span / steps as f64;
-            // The steps' times only grow: the first sample they need is found once, by
-            // bisection, not by a scan of the whole ring (2.56 s of samples at 100 Hz).
-            let mut cursor = self.first_wheel_sample_at(t0 + 0.5 * h);
             // The heading's sine and cosine are carried from step to step by rotations through
             // each half step's small angle, not taken afresh: a sin/cos per step is most of
             // this loop's cost, and it runs at every fix and every control period.
             let (mut sin, mut cos) = th.sin_cos();
             for i in 0..steps {
                 // Midpoint rule for the heading keeps the arc accurate at this step.
-                let t_mid = t0 + (i as f64 + 0.5) * h;
-                let rate = v * (self.wheel_angle_from(t_mid, &mut cursor) - self.bias).tan() / l;
+                let rate = yaw_rate(i);
                 let half = small_sin_cos(0.5 * h * rate);
                 (sin, cos) = rotate((sin, cos), half);
                 // At the midpoint: the motion and the slip's direction.

@@ -156,23 +156,34 @@ impl super::Estimator {
             return;
         }
         let measured = crate::geo::wrap_angle(i.heading + (i.predicted.heading - previous.heading));
-        let steps = (i.dt / super::PREDICT_STEP).ceil() as usize;
-        let h = i.dt / steps.max(1) as f64;
-        let mut cursor = self.first_wheel_sample_at(i.t_prev + 0.5 * h);
-        let (l, bias) = (self.params.wheelbase, self.bias);
-        // (Taken out while the closure below borrows the estimator.)
+        // (Taken out while the model's rates borrow the estimator.)
         let mut bank = std::mem::take(&mut self.yaw_lag);
-        bank.interval(
-            i.t_prev,
-            steps,
-            h,
-            |k| {
-                let t = i.t_prev + (k as f64 + 0.5) * h;
-                v * (self.wheel_angle_from(t, &mut cursor) - bias).tan() / l
-            },
-            measured,
-        );
+        let (steps, h, yaw_rate) = self.model_yaw_rates(v, i.t_prev, i.dt);
+        bank.interval(i.t_prev, steps, h, yaw_rate, measured);
         self.yaw_lag = bank;
+    }
+
+    /// The bicycle model's yaw rate over `span` s from `t0` at speed `v` (m/s), in the
+    /// prediction's steps (at most [`super::PREDICT_STEP`]): the step count, the step (s) and
+    /// the rate (rad/s) at step `i`'s middle from the measured wheel angles less the
+    /// estimated offset, asked for in order (`propagate` and the bank above use the same).
+    pub(super) fn model_yaw_rates(
+        &self,
+        v: f64,
+        t0: f64,
+        span: f64,
+    ) -> (usize, f64, impl FnMut(usize) -> f64 + '_) {
+        let steps = (span / super::PREDICT_STEP).ceil() as usize;
+        let h = span / steps.max(1) as f64;
+        // The steps' times only grow: the first sample they need is found once, by bisection,
+        // not by a scan of the whole ring (2.56 s of samples at 100 Hz).
+        let mut cursor = self.first_wheel_sample_at(t0 + 0.5 * h);
+        let l = self.params.wheelbase;
+        let rate = move |i: usize| {
+            let t_mid = t0 + (i as f64 + 0.5) * h;
+            v * (self.wheel_angle_from(t_mid, &mut cursor) - self.bias).tan() / l
+        };
+        (steps, h, rate)
     }
 
     /// The vehicle's lag learnt so far, s (0 until learnt: [the module](self)).
