@@ -1,4 +1,4 @@
-//! [`super::implement_clear`] for every point a plan tries, made cheap: a lazily filled grid
+//! [`implement_clear`] for every point a plan tries, made cheap: a lazily filled grid
 //! of cells that are clear throughout (one lookup), blocked throughout, or near an edge. A cell
 //! near an edge keeps the edges within reach of it and a reference point whose side of every
 //! ring is known, so a point there is checked against those few edges (its distance to each,
@@ -7,11 +7,30 @@
 //! A cell is classified against the edges near its block of [`BLOCK`] × [`BLOCK`] cells (found
 //! once per block), not against every edge: an edge far from the block is far from its cells.
 
-use super::{implement_clear, Field};
+use super::Field;
 use crate::geo::polygon::{bbox, contains_point, point_segment_distance};
 use crate::geo::{cross, v2, Vec2};
 use std::cell::RefCell;
 use std::ops::Range;
+
+/// A point of a path keeps the implement inside the field and off the obstacles: inside the
+/// boundary and at least `half` m from every boundary edge and every obstacle.
+pub fn implement_clear(field: &Field, half: f64, q: &Vec2) -> bool {
+    use crate::geo::polygon::point_segment_distance;
+    let far = |ring: &Vec<Vec2>| {
+        let n = ring.len();
+        (0..n).all(|i| point_segment_distance(q, &ring[i], &ring[(i + 1) % n]) >= half - 1e-6)
+    };
+    field.contains(q)
+        && std::iter::once(&field.boundary)
+            .chain(&field.obstacles)
+            .all(far)
+}
+
+/// How far a transit that cannot keep the implement clear of the edge keeps its path inside
+/// the field and off the obstacles, m (about half a tractor's width; the implement is lifted
+/// and may reach over the edge there): the guarantee for paths that do not work.
+pub const TRANSIT_CLEARANCE_M: f64 = 1.5;
 
 /// The edges of the rings near one cell.
 #[derive(Debug)]

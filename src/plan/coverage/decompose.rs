@@ -11,7 +11,7 @@ use geo::BooleanOps;
 /// The cells of the working area `working` with their swath angles (rad): every area at the
 /// field's angle (`field.swath_angle` fixed, or the minimum span of the whole working area),
 /// or cut into convex cells merged where single swaths still sweep them, each at its own
-/// minimum span (`min_turns`); then each piece of `own` ([`super::headland::Worked::own`]) at
+/// minimum span (`min_turns`); then each piece of `own` ([`super::leftover::Worked::own`]) at
 /// its own minimum span, last.
 pub fn cells(working: &[Area], own: &[Area], p: &super::CoverageParams) -> Vec<(Area, f64)> {
     use super::SwathAngle;

@@ -12,9 +12,8 @@
 //! such a bend and the corner is what the metrics report as unworked near the corner; the pass
 //! keeps its offset everywhere else (the whole ring is no longer raised to r_min).
 
-use super::geometry::{offset, simplified, Area};
+use super::geometry::{offset, Area};
 use super::CoverageParams;
-use crate::geo::polygon::contains_point;
 pub use crate::geo::polygon::resample;
 use crate::geo::{cross, v2, Vec2};
 use geo::BooleanOps;
@@ -234,13 +233,13 @@ fn corner_disc_centres(ring: &[Vec2], d: f64, r: f64) -> Vec<Vec2> {
         .collect()
 }
 
-fn union(a: &[Area], b: &[Area]) -> Vec<Area> {
+pub(super) fn union(a: &[Area], b: &[Area]) -> Vec<Area> {
     let a = geo::MultiPolygon::new(a.iter().map(super::geometry::to_geo).collect());
     let b = geo::MultiPolygon::new(b.iter().map(super::geometry::to_geo).collect());
     super::geometry::from_geo(&a.union(&b))
 }
 
-fn difference(a: &[Area], b: &[Area]) -> Vec<Area> {
+pub(super) fn difference(a: &[Area], b: &[Area]) -> Vec<Area> {
     let a = geo::MultiPolygon::new(a.iter().map(super::geometry::to_geo).collect());
     let b = geo::MultiPolygon::new(b.iter().map(super::geometry::to_geo).collect());
     super::geometry::from_geo(&a.difference(&b))
@@ -321,7 +320,7 @@ pub fn obstacle_tracks(obstacles: &[Vec<Vec2>], p: &CoverageParams) -> Vec<Vec<V
 }
 
 /// Least distance between two rings that do not cross, m.
-fn ring_distance(a: &[Vec2], b: &[Vec2]) -> f64 {
+pub(super) fn ring_distance(a: &[Vec2], b: &[Vec2]) -> f64 {
     use crate::geo::polygon::point_segment_distance;
     let one_way = |a: &[Vec2], b: &[Vec2]| {
         let n = b.len();
@@ -410,127 +409,6 @@ pub fn passes_around(boundary: &[Vec2], obstacles: &[Vec<Vec2>], p: &CoveragePar
         out.areas.push(opened);
     }
     out
-}
-
-/// Vertices of the leftover ground dropped within this distance of its outline, m
-/// ([`with_leftover`]): its offsets' fine arcs made the clipper cross every edge with every
-/// other (over a second on one parcel), for ground drawn to a few centimetres anyway.
-const LEFTOVER_SIMPLIFY_M: f64 = 0.05;
-
-/// How much wider than the implement each footprint is taken when the leftover ground is
-/// found, m ([`with_leftover`]).
-const LEFTOVER_SLACK_M: f64 = 0.05;
-
-/// The ground a plan works by swaths ([`with_leftover`]).
-#[derive(Debug, Clone, Default)]
-pub struct Worked {
-    /// The working area with the leftover ground wide enough for it: swaths at the field's
-    /// swath angle.
-    pub working: Vec<Area>,
-    /// Pieces worked as cells of their own, each at its own minimum-span angle: leftover strips
-    /// too narrow for a disc an implement wide (between the passes' footprints in an arm the
-    /// inner passes do not reach, which swaths at the field's angle would only cross for a few
-    /// metres), and the ground outside the outermost pass where it splits at a neck.
-    pub own: Vec<Area>,
-}
-
-/// The working area with the ground inside the outermost pass that neither the passes'
-/// footprints nor `working` cover, larger than 4·w² and a mean w/2 thick at least: in an arm
-/// narrower than the inner passes need (each pass is opened at r_min and vanishes there) that
-/// ground was never worked. Where a disc an implement wide fits (an opening of radius w/2) it
-/// joins the working area and gets swaths, with turns on the passes' ground where they fit;
-/// a piece where none fits is a strip narrower than the implement, worked along its length
-/// ([`Worked::own`]), and so is the ground a neck leaves outside the outermost pass.
-pub fn with_leftover(
-    working: Vec<Area>,
-    (boundary, obstacles): (&[Vec2], &[Vec<Vec2>]),
-    passes: &Passes,
-    p: &CoverageParams,
-) -> Worked {
-    if passes.areas.is_empty() {
-        return Worked {
-            working,
-            own: Vec::new(),
-        };
-    }
-    let half = p.line_width / 2.0;
-    let min_area = 4.0 * p.line_width * p.line_width;
-    // Inside pass k's footprint and outside pass k + 1's (the working area's after the last):
-    // the footprints tile the headland, so their edges coincide where both passes run; each
-    // footprint is taken LEFTOVER_SLACK_M wider, which keeps the clipper off coincident edges.
-    let reach = half + LEFTOVER_SLACK_M;
-    let areas: Vec<Vec<Area>> = passes
-        .areas
-        .iter()
-        .map(|a| simplified(a, LEFTOVER_SIMPLIFY_M))
-        .collect();
-    let left: Vec<Area> = (0..areas.len())
-        .flat_map(|k| {
-            let inner = match areas.get(k + 1) {
-                Some(next) => offset(next, reach),
-                None => offset(&simplified(&working, LEFTOVER_SIMPLIFY_M), LEFTOVER_SLACK_M),
-            };
-            difference(&offset(&areas[k], -reach), &inner)
-        })
-        // Slivers (mean thickness 2·area/perimeter under w/2) go first, cheaply.
-        .filter(|a| {
-            let area = super::geometry::area_m2(a);
-            area > min_area && 2.0 * area >= half * super::geometry::perimeter(a)
-        })
-        .collect();
-    // Outside the outermost pass's footprint: where the field narrows to a neck, the outermost
-    // pass (opened at r_min) splits into rings round each side and leaves the neck's ground;
-    // kept where a disc of the turns' radius (and the implement's width) fits, which the
-    // corners that the pass rounds off (the unreachable ground) do not hold. (A pass that did
-    // not split runs through every neck: nothing to find, and the clips are skipped.)
-    let junctions = if areas[0].len() < 2 {
-        Vec::new()
-    } else {
-        let reach0 = pass_offset(p, 0) + LEFTOVER_SLACK_M;
-        let around = difference(
-            &[(boundary.to_vec(), obstacles.to_vec())],
-            &offset(&areas[0], reach0),
-        );
-        let r = (p.r_min * SMOOTHING_RADIUS_FACTOR).max(half);
-        let eroded = offset(&simplified(&around, LEFTOVER_SIMPLIFY_M), -r);
-        offset(&simplified(&eroded, LEFTOVER_SIMPLIFY_M), r)
-    };
-    let eroded = offset(&simplified(&left, LEFTOVER_SIMPLIFY_M), -half);
-    let wide: Vec<Area> = offset(&simplified(&eroded, LEFTOVER_SIMPLIFY_M), half)
-        .into_iter()
-        .filter(|a| super::geometry::area_m2(a) > min_area)
-        .collect();
-    // The pieces the opening kept nothing of: strips narrower than the implement (a kept
-    // piece's vertices lie in or on the pieces it came from, within the simplification).
-    let near = |q: &Vec2, (outer, holes): &Area| {
-        std::iter::once(outer)
-            .chain(holes)
-            .any(|ring| ring_distance(std::slice::from_ref(q), ring) < 2.0 * LEFTOVER_SIMPLIFY_M)
-            || (contains_point(outer, q) && !holes.iter().any(|h| contains_point(h, q)))
-    };
-    // (Sixteen of each kept piece's vertices, spread round it, stand for it.)
-    let samples: Vec<Vec2> = wide
-        .iter()
-        .flat_map(|w| w.0.iter().step_by(w.0.len().div_ceil(16).max(1)).copied())
-        .collect();
-    let narrow: Vec<Area> = left
-        .into_iter()
-        .filter(|piece| !samples.iter().any(|q| near(q, piece)))
-        .collect();
-    let own = narrow
-        .into_iter()
-        .chain(
-            junctions
-                .into_iter()
-                .filter(|a| super::geometry::area_m2(a) > min_area),
-        )
-        .collect();
-    let working = if wide.is_empty() {
-        working
-    } else {
-        union(&working, &wide)
-    };
-    Worked { working, own }
 }
 
 /// The area of pass centres at offset `d` (boundary shrunk by `d`, obstacles grown by `d`, the

@@ -14,6 +14,7 @@ mod disc_caps;
 mod edges;
 pub mod geometry;
 pub mod headland;
+pub mod leftover;
 pub mod metrics;
 pub mod narrow;
 mod params;
@@ -27,6 +28,7 @@ mod to_goal;
 pub mod transit;
 
 pub use crate::plan::types::{Field, PlanSegment, SegmentKind};
+pub use clear_map::{implement_clear, TRANSIT_CLEARANCE_M};
 pub use params::{CoverageParams, FieldPlan, HeadlandOrder, RouteOrder, SwathAngle};
 pub use runs::obstacle_size;
 
@@ -35,25 +37,6 @@ use runs::drive_run;
 
 use crate::geo::{v2, vec_heading, wrap_angle, Direction, Vec2};
 use crate::plan::types::PlanError;
-
-/// A point of a path keeps the implement inside the field and off the obstacles: inside the
-/// boundary and at least `half` m from every boundary edge and every obstacle.
-pub fn implement_clear(field: &Field, half: f64, q: &Vec2) -> bool {
-    use crate::geo::polygon::point_segment_distance;
-    let far = |ring: &Vec<Vec2>| {
-        let n = ring.len();
-        (0..n).all(|i| point_segment_distance(q, &ring[i], &ring[(i + 1) % n]) >= half - 1e-6)
-    };
-    field.contains(q)
-        && std::iter::once(&field.boundary)
-            .chain(&field.obstacles)
-            .all(far)
-}
-
-/// How far a transit that cannot keep the implement clear of the edge keeps its path inside
-/// the field and off the obstacles, m (about half a tractor's width; the implement is lifted
-/// and may reach over the edge there): the guarantee for paths that do not work.
-pub const TRANSIT_CLEARANCE_M: f64 = 1.5;
 
 /// The reversing transits are tried with the ends pulled back this many times, evenly up to
 /// the forward attempts' longest pull-back (none first).
@@ -70,6 +53,10 @@ const DETOUR_MAX_EXPANSIONS: usize = 2_000;
 /// Clearance added to the bypass circle beyond the implement's half width and the chord
 /// margin, m.
 const BYPASS_SLACK_M: f64 = 0.05;
+
+/// Where a plan stood before a run: its segment count, its last segment, the vehicle's pose
+/// and the warnings' count (a run put back restores them).
+type UndoPoint = (usize, Option<PlanSegment>, Option<(Vec2, f64)>, usize);
 
 /// Plan the whole field: headland passes (outermost first), then the cells in a short order,
 /// each swept by its runs of swaths with turns, joined by transits; with
@@ -185,7 +172,7 @@ fn plan_once(
         margin,
     );
     let passes = headland::passes_around(&field.boundary, &large, p);
-    let headland::Worked { working, own } = headland::with_leftover(
+    let leftover::Worked { working, own } = leftover::with_leftover(
         headland::working_area(&field.boundary, &large, p),
         (&field.boundary, &large),
         &passes,
@@ -582,6 +569,9 @@ fn plan_once(
         .collect();
     let first = field_tracks.front().map(|t| t.0);
     let mut region = first.or_else(|| pending.first().map(|r| r.0)).unwrap_or(0);
+    // The last run kept of a cell of its own: the plan's length after it, where it was entered
+    // from, its swaths.
+    let mut last_own: Option<(usize, UndoPoint, usize)> = None;
     loop {
         for headland_phase in phases {
             if headland_phase {
@@ -716,42 +706,60 @@ fn plan_once(
                     };
                     let (_, _, (ci, angle, run, lines)) = pending.swap_remove(k);
                     // A run of those cells that no transit reaches, or leaves for where it was
-                    // entered from, is left (not driven to by hand): what it held is put back.
+                    // entered from, is put back (not driven to by hand); so is the last one kept
+                    // when the next run of the others finds no transit from its end (that run is
+                    // then driven again from where the vehicle entered the other).
                     let gaps = transit_gaps.get();
-                    let undo = (ci >= worked_cells)
-                        .then(|| (segments.len(), segments.last().cloned(), at, warnings_len()));
-                    drive_run(
-                        &run,
-                        &lines,
-                        angle,
-                        ci,
-                        p,
-                        &tp,
-                        &mut cache,
-                        &mut block_orders,
-                        &clear,
-                        field,
-                        &mut segments,
-                        &mut at,
-                        &mut go_to,
-                        &detour,
-                        &small_discs,
-                    )?;
-                    if let Some((_, _, Some((q, h)), _)) =
-                        undo.as_ref().filter(|_| transit_gaps.get() == gaps)
-                    {
-                        let back = [*q, q + crate::geo::heading_vec(*h)];
-                        go_to(&mut Vec::new(), &mut at.clone(), &back, ci);
-                    }
-                    if let Some(u) = undo.filter(|_| transit_gaps.get() > gaps) {
-                        segments.truncate(u.0);
-                        if let (Some(last), Some(kept)) = (segments.last_mut(), u.1) {
-                            *last = kept;
+                    let own = ci >= worked_cells;
+                    let mut before = (segments.len(), segments.last().cloned(), at, warnings_len());
+                    for attempt in 0..2 {
+                        drive_run(
+                            &run,
+                            &lines,
+                            angle,
+                            ci,
+                            p,
+                            &tp,
+                            &mut cache,
+                            &mut block_orders,
+                            &clear,
+                            field,
+                            &mut segments,
+                            &mut at,
+                            &mut go_to,
+                            &detour,
+                            &small_discs,
+                        )?;
+                        if let Some((q, h)) = before.2.filter(|_| own && transit_gaps.get() == gaps)
+                        {
+                            let back = [q, q + crate::geo::heading_vec(h)];
+                            go_to(&mut Vec::new(), &mut at.clone(), &back, ci);
                         }
-                        (at, swath_total) = (u.2, swath_total - run.len());
-                        warnings.borrow_mut().truncate(u.3);
+                        let undo = match (own, last_own.take()) {
+                            _ if transit_gaps.get() == gaps || attempt > 0 => None,
+                            (true, _) => Some((before.clone(), run.len())),
+                            (false, Some((end, state, runs))) if end == before.0 => {
+                                Some((state, runs))
+                            }
+                            _ => None,
+                        };
+                        let Some(((len, last, pose, warned), runs)) = undo else {
+                            break;
+                        };
+                        segments.truncate(len);
+                        if let (Some(l), Some(kept)) = (segments.last_mut(), last) {
+                            *l = kept;
+                        }
+                        (at, swath_total) = (pose, swath_total - runs);
+                        warnings.borrow_mut().truncate(warned);
                         transit_gaps.set(gaps);
+                        if own {
+                            break;
+                        }
+                        before = (segments.len(), segments.last().cloned(), at, warnings_len());
                     }
+                    let kept = (segments.len(), before, run.len());
+                    last_own = (own && transit_gaps.get() == gaps).then_some(kept);
                 }
             }
         }

@@ -277,7 +277,7 @@ fn an_arm_narrower_than_the_inner_passes_is_worked() {
 /// An L whose arm (34 m wide) holds the outer pass at w 12 m but not the inner one: between the
 /// outer pass's footprints a strip 10 m wide is left, too narrow for a disc an implement wide,
 /// and swaths at the field's angle (East) cross it for a few metres at most. Worked along its
-/// length (`headland::Worked::own`): a swath runs North up the arm over the strip's middle,
+/// length (`leftover::Worked::own`): a swath runs North up the arm over the strip's middle,
 /// within the guarantees. Before, the strip was left (10 × 90 m unworked).
 #[test]
 fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
@@ -311,6 +311,38 @@ fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
     assert!(up_the_arm, "no swath up the arm over {middle:?}");
 }
 
+/// The same L with an arm of 40 m (w 12 m, r_min 8 m): the strip between the outer pass's
+/// footprints is 10 m by about 45 (some 440 m², under 4·w²). A pocket a farmer would
+/// work, and worked: some work's footprint holds its middle, within the guarantees and with no
+/// gap. Before, leftover ground under 4·w² was left.
+#[test]
+fn a_short_strip_between_the_outer_pass_footprints_is_worked() {
+    let field = Field {
+        boundary: vec![
+            v2(0.0, 0.0),
+            v2(120.0, 0.0),
+            v2(120.0, 100.0),
+            v2(34.0, 100.0),
+            v2(34.0, 140.0),
+            v2(0.0, 140.0),
+        ],
+        obstacles: vec![],
+    };
+    let p = CoverageParams {
+        swath_angle: SwathAngle::Fixed { angle: 0.0 },
+        ..params(12.0, 8.0, 2)
+    };
+    let plan = plan_field(&field, &p).unwrap();
+    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
+    assert!(violations.is_empty(), "{violations:?}");
+    assert_eq!(plan.transit_gaps, 0, "{:?}", plan.warnings);
+    let middle = v2(17.0, 110.0);
+    let over = work_over(&plan, &middle, p.line_width / 2.0)
+        .next()
+        .is_some();
+    assert!(over, "no work over the strip's middle {middle:?}");
+}
+
 /// The work segments of `plan` whose footprint (`half` m either side) holds `q`.
 fn work_over<'a>(
     plan: &'a FieldPlan,
@@ -329,7 +361,7 @@ fn work_over<'a>(
 
 /// Two blocks joined by a neck 22 m wide and 60 m long (w 6 m, r_min 8 m): the outermost
 /// pass, opened at r_min, cannot run through the neck and splits into a ring round each block,
-/// leaving the neck's ground outside both. Worked as a cell of its own (`headland::Worked::own`):
+/// leaving the neck's ground outside both. Worked as a cell of its own (`leftover::Worked::own`):
 /// some work's footprint holds the neck's middle, within the guarantees and with no gap.
 #[test]
 fn the_ground_a_neck_leaves_outside_the_outer_pass_is_worked() {
