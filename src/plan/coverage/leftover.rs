@@ -47,9 +47,9 @@ pub struct Worked {
 }
 
 /// The working area with the ground inside the outermost pass that neither the passes'
-/// footprints nor `working` cover, larger than w² and a mean w/2 thick at least: in an arm
-/// narrower than the inner passes need (each pass is opened at r_min and vanishes there) that
-/// ground was never worked. Where discs an implement wide fit (an opening of radius w/2) over
+/// footprints nor `working` cover, larger than w² and a mean w/4 thick at least (one pass
+/// works it): in an arm narrower than the inner passes need (each pass is opened at r_min and
+/// vanishes there) that ground was never worked. Where discs an implement wide fit (an opening of radius w/2) over
 /// half of a piece and over 4·w², they join the working area and get swaths, with turns on the
 /// passes' ground where they fit; any other piece (a strip narrower than the implement, with
 /// a wider bulge or none, or a small pocket) is worked whole along its length
@@ -86,10 +86,10 @@ pub fn with_leftover(
             };
             difference(&offset(&areas[k], -reach), &inner)
         })
-        // Slivers (mean thickness 2·area/perimeter under w/2) go first, cheaply.
+        // Slivers (mean thickness 2·area/perimeter under w/4) go first, cheaply.
         .filter(|a| {
             let area = super::geometry::area_m2(a);
-            area > min_area && 2.0 * area >= half * super::geometry::perimeter(a)
+            area > min_area && 4.0 * area >= half * super::geometry::perimeter(a)
         })
         .collect();
     // Outside the outermost pass's footprint: where the field narrows to a neck, the outermost
