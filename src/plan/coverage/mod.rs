@@ -705,10 +705,10 @@ fn plan_once(
                         break;
                     };
                     let (_, _, (ci, angle, run, lines)) = pending.swap_remove(k);
-                    // A run of those cells that no transit reaches, or leaves for where it was
-                    // entered from, is put back (not driven to by hand); so is the last one kept
-                    // when the next run of the others finds no transit from its end (that run is
-                    // then driven again from where the vehicle entered the other).
+                    // A run of those cells that no transit reaches is put back (not driven to
+                    // by hand); so is the last one kept when the next run of the others finds no
+                    // transit from its end (that run is then driven again from where the vehicle
+                    // entered the other).
                     let gaps = transit_gaps.get();
                     let own = ci >= worked_cells;
                     let mut before = (segments.len(), segments.last().cloned(), at, warnings_len());
@@ -730,11 +730,6 @@ fn plan_once(
                             &detour,
                             &small_discs,
                         )?;
-                        if let Some((q, h)) = before.2.filter(|_| own && transit_gaps.get() == gaps)
-                        {
-                            let back = [q, q + crate::geo::heading_vec(h)];
-                            go_to(&mut Vec::new(), &mut at.clone(), &back, ci);
-                        }
                         let undo = match (own, last_own.take()) {
                             _ if transit_gaps.get() == gaps || attempt > 0 => None,
                             (true, _) => Some((before.clone(), run.len())),
