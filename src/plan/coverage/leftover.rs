@@ -22,11 +22,6 @@ const LEFTOVER_SLACK_M: f64 = 0.05;
 /// Leftover ground smaller than this many implement widths squared is left ([`with_leftover`]).
 const LEFTOVER_MIN_AREA_W2: f64 = 1.0;
 
-/// Leftover ground joins the working area (swaths at the field's angle) only where its
-/// opening keeps more than this many implement widths squared; smaller pieces are cells of
-/// their own ([`with_leftover`]).
-const WORKING_MIN_AREA_W2: f64 = 4.0;
-
 /// A leftover piece whose opening at w/2 keeps less than this fraction of it is worked whole,
 /// as a cell of its own ([`with_leftover`]).
 const KEPT_FRACTION: f64 = 0.5;
@@ -40,7 +35,7 @@ pub struct Worked {
     /// Pieces worked as cells of their own, each at its own minimum-span angle: leftover strips
     /// too narrow for a disc an implement wide (between the passes' footprints in an arm the
     /// inner passes do not reach, which swaths at the field's angle would only cross for a few
-    /// metres), or mostly so, small pockets, and the ground outside the outermost pass where it
+    /// metres), or mostly so, and the ground outside the outermost pass where it
     /// splits at a neck. A run of one that no transit reaches, or that strands the vehicle, is
     /// put back (the plan's own choice: nothing is driven by hand for it).
     pub own: Vec<Area>,
@@ -49,11 +44,11 @@ pub struct Worked {
 /// The working area with the ground inside the outermost pass that neither the passes'
 /// footprints nor `working` cover, larger than w² and a mean w/4 thick at least (one pass
 /// works it): in an arm narrower than the inner passes need (each pass is opened at r_min and
-/// vanishes there) that ground was never worked. Where discs an implement wide fit (an opening of radius w/2) over
-/// half of a piece and over 4·w², they join the working area and get swaths, with turns on the
-/// passes' ground where they fit; any other piece (a strip narrower than the implement, with
-/// a wider bulge or none, or a small pocket) is worked whole along its length
-/// ([`Worked::own`]), and so is the ground a neck leaves outside the outermost pass.
+/// vanishes there) that ground was never worked. Where discs an implement wide fit (an opening
+/// of radius w/2) over half of a piece, those parts join the working area and get swaths, with
+/// turns on the passes' ground where they fit; any other piece (a strip narrower than the
+/// implement, with a wider bulge or none) is worked whole along its length ([`Worked::own`]),
+/// and so is the ground a neck leaves outside the outermost pass.
 pub fn with_leftover(
     working: Vec<Area>,
     (boundary, obstacles): (&[Vec2], &[Vec<Vec2>]),
@@ -124,9 +119,8 @@ pub fn with_leftover(
     };
     // Each kept piece stands by sixteen of its vertices, spread round it, for the piece it
     // came from; a piece whose opening kept less than KEPT_FRACTION of it (a strip narrower than
-    // the implement, with a wider bulge or none) or no more than WORKING_MIN_AREA_W2·w² is
-    // worked whole as a cell of its own, along its length; the others' kept pieces join the
-    // working area.
+    // the implement, with a wider bulge or none) is worked whole as a cell of its own, along its
+    // length; the others' kept pieces join the working area.
     let source = |w: &Area| {
         let samples: Vec<Vec2> =
             w.0.iter()
@@ -146,9 +140,7 @@ pub fn with_leftover(
     let whole: Vec<bool> = left
         .iter()
         .zip(&kept)
-        .map(|(piece, k)| {
-            *k < KEPT_FRACTION * super::geometry::area_m2(piece) || *k <= WORKING_MIN_AREA_W2 * w2
-        })
+        .map(|(piece, k)| *k < KEPT_FRACTION * super::geometry::area_m2(piece))
         .collect();
     let wide: Vec<Area> = wide
         .into_iter()
