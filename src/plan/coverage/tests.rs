@@ -274,21 +274,17 @@ fn an_arm_narrower_than_the_inner_passes_is_worked() {
     assert_eq!(plan.transit_gaps, 0);
 }
 
-/// An L whose arm (34 m wide) holds the outer pass at w 12 m but not the inner one: between the
-/// outer pass's footprints a strip 10 m wide is left, too narrow for a disc an implement wide,
-/// and swaths at the field's angle (East) cross it for a few metres at most. Worked along its
-/// length (`leftover::Worked::own`): a swath runs North up the arm over the strip's middle,
-/// within the guarantees. Before, the strip was left (10 × 90 m unworked).
-#[test]
-fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
+/// An L, 120 × 100 m with an arm 34 m wide up to `arm_top` m, planned at w 12 m, r_min 8 m,
+/// 2 passes and swaths East; the plan holds the guarantees and is one path throughout.
+fn l_field_plan(arm_top: f64) -> (FieldPlan, CoverageParams) {
     let field = Field {
         boundary: vec![
             v2(0.0, 0.0),
             v2(120.0, 0.0),
             v2(120.0, 100.0),
             v2(34.0, 100.0),
-            v2(34.0, 220.0),
-            v2(0.0, 220.0),
+            v2(34.0, arm_top),
+            v2(0.0, arm_top),
         ],
         obstacles: vec![],
     };
@@ -302,6 +298,17 @@ fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
     for pair in plan.segments.windows(2) {
         assert!((pair[1].points[0] - *pair[0].points.last().unwrap()).norm() < 1e-6);
     }
+    (plan, p)
+}
+
+/// An L whose arm (34 m wide) holds the outer pass at w 12 m but not the inner one: between the
+/// outer pass's footprints a strip 10 m wide is left, too narrow for a disc an implement wide,
+/// and swaths at the field's angle (East) cross it for a few metres at most. Worked along its
+/// length (`leftover::Worked::own`): a swath runs North up the arm over the strip's middle,
+/// within the guarantees. Before, the strip was left (10 × 90 m unworked).
+#[test]
+fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
+    let (plan, p) = l_field_plan(220.0);
     // Work up the arm, along it, whose footprint holds the strip's middle.
     let middle = v2(17.0, 165.0);
     let up_the_arm = work_over(&plan, &middle, p.line_width / 2.0).any(|s| {
@@ -311,30 +318,13 @@ fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
     assert!(up_the_arm, "no swath up the arm over {middle:?}");
 }
 
-/// The same L with an arm of 40 m (w 12 m, r_min 8 m): the strip between the outer pass's
-/// footprints is 10 m by about 45 (some 440 m², under 4·w²). A pocket a farmer would
-/// work, and worked: some work's footprint holds its middle, within the guarantees and with no
-/// gap. Before, leftover ground under 4·w² was left.
+/// The same L with an arm of 40 m: the strip between the outer pass's footprints is 10 m by
+/// about 45 (some 440 m², under 4·w²). A pocket a farmer would work, and worked: some work's
+/// footprint holds its middle, within the guarantees and with no gap. Before, leftover ground
+/// under 4·w² was left.
 #[test]
 fn a_short_strip_between_the_outer_pass_footprints_is_worked() {
-    let field = Field {
-        boundary: vec![
-            v2(0.0, 0.0),
-            v2(120.0, 0.0),
-            v2(120.0, 100.0),
-            v2(34.0, 100.0),
-            v2(34.0, 140.0),
-            v2(0.0, 140.0),
-        ],
-        obstacles: vec![],
-    };
-    let p = CoverageParams {
-        swath_angle: SwathAngle::Fixed { angle: 0.0 },
-        ..params(12.0, 8.0, 2)
-    };
-    let plan = plan_field(&field, &p).unwrap();
-    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
-    assert!(violations.is_empty(), "{violations:?}");
+    let (plan, p) = l_field_plan(140.0);
     assert_eq!(plan.transit_gaps, 0, "{:?}", plan.warnings);
     let middle = v2(17.0, 110.0);
     let over = work_over(&plan, &middle, p.line_width / 2.0)
