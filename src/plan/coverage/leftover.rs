@@ -62,8 +62,7 @@ pub fn with_leftover(
         };
     }
     let half = p.line_width / 2.0;
-    let w2 = p.line_width * p.line_width;
-    let min_area = LEFTOVER_MIN_AREA_W2 * w2;
+    let min_area = LEFTOVER_MIN_AREA_W2 * p.line_width * p.line_width;
     // Inside pass k's footprint and outside pass k + 1's (the working area's after the last):
     // the footprints tile the headland, so their edges coincide where both passes run; each
     // footprint is taken LEFTOVER_SLACK_M wider, which keeps the clipper off coincident edges.

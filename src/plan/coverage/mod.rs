@@ -730,13 +730,13 @@ fn plan_once(
                             &detour,
                             &small_discs,
                         )?;
-                        let undo = match (own, last_own.take()) {
-                            _ if transit_gaps.get() == gaps || attempt > 0 => None,
-                            (true, _) => Some((before.clone(), run.len())),
-                            (false, Some((end, state, runs))) if end == before.0 => {
-                                Some((state, runs))
-                            }
-                            _ => None,
+                        let undo = if transit_gaps.get() == gaps || attempt > 0 {
+                            None
+                        } else if own {
+                            Some((before.clone(), run.len()))
+                        } else {
+                            let kept = last_own.take().filter(|(end, _, _)| *end == before.0);
+                            kept.map(|(_, state, runs)| (state, runs))
                         };
                         let Some(((len, last, pose, warned), runs)) = undo else {
                             break;
@@ -753,8 +753,12 @@ fn plan_once(
                         }
                         before = (segments.len(), segments.last().cloned(), at, warnings_len());
                     }
-                    let kept = (segments.len(), before, run.len());
-                    last_own = (own && transit_gaps.get() == gaps).then_some(kept);
+                    // (An own run put back leaves the one before it the last kept.)
+                    if !own {
+                        last_own = None;
+                    } else if transit_gaps.get() == gaps {
+                        last_own = Some((segments.len(), before, run.len()));
+                    }
                 }
             }
         }

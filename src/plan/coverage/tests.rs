@@ -274,6 +274,14 @@ fn an_arm_narrower_than_the_inner_passes_is_worked() {
     assert_eq!(plan.transit_gaps, 0);
 }
 
+/// The plan of `field`, asserted to hold the guarantees (`metrics::checks::check_plan`).
+fn plan_within_guarantees(field: &Field, p: &CoverageParams) -> FieldPlan {
+    let plan = plan_field(field, p).unwrap();
+    let violations = metrics::checks::check_plan(field, &plan, p.line_width, p.r_min);
+    assert!(violations.is_empty(), "{violations:?}");
+    plan
+}
+
 /// An L, 120 × 100 m with an arm 34 m wide up to `arm_top` m, planned at w 12 m, r_min 8 m,
 /// 2 passes and swaths East; the plan holds the guarantees and is one path throughout.
 fn l_field_plan(arm_top: f64) -> (FieldPlan, CoverageParams) {
@@ -292,9 +300,7 @@ fn l_field_plan(arm_top: f64) -> (FieldPlan, CoverageParams) {
         swath_angle: SwathAngle::Fixed { angle: 0.0 },
         ..params(12.0, 8.0, 2)
     };
-    let plan = plan_field(&field, &p).unwrap();
-    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
-    assert!(violations.is_empty(), "{violations:?}");
+    let plan = plan_within_guarantees(&field, &p);
     for pair in plan.segments.windows(2) {
         assert!((pair[1].points[0] - *pair[0].points.last().unwrap()).norm() < 1e-6);
     }
@@ -325,12 +331,15 @@ fn a_strip_narrower_than_the_implement_is_worked_along_its_length() {
 #[test]
 fn a_short_strip_between_the_outer_pass_footprints_is_worked() {
     let (plan, p) = l_field_plan(140.0);
+    assert_worked_without_a_gap(&plan, &v2(17.0, 110.0), p.line_width / 2.0);
+}
+
+/// `plan` has no place without a transit and some work whose footprint (`half` m either side)
+/// holds `q`.
+fn assert_worked_without_a_gap(plan: &FieldPlan, q: &Vec2, half: f64) {
     assert_eq!(plan.transit_gaps, 0, "{:?}", plan.warnings);
-    let middle = v2(17.0, 110.0);
-    let over = work_over(&plan, &middle, p.line_width / 2.0)
-        .next()
-        .is_some();
-    assert!(over, "no work over the strip's middle {middle:?}");
+    let over = work_over(plan, q, half).next().is_some();
+    assert!(over, "no work over {q:?}");
 }
 
 /// The work segments of `plan` whose footprint (`half` m either side) holds `q`.
@@ -376,15 +385,8 @@ fn the_ground_a_neck_leaves_outside_the_outer_pass_is_worked() {
         swath_angle: SwathAngle::MinSpan,
         ..params(6.0, 8.0, 2)
     };
-    let plan = plan_field(&field, &p).unwrap();
-    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
-    assert!(violations.is_empty(), "{violations:?}");
-    assert_eq!(plan.transit_gaps, 0, "{:?}", plan.warnings);
-    let middle = v2(110.0, 40.0);
-    let over = work_over(&plan, &middle, p.line_width / 2.0)
-        .next()
-        .is_some();
-    assert!(over, "no work over the neck's middle {middle:?}");
+    let plan = plan_within_guarantees(&field, &p);
+    assert_worked_without_a_gap(&plan, &v2(110.0, 40.0), p.line_width / 2.0);
 }
 
 /// Two blocks joined by a neck 12 m wide (w 3 m, r_min 8 m, 3 passes): the outermost pass's
@@ -416,9 +418,7 @@ fn a_field_of_two_blocks_is_worked_block_by_block() {
         obstacles: vec![],
     };
     let p = params(3.0, 8.0, 3);
-    let plan = plan_field(&field, &p).unwrap();
-    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
-    assert!(violations.is_empty(), "{violations:?}");
+    let plan = plan_within_guarantees(&field, &p);
     // The block of each worked segment (by its middle point, in the field's own frame).
     let upper = |q: &Vec2| -q.x * sin + q.y * cos > 90.0;
     let blocks: Vec<bool> = plan
@@ -450,9 +450,7 @@ fn a_swath_end_where_no_forward_turn_fits_turns_backing_up() {
         obstacles: vec![],
     };
     let p = params(3.0, 8.0, 3);
-    let plan = plan_field(&field, &p).unwrap();
-    let violations = metrics::checks::check_plan(&field, &plan, p.line_width, p.r_min);
-    assert!(violations.is_empty(), "{violations:?}");
+    let plan = plan_within_guarantees(&field, &p);
     for pair in plan.segments.windows(2) {
         assert!((pair[1].points[0] - *pair[0].points.last().unwrap()).norm() < 1e-6);
     }
