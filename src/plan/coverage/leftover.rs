@@ -94,13 +94,16 @@ pub fn with_leftover(
     let junctions = if areas[0].len() < 2 {
         Vec::new()
     } else {
+        // The ground outside the pass's footprint (grown by reach0), opened at r: shrinking
+        // distributes over the difference (the field shrunk by r minus the footprint grown by
+        // r), which spares the clipper the thin band all along the boundary, whose offset
+        // crossed every arc with every other (11 ms of a 35 ms plan at w 36).
         let reach0 = pass_offset(p, 0) + LEFTOVER_SLACK_M;
-        let around = difference(
-            &[(boundary.to_vec(), obstacles.to_vec())],
-            &offset(&areas[0], reach0),
-        );
         let r = (p.r_min * SMOOTHING_RADIUS_FACTOR).max(half);
-        let eroded = offset(&simplified(&around, LEFTOVER_SIMPLIFY_M), -r);
+        let eroded = difference(
+            &offset(&[(boundary.to_vec(), obstacles.to_vec())], -r),
+            &offset(&areas[0], reach0 + r),
+        );
         offset(&simplified(&eroded, LEFTOVER_SIMPLIFY_M), r)
     };
     let eroded = offset(&simplified(&left, LEFTOVER_SIMPLIFY_M), -half);
