@@ -9,7 +9,7 @@
 pub mod checks;
 
 use super::{Field, FieldPlan, PlanSegment, SegmentKind};
-use crate::geo::polygon::{contains_point, point_segment_distance};
+use crate::geo::polygon::{bbox, contains_point, point_segment_distance};
 use crate::geo::{cross, Vec2};
 use geo::algorithm::buffer::{BufferStyle, LineCap, LineJoin};
 use geo::{Area, BooleanOps, Buffer, Coord, LineString, MultiLineString, MultiPolygon, Polygon};
@@ -133,48 +133,73 @@ fn stroke(pts: &[Vec2], width: f64) -> Vec<Polygon<f64>> {
         .0
 }
 
-/// How far inside a section's edge its edge lines are taken, m ([`section_strokes`]): an edge
+/// How far inside a section's edge its edge lines are taken, m ([`sections_area`]): an edge
 /// of a swath's outer section runs along the headland pass's footprint edge, where inside
 /// and outside are a rounding apart.
 const SECTION_EDGE_INSET_M: f64 = 0.01;
 
-/// The ground the swaths (`Work`) of a plan made for n > 1 sections work: each section on
-/// where `ground` (the ground left to the swaths: the field less the headland passes'
-/// footprints) holds any of the ground under it, its centre line or one of its edge lines
-/// ([`SECTION_EDGE_INSET_M`] inside) lying over it. A section switches off only once nothing
-/// under it is left to work, so section control never leaves a sliver where an edge runs
-/// slanted to the swaths, and lays at most a section's width twice. Each straight swath's
-/// sections are found on scan lines in the swath's frame (`geometry::scan_intervals`, the
-/// ground turned once per swath direction); a swath that is not straight (none is planned so)
-/// counts its whole footprint.
+/// The ground the swaths and detours (`Work`, `Detour`, in driving order) of a plan made for
+/// n > 1 sections work, as a section controller with a coverage map switches them: each
+/// section on where ground left to work lies under it (its centre line or one of its edge
+/// lines, [`SECTION_EDGE_INSET_M`] inside, over it). Left to work: `ground` (the field less
+/// the headland passes' footprints) less the footprints of the swaths and detours driven
+/// before. A section switches off only once nothing under it is left to work, so section
+/// control never leaves a sliver where an edge runs slanted to the swaths, and lays at most a
+/// section's width twice. Each straight swath's sections are found on scan lines in the
+/// swath's frame (`geometry::scan_intervals`, the ground turned once per swath direction);
+/// a curved path (a detour round an obstacle) is sampled along its length
+/// ([`curved_sections`]).
 ///
 /// The union of these strokes and the headland passes' footprints is that of the whole
-/// footprints (a section is off only over the passes' ground), so [`plan_metrics`] takes the
+/// footprints (a section is off only over ground worked by the passes or before), so
+/// [`plan_metrics`] takes the
 /// ground worked from the whole footprints and these only for the sum of their areas (the
 /// overlap): united, their many near-coincident long edges kept i_overlay 4's fragment split
 /// busy for minutes on a large field at w 3 m (bg_arable_60ha).
-fn section_strokes<'a>(
+fn sections_area<'a>(
     swaths: impl IntoIterator<Item = &'a PlanSegment>,
     width: f64,
     n: usize,
     ground: &MultiPolygon<f64>,
-) -> Vec<Polygon<f64>> {
-    use super::geometry::{from_geo, rotate, rotate_area, scan_intervals};
+) -> f64 {
+    use super::geometry::{from_geo, rotate, rotate_area, scan_intervals, Area};
     let ground = from_geo(ground);
     // The ground turned into each swath direction met so far (swaths of a cell share one).
-    let mut turned: Vec<(f64, Vec<super::geometry::Area>)> = Vec::new();
+    let mut turned: Vec<(f64, Vec<Area>)> = Vec::new();
     let w = width / n as f64;
     let lateral = |k: usize| (k as f64 + 0.5) * w - 0.5 * width;
     let edge = 0.5 * w - SECTION_EDGE_INSET_M.min(0.25 * w);
-    let mut out = Vec::new();
-    for pts in swaths.into_iter().map(|s| merged(&s.points)) {
+    let (mut out, mut curved) = (Vec::new(), 0.0);
+    // The whole footprints of the swaths and detours driven so far, in driving order, with
+    // their bounding boxes.
+    let mut done: Vec<(Area, (Vec2, Vec2))> = Vec::new();
+    let meets = |(lo, hi): &(Vec2, Vec2), (a, b): &(Vec2, Vec2)| {
+        lo.x <= b.x && a.x <= hi.x && lo.y <= b.y && a.y <= hi.y
+    };
+    for s in swaths {
+        let pts = merged(&s.points);
         if pts.len() < 2 {
             continue;
         }
         let (a, b) = (pts[0], pts[pts.len() - 1]);
         let t = (b - a) / (b - a).norm().max(1e-12);
         if pts.iter().any(|q| cross(&t, &(q - a)).abs() >= 1e-6) {
-            out.extend(stroke(&pts, width));
+            // A curved path (a detour round an obstacle): its sections sampled along it.
+            let stroked = from_geo(&MultiPolygon::new(stroke(&pts, width)));
+            let bounds = bbox(stroked.iter().flat_map(|g| g.0.iter())).unwrap_or((a, b));
+            let before: Vec<&Area> = done
+                .iter()
+                .filter(|(_, bb)| meets(bb, &bounds))
+                .map(|(g, _)| g)
+                .collect();
+            curved += stroked.iter().map(super::geometry::area_m2).sum::<f64>()
+                - curved_sections(&pts, width, n, &|q| {
+                    in_any(ground.iter(), q) && !in_any(before.iter().copied(), q)
+                });
+            done.extend(stroked.into_iter().map(|g| {
+                let bb = bbox(g.0.iter()).unwrap_or((a, b));
+                (g, bb)
+            }));
             continue;
         }
         let angle = t.y.atan2(t.x);
@@ -187,15 +212,37 @@ fn section_strokes<'a>(
             }
         };
         let areas = &turned[i].1;
+        let at = |x: f64, l: f64| a + t * x + crate::geo::v2(-t.y, t.x) * l;
         // The swath in its frame: from (x0, y) along +x for `length`; left is +y.
         let (start, length) = (rotate(&a, -angle), (b - a).dot(&t));
+        let corners = vec![
+            at(0.0, -0.5 * width),
+            at(length, -0.5 * width),
+            at(length, 0.5 * width),
+            at(0.0, 0.5 * width),
+        ];
+        let bounds = bbox(corners.iter()).unwrap_or((a, b));
+        // What was worked before that may lie under this swath, in its frame.
+        let before: Vec<Area> = done
+            .iter()
+            .filter(|(_, bb)| meets(bb, &bounds))
+            .map(|(g, _)| rotate_area(g, -angle))
+            .collect();
         let stretches: Vec<Vec<(f64, f64)>> = (0..n)
             .map(|k| {
                 let lines = [-edge, 0.0, edge].map(|d| start.y + lateral(k) + d);
+                let left_on = |y: f64| {
+                    let left = areas.iter().flat_map(|g| scan_intervals(g, y)).collect();
+                    let worked = before.iter().flat_map(|g| scan_intervals(g, y)).collect();
+                    without(
+                        super::swaths::merge_overlapping(left),
+                        &super::swaths::merge_overlapping(worked),
+                    )
+                };
                 super::swaths::merge_overlapping(
                     lines
                         .iter()
-                        .flat_map(|&y| areas.iter().flat_map(move |g| scan_intervals(g, y)))
+                        .flat_map(|&y| left_on(y))
                         .map(|(x0, x1)| (x0 - start.x).max(0.0)..(x1 - start.x).min(length))
                         .filter(|r| r.end > r.start)
                         .map(|r| (r.start, r.end))
@@ -203,8 +250,157 @@ fn section_strokes<'a>(
                 )
             })
             .collect();
-        let at = |x: f64, l: f64| a + t * x + crate::geo::v2(-t.y, t.x) * l;
         out.extend(sections_polygons(&stretches, w, &lateral, &at));
+        done.push(((corners, Vec::new()), bounds));
+    }
+    out.iter().map(|q| q.unsigned_area()).sum::<f64>() + curved
+}
+
+/// Is `q` in one of `areas` (inside its outer ring, outside its holes)?
+fn in_any<'a>(mut areas: impl Iterator<Item = &'a super::geometry::Area>, q: &Vec2) -> bool {
+    areas.any(|(outer, holes)| {
+        contains_point(outer, q) && !holes.iter().any(|h| contains_point(h, q))
+    })
+}
+
+/// Spacing of the samples along a curved path whose sections are found one sample at a time,
+/// m ([`curved_sections`]).
+const CURVED_SAMPLE_M: f64 = 0.2;
+
+/// The area `n` sections of an implement `width` wide leave unworked along the curved
+/// polyline `pts` because they are off, m²: sampled every [`CURVED_SAMPLE_M`], a section is on
+/// from one sample to the next where its centre or an edge point ([`SECTION_EDGE_INSET_M`]
+/// inside) is `left` at either sample, else off over the quadrilateral between the two
+/// samples' cross-sections. (The path's footprint less this is the ground its sections work:
+/// quadrilaterals summed would count twice what a tight bend's inner side sweeps twice.)
+fn curved_sections(pts: &[Vec2], width: f64, n: usize, left: &dyn Fn(&Vec2) -> bool) -> f64 {
+    let w = width / n as f64;
+    let lateral = |k: usize| (k as f64 + 0.5) * w - 0.5 * width;
+    let edge = 0.5 * w - SECTION_EDGE_INSET_M.min(0.25 * w);
+    // Samples (point, left normal) along the path.
+    let mut samples: Vec<(Vec2, Vec2)> = Vec::new();
+    for seg in pts.windows(2) {
+        let d = seg[1] - seg[0];
+        let len = d.norm();
+        if len <= 1e-9 {
+            continue;
+        }
+        let normal = crate::geo::v2(-d.y, d.x) / len;
+        let steps = (len / CURVED_SAMPLE_M).ceil() as usize;
+        samples.extend((0..steps).map(|i| (seg[0] + d * (i as f64 / steps as f64), normal)));
+    }
+    if let (Some(last), Some(&(_, normal))) = (pts.last(), samples.last()) {
+        samples.push((*last, normal));
+    }
+    let on_at = |(q, normal): &(Vec2, Vec2), k: usize| {
+        [-edge, 0.0, edge]
+            .iter()
+            .any(|d| left(&(q + normal * (lateral(k) + d))))
+    };
+    let mut area = 0.0;
+    let mut on = vec![false; samples.len()];
+    for k in 0..n {
+        for (o, s) in on.iter_mut().zip(&samples) {
+            *o = on_at(s, k);
+        }
+        for (i, pair) in samples.windows(2).enumerate() {
+            if on[i] || on[i + 1] {
+                continue;
+            }
+            let side = |(q, normal): &(Vec2, Vec2), l: f64| q + normal * (lateral(k) + l);
+            let quad = [
+                side(&pair[0], -0.5 * w),
+                side(&pair[1], -0.5 * w),
+                side(&pair[1], 0.5 * w),
+                side(&pair[0], 0.5 * w),
+            ];
+            // (Not where the section's edge moves backward, inside a bend tighter than its
+            // offset: the footprint there is not the quadrilateral.)
+            let ahead = pair[1].0 - pair[0].0;
+            if (quad[1] - quad[0]).dot(&ahead) > 0.0 && (quad[2] - quad[3]).dot(&ahead) > 0.0 {
+                area += crate::geo::polygon::signed_area(&quad).abs();
+            }
+        }
+    }
+    area
+}
+
+/// The headland passes (in driving order) of a plan made for n > 1 sections, the area their
+/// sections work, m²: each pass's sections switch off over what the passes before it worked
+/// (within w/2 of their centre lines, butt ends), found through a grid of their segments.
+fn headland_sections_area<'a>(
+    passes: impl IntoIterator<Item = &'a PlanSegment>,
+    width: f64,
+    n: usize,
+) -> f64 {
+    let cell = width.max(1e-3);
+    let key = |q: &Vec2| ((q.x / cell).floor() as i64, (q.y / cell).floor() as i64);
+    // Segments of the passes before, by grid cell: (a, b, first of its pass, last of it).
+    type Segment = (Vec2, Vec2, bool, bool);
+    let mut grid: std::collections::HashMap<(i64, i64), Vec<Segment>> =
+        std::collections::HashMap::new();
+    let half = 0.5 * width;
+    let mut area = 0.0;
+    for s in passes {
+        let pts = merged(&s.points);
+        if pts.len() < 2 {
+            continue;
+        }
+        let worked_before = |q: &Vec2| {
+            let (i, j) = key(q);
+            (i - 1..=i + 1)
+                .flat_map(|x| (j - 1..=j + 1).map(move |y| (x, y)))
+                .any(|c| {
+                    grid.get(&c).is_some_and(|segs| {
+                        segs.iter().any(|&(a, b, first, last)| {
+                            let d = b - a;
+                            let t = (q - a).dot(&d) / d.norm_squared().max(1e-12);
+                            !((first && t < 0.0) || (last && t > 1.0))
+                                && point_segment_distance(q, &a, &b) <= half
+                        })
+                    })
+                })
+        };
+        let whole: f64 = stroke(&pts, width).iter().map(|q| q.unsigned_area()).sum();
+        area += (whole - curved_sections(&pts, width, n, &|q| !worked_before(q))).max(0.0);
+        let closed = (pts[0] - pts[pts.len() - 1]).norm() < 1e-6;
+        let m = pts.len() - 1;
+        for (i, seg) in pts.windows(2).enumerate() {
+            let (first, last) = (!closed && i == 0, !closed && i + 1 == m);
+            // In every cell its bounding box meets (a segment is shorter than a cell or so).
+            let (lo, hi) = (key(&seg[0]), key(&seg[1]));
+            for x in lo.0.min(hi.0)..=lo.0.max(hi.0) {
+                for y in lo.1.min(hi.1)..=lo.1.max(hi.1) {
+                    grid.entry((x, y))
+                        .or_default()
+                        .push((seg[0], seg[1], first, last));
+                }
+            }
+        }
+    }
+    area
+}
+
+/// The parts of the sorted, disjoint intervals `from` outside the sorted, disjoint intervals
+/// `cut`.
+fn without(from: Vec<(f64, f64)>, cut: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    if cut.is_empty() {
+        return from;
+    }
+    let mut out = Vec::with_capacity(from.len());
+    for (mut x0, x1) in from {
+        for &(c0, c1) in cut {
+            if c1 <= x0 || c0 >= x1 {
+                continue;
+            }
+            if c0 > x0 {
+                out.push((x0, c0));
+            }
+            x0 = x0.max(c1);
+        }
+        if x1 > x0 {
+            out.push((x0, x1));
+        }
     }
     out
 }
@@ -351,16 +547,16 @@ pub fn plan_metrics(field: &Field, plan: &FieldPlan, line_width: f64) -> PlanMet
     let outside_length_m = length(&boundary_poly.clip(&paths, true));
     let obstacle_length_m = length(&obstacles.clip(&paths, false));
     // (Strokes overlap only where two segments work the same ground.) With sections, a swath
-    // counts the ground its sections work (`section_strokes`: the ground worked is the same).
+    // counts the ground its sections work (`sections_area`: the ground worked is the same).
     let area_of = |p: &[Polygon<f64>]| p.iter().map(|q| q.unsigned_area()).fold(0.0, |a, b| a + b);
-    let work_area = if plan.sections > 1 {
+    let sum_single = if plan.sections > 1 {
         let left = field_poly.difference(&union(&headland_strokes));
-        let swaths = section_strokes(of(plan, &[Work]), line_width, plan.sections, &left);
-        area_of(&swaths) + area_of(&strokes(of(plan, &[Detour]), line_width))
+        let n = plan.sections;
+        sections_area(of(plan, &[Work, Detour]), line_width, n, &left)
+            + headland_sections_area(of(plan, &[Headland]), line_width, n)
     } else {
-        area_of(&work_strokes)
+        area_of(&headland_strokes) + area_of(&work_strokes)
     };
-    let sum_single = area_of(&headland_strokes) + work_area;
     let union_area = passes_fp.unsigned_area();
     let overlap_fraction = ratio((sum_single - union_area).max(0.0), union_area);
     let outside_area_m2 = all_fp.difference(&boundary_poly).unsigned_area();
@@ -440,7 +636,7 @@ pub fn field_polygon(field: &Field) -> MultiPolygon<f64> {
 }
 
 /// Ground of the field that no working footprint (work, detour, headland) covers (with
-/// sections too: see [`section_strokes`]).
+/// sections too: see [`sections_area`]).
 pub fn unworked_ground(field: &Field, plan: &FieldPlan, line_width: f64) -> MultiPolygon<f64> {
     use SegmentKind::*;
     let passes = plan

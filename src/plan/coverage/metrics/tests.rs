@@ -186,17 +186,19 @@ fn footprints_of_a_plan_on_the_axes() {
     assert!(m.covered_fraction > 0.0 && m.covered_fraction <= 1.0);
 }
 
+/// 101 points from `a` to `b`.
+fn line(a: Vec2, b: Vec2) -> Vec<Vec2> {
+    (0..=100)
+        .map(|k| a + (b - a) * (k as f64 / 100.0))
+        .collect()
+}
+
 /// A 10 m swath along y = 30 over a 100 × 60 m field whose 10 m headland pass runs from
 /// (`x_bottom`, 0) to (`x_top`, 60); the plan made for `sections`.
 fn swath_into_headland(x_bottom: f64, x_top: f64, sections: usize) -> (Field, FieldPlan) {
     let field = Field {
         boundary: rect(0.0, 0.0, 100.0, 60.0),
         obstacles: Vec::new(),
-    };
-    let line = |a: Vec2, b: Vec2| {
-        (0..=100)
-            .map(|k| a + (b - a) * (k as f64 / 100.0))
-            .collect()
     };
     let plan = FieldPlan {
         segments: vec![
@@ -249,4 +251,108 @@ fn sections_switched_off_over_the_headland_lay_nothing_twice_and_leave_nothing()
     assert!((s.covered_fraction - m.covered_fraction).abs() < 1e-9);
     let unworked = |p: &FieldPlan| unworked_ground(&field, p, 10.0).unsigned_area();
     assert!((unworked(&sectioned) - unworked(&whole)).abs() < 1e-6);
+}
+
+/// A 100 × 100 m field without headland, w 10 m: a swath along y = 50, then `second` (a
+/// crossing swath or a bent path laid partly over the first), both worked by `sections`.
+fn over_a_swath_before(
+    second: Vec<Vec2>,
+    kind: SegmentKind,
+    sections: usize,
+) -> (Field, FieldPlan) {
+    let field = Field {
+        boundary: rect(0.0, 0.0, 100.0, 100.0),
+        obstacles: Vec::new(),
+    };
+    let plan = FieldPlan {
+        segments: vec![
+            seg(SegmentKind::Work, 0, line(v2(0.0, 50.0), v2(100.0, 50.0))),
+            seg(kind, 1, second),
+        ],
+        working_area: vec![(field.boundary.clone(), Vec::new())],
+        swaths: 2,
+        sections,
+        ..FieldPlan::default()
+    };
+    (field, plan)
+}
+
+#[test]
+fn sections_switch_off_over_the_swaths_and_detours_driven_before() {
+    // Crossing square: the whole implement lays the 10 × 10 m crossing twice; its sections
+    // switch off over it.
+    let crossing = line(v2(50.0, 0.0), v2(50.0, 100.0));
+    let (field, whole) = over_a_swath_before(crossing.clone(), SegmentKind::Work, 1);
+    let (_, sectioned) = over_a_swath_before(crossing, SegmentKind::Work, 5);
+    let (m, s) = (
+        plan_metrics(&field, &whole, 10.0),
+        plan_metrics(&field, &sectioned, 10.0),
+    );
+    assert!(
+        (m.overlap_fraction - 100.0 / 1900.0).abs() < 1e-6,
+        "{}",
+        m.overlap_fraction
+    );
+    assert!(s.overlap_fraction.abs() < 1e-6, "{}", s.overlap_fraction);
+    // A bent path (a detour's shape: not straight) 7 m from the swath over its first half,
+    // 3 m of its width over the swath's: two of five sections switch off there, one stays on
+    // over its 1 m; beyond the bend it climbs away.
+    let mut bent = line(v2(0.0, 57.0), v2(50.0, 57.0));
+    bent.extend(line(v2(50.0, 57.0), v2(100.0, 70.0)).into_iter().skip(1));
+    let (_, whole) = over_a_swath_before(bent.clone(), SegmentKind::Detour, 1);
+    let (_, sectioned) = over_a_swath_before(bent, SegmentKind::Detour, 5);
+    let (m, s) = (
+        plan_metrics(&field, &whole, 10.0),
+        plan_metrics(&field, &sectioned, 10.0),
+    );
+    assert!(m.overlap_fraction > 0.0);
+    assert!(
+        s.overlap_fraction < 0.5 * m.overlap_fraction,
+        "sectioned {} whole {}",
+        s.overlap_fraction,
+        m.overlap_fraction
+    );
+    assert!((s.covered_fraction - m.covered_fraction).abs() < 1e-9);
+}
+
+#[test]
+fn a_headland_pass_switches_sections_off_over_the_pass_before() {
+    // Two square passes round a 100 × 100 m field at w 10 m, 5 m apart: the inner one lays a
+    // 5 m band over the outer one's footprint. With five 2 m sections the two outermost of the
+    // inner pass switch off there and one stays on over its 1 m: about a fifth of the band.
+    let field = Field {
+        boundary: rect(0.0, 0.0, 100.0, 100.0),
+        obstacles: Vec::new(),
+    };
+    let ring = |inset: f64| {
+        let (lo, hi) = (inset, 100.0 - inset);
+        let corners = [v2(lo, lo), v2(hi, lo), v2(hi, hi), v2(lo, hi), v2(lo, lo)];
+        let mut pts = vec![corners[0]];
+        for c in corners.windows(2) {
+            pts.extend(line(c[0], c[1]).into_iter().skip(1));
+        }
+        pts
+    };
+    let plan = |sections| FieldPlan {
+        segments: vec![
+            seg(SegmentKind::Headland, 0, ring(5.0)),
+            seg(SegmentKind::Headland, 1, ring(10.0)),
+        ],
+        working_area: vec![(rect(15.0, 15.0, 85.0, 85.0), Vec::new())],
+        sections,
+        ..FieldPlan::default()
+    };
+    let (m, s) = (
+        plan_metrics(&field, &plan(1), 10.0),
+        plan_metrics(&field, &plan(5), 10.0),
+    );
+    assert!(m.overlap_fraction > 0.0);
+    assert!(s.overlap_fraction > 0.0);
+    assert!(
+        s.overlap_fraction < 0.35 * m.overlap_fraction,
+        "sectioned {} whole {}",
+        s.overlap_fraction,
+        m.overlap_fraction
+    );
+    assert!((s.covered_fraction - m.covered_fraction).abs() < 1e-9);
 }
