@@ -367,14 +367,24 @@ fn headland_sections_area<'a>(
         let m = pts.len() - 1;
         for (i, seg) in pts.windows(2).enumerate() {
             let (first, last) = (!closed && i == 0, !closed && i + 1 == m);
-            // In every cell its bounding box meets (a segment is shorter than a cell or so).
-            let (lo, hi) = (key(&seg[0]), key(&seg[1]));
-            for x in lo.0.min(hi.0)..=lo.0.max(hi.0) {
-                for y in lo.1.min(hi.1)..=lo.1.max(hi.1) {
-                    grid.entry((x, y))
-                        .or_default()
-                        .push((seg[0], seg[1], first, last));
-                }
+            // In every cell that the bounding box of a piece of it, a cell long at most, meets
+            // (a long diagonal segment's own box would span a square of cells).
+            let d = seg[1] - seg[0];
+            let pieces = (d.norm() / cell).ceil().max(1.0) as usize;
+            let mut cells: Vec<(i64, i64)> = (0..pieces)
+                .flat_map(|k| {
+                    let a = key(&(seg[0] + d * (k as f64 / pieces as f64)));
+                    let b = key(&(seg[0] + d * ((k + 1) as f64 / pieces as f64)));
+                    (a.0.min(b.0)..=a.0.max(b.0))
+                        .flat_map(move |x| (a.1.min(b.1)..=a.1.max(b.1)).map(move |y| (x, y)))
+                })
+                .collect();
+            cells.sort_unstable();
+            cells.dedup();
+            for c in cells {
+                grid.entry(c)
+                    .or_default()
+                    .push((seg[0], seg[1], first, last));
             }
         }
     }
