@@ -6,6 +6,7 @@
 //! ISO 11783-10 TASKDATA into one). Every stage is a pure function of its inputs.
 
 mod apart;
+mod attempts;
 pub mod bypass;
 mod clear_map;
 mod closed;
@@ -37,10 +38,6 @@ use runs::drive_run;
 
 use crate::geo::{v2, vec_heading, wrap_angle, Direction, Vec2};
 use crate::plan::types::PlanError;
-
-/// The reversing transits are tried with the ends pulled back this many times, evenly up to
-/// the forward attempts' longest pull-back (none first).
-const REVERSE_CUTS: usize = 4;
 
 /// States a transit's waypoint search may expand before giving up.
 const ROUTE_MAX_EXPANSIONS: usize = 20_000;
@@ -308,37 +305,8 @@ fn plan_once(
                 heading_at(target, cut_next),
             )
         };
-        // Without shortening any work first (direct, then along the headland), then pulling
-        // the ends back metre by metre up to r_min, then backing out (a Reeds–Shepp path with
-        // only the tractor inside the field, no work shortened), then pulling back further,
-        // then along the headland again; all with the implement clear of the edge. Then with
-        // only the tractor inside the field: direct, along the headland, through waypoints,
-        // and backing out with the ends pulled back.
-        #[derive(Clone, Copy, Debug)]
-        enum Way {
-            Direct,
-            Headland,
-            Waypoints,
-            Reverse,
-        }
-        let before_reverse = ((p.r_min / p.point_spacing).ceil() as usize).min(max_cut);
-        let mut attempts = vec![(0, Way::Direct, false), (0, Way::Headland, false)];
-        attempts.extend((1..=before_reverse).map(|t| (t, Way::Direct, false)));
-        attempts.push((0, Way::Reverse, true));
-        attempts.extend((before_reverse + 1..=max_cut).map(|t| (t, Way::Direct, false)));
-        attempts.push((max_cut, Way::Headland, false));
-        attempts.extend([
-            (0, Way::Direct, true),
-            (0, Way::Headland, true),
-            (0, Way::Waypoints, true),
-        ]);
-        attempts.extend(
-            (1..REVERSE_CUTS).map(|i| (i * max_cut / (REVERSE_CUTS - 1), Way::Reverse, true)),
-        );
-        if cell >= worked_cells {
-            // (To a cell of its own, left when not reached: no waypoint search, the dearest.)
-            attempts.retain(|a| !matches!(a.1, Way::Waypoints));
-        }
+        use attempts::Way;
+        let attempts = attempts::order(p, max_cut, cell >= worked_cells);
         let mut found = None;
         // The relaxed headland attempt without shortening, made first (once) where the tests
         // differ and one of this plan's relaxed headland attempts found no way before: its
