@@ -172,7 +172,10 @@ fn sections_area<'a>(
     let (mut out, mut curved) = (Vec::new(), 0.0);
     // The whole footprints of the swaths and detours driven so far, in driving order, with
     // their bounding boxes.
-    let mut done: Vec<(Area, (Vec2, Vec2))> = Vec::new();
+    // (A straight swath also with its centre line: two swaths' footprints meet only where
+    // their centre lines come closer than w, which neighbours w apart do not.)
+    type Done = (Area, (Vec2, Vec2), Option<(Vec2, Vec2)>);
+    let mut done: Vec<Done> = Vec::new();
     let meets = |(lo, hi): &(Vec2, Vec2), (a, b): &(Vec2, Vec2)| {
         lo.x <= b.x && a.x <= hi.x && lo.y <= b.y && a.y <= hi.y
     };
@@ -189,16 +192,18 @@ fn sections_area<'a>(
             let bounds = bbox(stroked.iter().flat_map(|g| g.0.iter())).unwrap_or((a, b));
             let before: Vec<&Area> = done
                 .iter()
-                .filter(|(_, bb)| meets(bb, &bounds))
-                .map(|(g, _)| g)
+                .filter(|(_, bb, _)| meets(bb, &bounds))
+                .map(|(g, _, _)| g)
                 .collect();
-            curved += stroked.iter().map(super::geometry::area_m2).sum::<f64>()
+            let whole: f64 = stroked.iter().map(super::geometry::area_m2).sum();
+            curved += (whole
                 - curved_sections(&pts, width, n, &|q| {
                     in_any(ground.iter(), q) && !in_any(before.iter().copied(), q)
-                });
+                }))
+            .max(0.0);
             done.extend(stroked.into_iter().map(|g| {
                 let bb = bbox(g.0.iter()).unwrap_or((a, b));
-                (g, bb)
+                (g, bb, None)
             }));
             continue;
         }
@@ -225,8 +230,11 @@ fn sections_area<'a>(
         // What was worked before that may lie under this swath, in its frame.
         let before: Vec<Area> = done
             .iter()
-            .filter(|(_, bb)| meets(bb, &bounds))
-            .map(|(g, _)| rotate_area(g, -angle))
+            .filter(|(_, bb, centre)| {
+                meets(bb, &bounds)
+                    && centre.is_none_or(|(c0, c1)| segment_distance(&(a, b), &(c0, c1)) < width)
+            })
+            .map(|(g, _, _)| rotate_area(g, -angle))
             .collect();
         let stretches: Vec<Vec<(f64, f64)>> = (0..n)
             .map(|k| {
@@ -251,9 +259,24 @@ fn sections_area<'a>(
             })
             .collect();
         out.extend(sections_polygons(&stretches, w, &lateral, &at));
-        done.push(((corners, Vec::new()), bounds));
+        done.push(((corners, Vec::new()), bounds, Some((a, b))));
     }
     out.iter().map(|q| q.unsigned_area()).sum::<f64>() + curved
+}
+
+/// The least distance between the segments `a` and `b`, m.
+fn segment_distance((a0, a1): &(Vec2, Vec2), (b0, b1): &(Vec2, Vec2)) -> f64 {
+    if crate::geo::polygon::segments_intersect(a0, a1, b0, b1) {
+        return 0.0;
+    }
+    [
+        point_segment_distance(a0, b0, b1),
+        point_segment_distance(a1, b0, b1),
+        point_segment_distance(b0, a0, a1),
+        point_segment_distance(b1, a0, a1),
+    ]
+    .into_iter()
+    .fold(f64::INFINITY, f64::min)
 }
 
 /// Is `q` in one of `areas` (inside its outer ring, outside its holes)?
