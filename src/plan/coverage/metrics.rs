@@ -138,11 +138,11 @@ fn stroke(pts: &[Vec2], width: f64) -> Vec<Polygon<f64>> {
 /// and outside are a rounding apart.
 const SECTION_EDGE_INSET_M: f64 = 0.01;
 
-/// The ground the swaths and detours (`Work`, `Detour`, in driving order) of a plan made for
-/// n > 1 sections work, as a section controller with a coverage map switches them: each
-/// section on where ground left to work lies under it (its centre line or one of its edge
-/// lines, [`SECTION_EDGE_INSET_M`] inside, over it). Left to work: `ground` (the field less
-/// the headland passes' footprints) less the footprints of the swaths and detours driven
+/// The area, m², that the swaths and detours (`Work`, `Detour`, in driving order) of a plan
+/// made for n > 1 sections work, as a section controller with a coverage map switches them:
+/// each section on where ground left to work lies under it (its centre line or one of its
+/// edge lines, [`SECTION_EDGE_INSET_M`] inside, over it). Left to work: `ground` (the field
+/// less the headland passes' footprints) less the footprints of the swaths and detours driven
 /// before. A section switches off only once nothing under it is left to work, so section
 /// control never leaves a sliver where an edge runs slanted to the swaths, and lays at most a
 /// section's width twice. Each straight swath's sections are found on scan lines in the
@@ -150,12 +150,11 @@ const SECTION_EDGE_INSET_M: f64 = 0.01;
 /// a curved path (a detour round an obstacle) is sampled along its length
 /// ([`curved_sections`]).
 ///
-/// The union of these strokes and the headland passes' footprints is that of the whole
+/// The ground so worked, united with the headland passes' footprints, is that of the whole
 /// footprints (a section is off only over ground worked by the passes or before), so
-/// [`plan_metrics`] takes the
-/// ground worked from the whole footprints and these only for the sum of their areas (the
-/// overlap): united, their many near-coincident long edges kept i_overlay 4's fragment split
-/// busy for minutes on a large field at w 3 m (bg_arable_60ha).
+/// [`plan_metrics`] takes the ground worked from the whole footprints and this area only for
+/// the overlap: united, the sections' many near-coincident long edges kept i_overlay 4's
+/// fragment split busy for minutes on a large field at w 3 m (bg_arable_60ha).
 fn sections_area<'a>(
     swaths: impl IntoIterator<Item = &'a PlanSegment>,
     width: f64,
