@@ -15,7 +15,6 @@
 
 use super::geometry::{self, Area};
 use super::Field;
-use crate::geo::polygon::contains_point;
 use crate::geo::Vec2;
 use std::cell::OnceCell;
 
@@ -54,11 +53,7 @@ impl<'a> Apart<'a> {
             let whole = (self.field.boundary.clone(), self.field.obstacles.clone());
             geometry::offset(&[whole], -self.depth)
         });
-        let piece = |q: &Vec2| {
-            pieces.iter().position(|(outer, holes)| {
-                contains_point(outer, q) && !holes.iter().any(|h| contains_point(h, q))
-            })
-        };
+        let piece = |q: &Vec2| pieces.iter().position(|piece| geometry::in_area(piece, q));
         matches!((piece(a), piece(b)), (Some(i), Some(j)) if i != j)
     }
 }

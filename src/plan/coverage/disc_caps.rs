@@ -5,20 +5,12 @@
 //! overlapping discs cost 18 ms a pass. Each disc is cut by a line beyond which no point of the
 //! area lies inside its circle, so the area minus the caps is the area minus the discs.
 
-use super::geometry::Area;
-use crate::geo::polygon::contains_point;
+use super::geometry::{in_area, Area};
 use crate::geo::{v2, Vec2};
 
 /// Clearance of the cutting line beyond the area's farthest point inside the circle, m: the
 /// cap keeps the disc's boundary wherever it could meet the area, with this to spare.
 const CUT_MARGIN: f64 = 0.01;
-
-/// Is `p` inside `area` (its outer ring and none of its holes; the holes may overlap)?
-fn inside(area: &[Area], p: &Vec2) -> bool {
-    area.iter().any(|(outer, holes)| {
-        contains_point(outer, p) && !holes.iter().any(|h| contains_point(h, p))
-    })
-}
 
 /// The part of `disc` (a convex counter-clockwise polygon whose vertices lie on the circle of
 /// radius `rr` about `c`) that can meet `area`: the disc cut by a line beyond which no point of
@@ -94,7 +86,10 @@ pub(super) fn cap(disc: Vec<Vec2>, c: Vec2, rr: f64, area: &[Area]) -> Option<Ve
     let on_circle = |a: f64| c + v2(a.cos(), a.sin()) * rr;
     let inside_arcs: Vec<(f64, f64)> = arcs
         .into_iter()
-        .filter(|&(a0, sweep)| inside(area, &on_circle(a0 + 0.5 * sweep)))
+        .filter(|&(a0, sweep)| {
+            area.iter()
+                .any(|a| in_area(a, &on_circle(a0 + 0.5 * sweep)))
+        })
         .collect();
     if ends.is_empty() && inside_arcs.is_empty() {
         return None;

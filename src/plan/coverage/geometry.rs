@@ -156,6 +156,12 @@ pub fn scan_intervals(area: &Area, y: f64) -> Vec<(f64, f64)> {
     xs.chunks_exact(2).map(|c| (c[0], c[1])).collect()
 }
 
+/// Is `q` inside `area`: in its outer ring and in none of its holes?
+pub fn in_area((outer, holes): &Area, q: &Vec2) -> bool {
+    use crate::geo::polygon::contains_point;
+    contains_point(outer, q) && !holes.iter().any(|h| contains_point(h, q))
+}
+
 /// Area of an area with holes, m².
 pub fn area_m2(area: &Area) -> f64 {
     signed_area(&area.0) - area.1.iter().map(|h| signed_area(h).abs()).sum::<f64>()

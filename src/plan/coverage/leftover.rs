@@ -2,12 +2,11 @@
 //! cover (docs/METHODS.md, Headland and working area): found once from the passes' areas, it
 //! joins the working area where an implement-wide disc fits, or is worked as cells of its own.
 
-use super::geometry::{offset, simplified, Area};
+use super::geometry::{in_area, offset, simplified, Area};
 use super::headland::{
     difference, pass_offset, ring_distance, union, Passes, SMOOTHING_RADIUS_FACTOR,
 };
 use super::CoverageParams;
-use crate::geo::polygon::contains_point;
 use crate::geo::Vec2;
 
 /// Vertices of the leftover ground dropped within this distance of its outline, m
@@ -113,11 +112,11 @@ pub fn with_leftover(
         .collect();
     // Is `q` in or on a leftover piece (a kept piece's vertices lie in or on the piece it came
     // from, within the simplification)?
-    let near = |q: &Vec2, (outer, holes): &Area| {
-        std::iter::once(outer)
-            .chain(holes)
+    let near = |q: &Vec2, piece: &Area| {
+        std::iter::once(&piece.0)
+            .chain(&piece.1)
             .any(|ring| ring_distance(std::slice::from_ref(q), ring) < 2.0 * LEFTOVER_SIMPLIFY_M)
-            || (contains_point(outer, q) && !holes.iter().any(|h| contains_point(h, q)))
+            || in_area(piece, q)
     };
     // Each kept piece stands by sixteen of its vertices, spread round it, for the piece it
     // came from; a piece whose opening kept less than KEPT_FRACTION of it (a strip narrower than

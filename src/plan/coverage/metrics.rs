@@ -9,7 +9,7 @@
 pub mod checks;
 
 use super::{Field, FieldPlan, PlanSegment, SegmentKind};
-use crate::geo::polygon::{bbox, contains_point, point_segment_distance};
+use crate::geo::polygon::{bbox, contains_point, point_segment_distance, segment_distance};
 use crate::geo::{cross, Vec2};
 use geo::algorithm::buffer::{BufferStyle, LineCap, LineJoin};
 use geo::{Area, BooleanOps, Buffer, Coord, LineString, MultiLineString, MultiPolygon, Polygon};
@@ -138,6 +138,17 @@ fn stroke(pts: &[Vec2], width: f64) -> Vec<Polygon<f64>> {
 /// and outside are a rounding apart.
 const SECTION_EDGE_INSET_M: f64 = 0.01;
 
+/// `n` equal sections across an implement `width` wide: each one's width, m; the lateral
+/// offset of section k's centre (left of the implement's centre positive), m; and the offsets
+/// from a section's centre of the lines whose ground tells whether it is on: its edges
+/// [`SECTION_EDGE_INSET_M`] inside, and its centre, m.
+fn section_layout(width: f64, n: usize) -> (f64, impl Fn(usize) -> f64, [f64; 3]) {
+    let w = width / n as f64;
+    let edge = 0.5 * w - SECTION_EDGE_INSET_M.min(0.25 * w);
+    let lateral = move |k: usize| (k as f64 + 0.5) * w - 0.5 * width;
+    (w, lateral, [-edge, 0.0, edge])
+}
+
 /// The area, m², that the swaths and detours (`Work`, `Detour`, in driving order) of a plan
 /// made for n > 1 sections work, as a section controller with a coverage map switches them:
 /// each section on where ground left to work lies under it (its centre line or one of its
@@ -161,13 +172,11 @@ fn sections_area<'a>(
     n: usize,
     ground: &MultiPolygon<f64>,
 ) -> f64 {
-    use super::geometry::{from_geo, rotate, rotate_area, scan_intervals, Area};
+    use super::geometry::{from_geo, in_area, rotate, rotate_area, scan_intervals, Area};
     let ground = from_geo(ground);
     // The ground turned into each swath direction met so far (swaths of a cell share one).
     let mut turned: Vec<(f64, Vec<Area>)> = Vec::new();
-    let w = width / n as f64;
-    let lateral = |k: usize| (k as f64 + 0.5) * w - 0.5 * width;
-    let edge = 0.5 * w - SECTION_EDGE_INSET_M.min(0.25 * w);
+    let (w, lateral, probes) = section_layout(width, n);
     let (mut out, mut curved) = (Vec::new(), 0.0);
     // The whole footprints of the swaths and detours driven so far, in driving order, with
     // their bounding boxes.
@@ -197,7 +206,7 @@ fn sections_area<'a>(
             let whole: f64 = stroked.iter().map(super::geometry::area_m2).sum();
             curved += (whole
                 - curved_sections(&pts, width, n, &|q| {
-                    in_any(ground.iter(), q) && !in_any(before.iter().copied(), q)
+                    ground.iter().any(|g| in_area(g, q)) && !before.iter().any(|g| in_area(g, q))
                 }))
             .max(0.0);
             done.extend(stroked.into_iter().map(|g| {
@@ -231,13 +240,13 @@ fn sections_area<'a>(
             .iter()
             .filter(|(_, bb, centre)| {
                 meets(bb, &bounds)
-                    && centre.is_none_or(|(c0, c1)| segment_distance(&(a, b), &(c0, c1)) < width)
+                    && centre.is_none_or(|(c0, c1)| segment_distance(a, b, c0, c1).0 < width)
             })
             .map(|(g, _, _)| rotate_area(g, -angle))
             .collect();
         let stretches: Vec<Vec<(f64, f64)>> = (0..n)
             .map(|k| {
-                let lines = [-edge, 0.0, edge].map(|d| start.y + lateral(k) + d);
+                let lines = probes.map(|d| start.y + lateral(k) + d);
                 let left_on = |y: f64| {
                     let left = areas.iter().flat_map(|g| scan_intervals(g, y)).collect();
                     let worked = before.iter().flat_map(|g| scan_intervals(g, y)).collect();
@@ -263,28 +272,6 @@ fn sections_area<'a>(
     out.iter().map(|q| q.unsigned_area()).sum::<f64>() + curved
 }
 
-/// The least distance between the segments `a` and `b`, m.
-fn segment_distance((a0, a1): &(Vec2, Vec2), (b0, b1): &(Vec2, Vec2)) -> f64 {
-    if crate::geo::polygon::segments_intersect(a0, a1, b0, b1) {
-        return 0.0;
-    }
-    [
-        point_segment_distance(a0, b0, b1),
-        point_segment_distance(a1, b0, b1),
-        point_segment_distance(b0, a0, a1),
-        point_segment_distance(b1, a0, a1),
-    ]
-    .into_iter()
-    .fold(f64::INFINITY, f64::min)
-}
-
-/// Is `q` in one of `areas` (inside its outer ring, outside its holes)?
-fn in_any<'a>(mut areas: impl Iterator<Item = &'a super::geometry::Area>, q: &Vec2) -> bool {
-    areas.any(|(outer, holes)| {
-        contains_point(outer, q) && !holes.iter().any(|h| contains_point(h, q))
-    })
-}
-
 /// Spacing of the samples along a curved path whose sections are found one sample at a time,
 /// m ([`curved_sections`]).
 const CURVED_SAMPLE_M: f64 = 0.2;
@@ -296,9 +283,7 @@ const CURVED_SAMPLE_M: f64 = 0.2;
 /// samples' cross-sections. (The path's footprint less this is the ground its sections work:
 /// quadrilaterals summed would count twice what a tight bend's inner side sweeps twice.)
 fn curved_sections(pts: &[Vec2], width: f64, n: usize, left: &dyn Fn(&Vec2) -> bool) -> f64 {
-    let w = width / n as f64;
-    let lateral = |k: usize| (k as f64 + 0.5) * w - 0.5 * width;
-    let edge = 0.5 * w - SECTION_EDGE_INSET_M.min(0.25 * w);
+    let (w, lateral, probes) = section_layout(width, n);
     // Samples (point, left normal) along the path.
     let mut samples: Vec<(Vec2, Vec2)> = Vec::new();
     for seg in pts.windows(2) {
@@ -315,7 +300,7 @@ fn curved_sections(pts: &[Vec2], width: f64, n: usize, left: &dyn Fn(&Vec2) -> b
         samples.push((*last, normal));
     }
     let on_at = |(q, normal): &(Vec2, Vec2), k: usize| {
-        [-edge, 0.0, edge]
+        probes
             .iter()
             .any(|d| left(&(q + normal * (lateral(k) + d))))
     };

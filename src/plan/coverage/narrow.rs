@@ -83,12 +83,12 @@ pub fn parts(field: &Field) -> Vec<super::geometry::Area> {
 
 /// Index of the part of `parts` nearest `q` (0 when there are none).
 pub fn part_of(parts: &[super::geometry::Area], q: &crate::geo::Vec2) -> usize {
-    use crate::geo::polygon::{contains_point, point_segment_distance};
-    let distance = |(outer, holes): &super::geometry::Area| {
-        let inside = contains_point(outer, q) && !holes.iter().any(|h| contains_point(h, q));
-        if inside {
+    use crate::geo::polygon::point_segment_distance;
+    let distance = |area: &super::geometry::Area| {
+        if super::geometry::in_area(area, q) {
             return 0.0;
         }
+        let (outer, holes) = area;
         std::iter::once(outer)
             .chain(holes.iter())
             .flat_map(|r| {

@@ -11,7 +11,7 @@
 //! distance 0). Walking back from the two closest points to the roots gives the route.
 
 use super::collision::{CollisionMap, Footprint};
-use crate::geo::polygon::closest_point_on_segment;
+use crate::geo::polygon::segment_distance;
 use crate::geo::{cross, left_normal, v2, vec_heading, Pose, Vec2};
 use std::collections::HashSet;
 
@@ -70,46 +70,6 @@ pub fn leg_clear(map: &CollisionMap, fp: &Footprint, a: Vec2, b: Vec2, spacing_m
             map.pose_clear(fp, &Pose::new(p.x, p.y, heading)).is_ok()
         })
     })
-}
-
-/// The crossing point of two segments, if they cross (parallel ones never do here).
-fn segments_intersect_point(a0: &Vec2, a1: &Vec2, b0: &Vec2, b1: &Vec2) -> Option<Vec2> {
-    let r = a1 - a0;
-    let s = b1 - b0;
-    let den = cross(&r, &s);
-    if den.abs() < 1e-12 {
-        return None;
-    }
-    let t = cross(&(b0 - a0), &s) / den;
-    let u = cross(&(b0 - a0), &r) / den;
-    ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)).then(|| a0 + r * t)
-}
-
-/// Distance between two segments and the closest points (on the first, on the second).
-fn segment_distance(a0: Vec2, a1: Vec2, b0: Vec2, b1: Vec2) -> (f64, Vec2, Vec2) {
-    if let Some(p) = segments_intersect_point(&a0, &a1, &b0, &b1) {
-        return (0.0, p, p);
-    }
-    // Each endpoint against the other segment; the nearest pair wins.
-    let cands = [
-        (a0, b0, b1, true),
-        (a1, b0, b1, true),
-        (b0, a0, a1, false),
-        (b1, a0, a1, false),
-    ]
-    .map(|(p, s0, s1, p_on_a)| {
-        let q = closest_point_on_segment(&p, &s0, &s1);
-        let d = (p - q).norm();
-        if p_on_a {
-            (d, p, q)
-        } else {
-            (d, q, p)
-        }
-    });
-    cands
-        .into_iter()
-        .min_by(|x, y| x.0.total_cmp(&y.0))
-        .unwrap_or((f64::INFINITY, a0, b0))
 }
 
 /// Drop route points where the route goes straight on, so each leg is a real change of
