@@ -680,6 +680,10 @@ fn plan_once(
                     let gaps = transit_gaps.get();
                     let own = ci >= worked_cells;
                     let mut before = (segments.len(), segments.last().cloned(), at, warnings_len());
+                    let mut put_back = false;
+                    // What undoing the last own run took off, put back on if the run of the
+                    // others finds no transit from where that one was entered either.
+                    let mut redo = None;
                     for attempt in 0..2 {
                         drive_run(
                             &run,
@@ -707,8 +711,24 @@ fn plan_once(
                             kept.map(|(_, state, runs)| (state, runs))
                         };
                         let Some(((len, last, pose, warned), runs)) = undo else {
+                            if let Some((tail, state, all_warned, gaps_then)) = redo.take() {
+                                if transit_gaps.get() >= gaps_then {
+                                    segments.truncate(before.0.saturating_sub(1));
+                                    segments.extend(tail);
+                                    (at, swath_total) = state;
+                                    *warnings.borrow_mut() = all_warned;
+                                    transit_gaps.set(gaps_then);
+                                }
+                            }
                             break;
                         };
+                        if !own {
+                            let from = len.saturating_sub(1);
+                            let tail = segments[from.min(segments.len())..].to_vec();
+                            let all_warned = warnings.borrow().clone();
+                            let gaps_then = transit_gaps.get();
+                            redo = Some((tail, (at, swath_total), all_warned, gaps_then));
+                        }
                         segments.truncate(len);
                         if let (Some(l), Some(kept)) = (segments.last_mut(), last) {
                             *l = kept;
@@ -717,14 +737,17 @@ fn plan_once(
                         warnings.borrow_mut().truncate(warned);
                         transit_gaps.set(gaps);
                         if own {
+                            put_back = true;
                             break;
                         }
                         before = (segments.len(), segments.last().cloned(), at, warnings_len());
                     }
-                    // (An own run put back leaves the one before it the last kept.)
+                    // (An own run put back leaves the one before it the last kept: set from it,
+                    // the next run of the others that found no transit undid nothing and took
+                    // the put-back run's swaths off the count a second time.)
                     if !own {
                         last_own = None;
-                    } else if transit_gaps.get() == gaps {
+                    } else if !put_back && transit_gaps.get() == gaps {
                         last_own = Some((segments.len(), before, run.len()));
                     }
                 }
