@@ -456,16 +456,18 @@ fn real_plan(name: &str, w: f64, r_min: f64) -> (Field, CoverageParams, FieldPla
         "{}/tools/fields/real/{name}.geojson",
         env!("CARGO_MANIFEST_DIR")
     );
-    let (field, p, plan) = plan_file(std::path::Path::new(&path), w, r_min);
+    let (field, p, plan) = plan_file(std::path::Path::new(&path), w, r_min, 1);
     (field, p, plan.expect("a plan"))
 }
 
 /// The field of the GeoJSON file at `path`, read as `agsteer plan` reads it, and its plan with
-/// the default configuration at width `w` and turning radius `r_min` (m).
+/// the default configuration at width `w` and turning radius `r_min` (m), the implement in
+/// `sections`.
 fn plan_file(
     path: &std::path::Path,
     w: f64,
     r_min: f64,
+    sections: usize,
 ) -> (
     Field,
     CoverageParams,
@@ -477,13 +479,15 @@ fn plan_file(
     let mut p = cfg.coverage_params();
     p.line_width = w;
     p.r_min = r_min;
+    p.sections = sections;
     let plan = plan_field(&loaded.field, &p);
     (loaded.field, p, plan)
 }
 
 /// The parcels of tools/fields/holdout/, which the planner was not developed on, at every
-/// width and turning radius of `agsteer plan --sweep` (3, 6, 12, 36 m; 5, 8 m): every plan
-/// keeps the guarantees (by these checks and by `check_plan`). Only the guarantees: the
+/// width and turning radius of `agsteer plan --sweep` (3, 6, 12, 36 m; 5, 8 m), without
+/// sections and with 8 (the swaths then run on to the cell's extent): every plan keeps the
+/// guarantees (by these checks and by `check_plan`). Only the guarantees: the
 /// coverage figures of this set are measured and reported (README, Session 30), not asserted.
 #[test]
 fn every_hold_out_parcel_keeps_the_guarantees() {
@@ -497,20 +501,23 @@ fn every_hold_out_parcel_keeps_the_guarantees() {
     assert!(files.len() >= 12, "{files:?}");
     let mut broken = Vec::new();
     for f in &files {
-        for w in [3.0, 6.0, 12.0, 36.0] {
-            for r_min in [5.0, 8.0] {
-                let (field, p, plan) = plan_file(f, w, r_min);
-                let name = f.file_name().unwrap_or_default().to_string_lossy();
-                let Ok(plan) = plan else {
-                    broken.push(format!("{name} w {w} r_min {r_min}: no plan: {plan:?}"));
-                    continue;
-                };
-                let mut found = independent_violations(&field, &plan, p.line_width, p.r_min);
-                let checked = check_plan(&field, &plan, p.line_width, p.r_min);
-                found.extend(checked.iter().map(|v| format!("check_plan: {v:?}")));
-                if !found.is_empty() {
-                    broken.push(format!("{name} w {w} r_min {r_min}: {}", found.join("; ")));
-                }
+        let name = f.file_name().unwrap_or_default().to_string_lossy();
+        for (w, r_min, sections) in [3.0, 6.0, 12.0, 36.0]
+            .into_iter()
+            .flat_map(|w| [5.0, 8.0].map(|r| (w, r)))
+            .flat_map(|(w, r)| [1, 8].map(|n| (w, r, n)))
+        {
+            let case = format!("{name} w {w} r_min {r_min} sections {sections}");
+            let (field, p, plan) = plan_file(f, w, r_min, sections);
+            let Ok(plan) = plan else {
+                broken.push(format!("{case}: no plan: {plan:?}"));
+                continue;
+            };
+            let mut found = independent_violations(&field, &plan, p.line_width, p.r_min);
+            let checked = check_plan(&field, &plan, p.line_width, p.r_min);
+            found.extend(checked.iter().map(|v| format!("check_plan: {v:?}")));
+            if !found.is_empty() {
+                broken.push(format!("{case}: {}", found.join("; ")));
             }
         }
     }
