@@ -547,6 +547,25 @@ fn a_leftover_run_that_strands_the_vehicle_is_put_back() {
     assert!(plan.swaths > 0);
 }
 
+/// A run of the working area that ends with a short swath in a pocket no transit leads out of
+/// (`es_cat_many_vertices` at w 3 m, r_min 8 m): the last swath is put back and the next run
+/// is driven from the swath before it, where before session 30 the plan went on from the
+/// pocket without a transit (one place; now none, for 0.04 % of the field left unworked).
+#[test]
+fn a_runs_last_swath_in_a_pocket_is_put_back_for_a_transit() {
+    let (field, p, plan) = real_plan("es_cat_many_vertices", 3.0, 8.0);
+    assert!(check_plan(&field, &plan, p.line_width, p.r_min).is_empty());
+    assert_eq!(plan.transit_gaps, 0, "{:?}", plan.warnings);
+    assert!(
+        !plan
+            .warnings
+            .iter()
+            .any(|w| w.contains("no transit inside the field from (")),
+        "{:?}",
+        plan.warnings
+    );
+}
+
 /// A real parcel whose parts join only by necks a few metres wide (`de_bb_concave` at w 12 m,
 /// r_min 8 m): before session 5 five transits found no way inside the field and were planned
 /// as the shortest curve, out of it (exit 4). The plan now goes on from the target without a

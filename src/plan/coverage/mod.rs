@@ -531,7 +531,7 @@ fn plan_once(
     let mut pending: Vec<(usize, Vec2, _)> = pending
         .into_iter()
         .map(|run| {
-            let q = run_start(&run.2, &run.3, run.1);
+            let q = runs::run_start(&run.2, &run.3, run.1);
             (regions.of(&q), q, run)
         })
         .collect();
@@ -674,9 +674,9 @@ fn plan_once(
                     };
                     let (_, _, (ci, angle, run, lines)) = pending.swap_remove(k);
                     // A run of those cells that no transit reaches is put back (not driven to
-                    // by hand); so is the last one kept when the next run of the others finds no
-                    // transit from its end (that run is then driven again from where the vehicle
-                    // entered the other).
+                    // by hand); so is the last one kept (of the working area's, its last swath)
+                    // when the next run of the others finds no transit from its end (that run is
+                    // then driven again from where the vehicle entered the other).
                     let gaps = transit_gaps.get();
                     let own = ci >= worked_cells;
                     let mut before = (segments.len(), segments.last().cloned(), at, warnings_len());
@@ -745,10 +745,20 @@ fn plan_once(
                     // (An own run put back leaves the one before it the last kept: set from it,
                     // the next run of the others that found no transit undid nothing and took
                     // the put-back run's swaths off the count a second time.)
-                    if !own {
+                    // A run of the working area: its last swath is put back instead when the
+                    // next run finds no transit from its end (a short piece in a pocket).
+                    if (own && !put_back) || (!own && transit_gaps.get() == gaps) {
+                        let last = (!own)
+                            .then(|| runs::before_last_swath(&segments, before.0))
+                            .flatten()
+                            .map(|(k, pose)| {
+                                let state = (k + 1, segments.get(k).cloned(), Some(pose));
+                                ((state.0, state.1, state.2, warnings_len()), 1)
+                            });
+                        let (state, runs) = last.unwrap_or((before, run.len()));
+                        last_own = Some((segments.len(), state, runs));
+                    } else if !own {
                         last_own = None;
-                    } else if !put_back && transit_gaps.get() == gaps {
-                        last_own = Some((segments.len(), before, run.len()));
                     }
                 }
             }
@@ -778,12 +788,6 @@ fn plan_once(
         sections: p.sections,
         pass_overlap_m: p.overlap,
     })
-}
-
-/// Where a swath run starts, in the field's frame.
-fn run_start(run: &[swaths::RunSwath], lines: &swaths::SwathLines, angle: f64) -> Vec2 {
-    let (line, (x0, _)) = run[0];
-    swaths::unrotate(v2(x0, lines.ys[line]), angle)
 }
 
 #[cfg(test)]

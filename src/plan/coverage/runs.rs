@@ -120,6 +120,30 @@ fn run_order(n: usize, spacing: f64, p: &CoverageParams, orders: &mut BlockOrder
     skip_order_with(n, min_gap_lines(p.r_min, spacing), 1, orders)
 }
 
+/// Where a swath run starts, in the field's frame.
+pub(super) fn run_start(run: &[swaths::RunSwath], lines: &swaths::SwathLines, angle: f64) -> Vec2 {
+    let (line, (x0, _)) = run[0];
+    swaths::unrotate(v2(x0, lines.ys[line]), angle)
+}
+
+/// Undoing the last swath of a run driven into `segments` from index `from` on: the index of
+/// the segment that then ends the plan (the swath before it, its turn onto the last one and
+/// the last one's pieces taken off) and the vehicle's pose at its end; `None` when the run
+/// holds a single swath (undo the whole run instead).
+pub(super) fn before_last_swath(
+    segments: &[PlanSegment],
+    from: usize,
+) -> Option<(usize, (Vec2, f64))> {
+    use SegmentKind::{Detour, Work};
+    let worked = |s: &PlanSegment| matches!(s.kind, Work | Detour);
+    let tail = segments.iter().rposition(|s| !worked(s))?;
+    let kept = segments[..tail].iter().rposition(worked)?;
+    let s = segments.get(kept).filter(|_| kept >= from)?;
+    let n = s.points.len();
+    let heading = vec_heading(&(s.points[n.checked_sub(1)?] - s.points[n.checked_sub(2)?]));
+    Some((kept, (s.points[n - 1], heading)))
+}
+
 #[allow(clippy::too_many_arguments)]
 pub(super) fn drive_run(
     run: &[swaths::RunSwath],
