@@ -103,7 +103,7 @@ pub fn point_segment_distance(p: &Vec2, a: &Vec2, b: &Vec2) -> f64 {
 }
 
 /// The crossing point of two segments, if they cross (parallel ones never do: `None`).
-pub fn segments_intersect_point(a0: &Vec2, a1: &Vec2, b0: &Vec2, b1: &Vec2) -> Option<Vec2> {
+fn segments_intersect_point(a0: &Vec2, a1: &Vec2, b0: &Vec2, b1: &Vec2) -> Option<Vec2> {
     let r = a1 - a0;
     let s = b1 - b0;
     let den = cross(&r, &s);

@@ -87,8 +87,8 @@ pub(super) fn cap(disc: Vec<Vec2>, c: Vec2, rr: f64, area: &[Area]) -> Option<Ve
     let inside_arcs: Vec<(f64, f64)> = arcs
         .into_iter()
         .filter(|&(a0, sweep)| {
-            area.iter()
-                .any(|a| in_area(a, &on_circle(a0 + 0.5 * sweep)))
+            let mid = on_circle(a0 + 0.5 * sweep);
+            area.iter().any(|a| in_area(a, &mid))
         })
         .collect();
     if ends.is_empty() && inside_arcs.is_empty() {

@@ -537,9 +537,10 @@ fn plan_once(
         .collect();
     let first = field_tracks.front().map(|t| t.0);
     let mut region = first.or_else(|| pending.first().map(|r| r.0)).unwrap_or(0);
-    // The last run kept of a cell of its own: the plan's length after it, where it was entered
-    // from, its swaths.
-    let mut last_own: Option<(usize, UndoPoint, usize)> = None;
+    // What to put back of the run kept last when the next run of the working area finds no
+    // transit from its end: the plan's length after that run, the state to return to, the
+    // swaths taken off.
+    let mut last_kept: Option<(usize, UndoPoint, usize)> = None;
     loop {
         for headland_phase in phases {
             if headland_phase {
@@ -707,10 +708,10 @@ fn plan_once(
                         } else if own {
                             Some((before.clone(), run.len()))
                         } else {
-                            let kept = last_own.take().filter(|(end, _, _)| *end == before.0);
-                            kept.map(|(_, state, runs)| (state, runs))
+                            let kept = last_kept.take().filter(|(end, _, _)| *end == before.0);
+                            kept.map(|(_, state, taken)| (state, taken))
                         };
-                        let Some(((len, last, pose, warned), runs)) = undo else {
+                        let Some(((len, last, pose, warned), taken)) = undo else {
                             if let Some((tail, state, all_warned, gaps_then)) = redo.take() {
                                 if transit_gaps.get() >= gaps_then {
                                     segments.truncate(before.0.saturating_sub(1));
@@ -733,7 +734,7 @@ fn plan_once(
                         if let (Some(l), Some(kept)) = (segments.last_mut(), last) {
                             *l = kept;
                         }
-                        (at, swath_total) = (pose, swath_total - runs);
+                        (at, swath_total) = (pose, swath_total - taken);
                         warnings.borrow_mut().truncate(warned);
                         transit_gaps.set(gaps);
                         if own {
@@ -742,23 +743,25 @@ fn plan_once(
                         }
                         before = (segments.len(), segments.last().cloned(), at, warnings_len());
                     }
-                    // (An own run put back leaves the one before it the last kept: set from it,
-                    // the next run of the others that found no transit undid nothing and took
-                    // the put-back run's swaths off the count a second time.)
-                    // A run of the working area: its last swath is put back instead when the
-                    // next run finds no transit from its end (a short piece in a pocket).
-                    if (own && !put_back) || (!own && transit_gaps.get() == gaps) {
-                        let last = (!own)
-                            .then(|| runs::before_last_swath(&segments, before.0))
-                            .flatten()
-                            .map(|(k, pose)| {
-                                let state = (k + 1, segments.get(k).cloned(), Some(pose));
-                                ((state.0, state.1, state.2, warnings_len()), 1)
-                            });
-                        let (state, runs) = last.unwrap_or((before, run.len()));
-                        last_own = Some((segments.len(), state, runs));
+                    // Kept whole (an own run put back leaves the one before it the last kept):
+                    // of a cell of its own, the whole run is what to put back; of the working
+                    // area's, only its last swath (a short piece in a pocket).
+                    if !put_back && transit_gaps.get() == gaps {
+                        let last_swath = if own {
+                            None
+                        } else {
+                            runs::before_last_swath(&segments, before.0)
+                        };
+                        let (state, taken) = match last_swath {
+                            Some((k, pose)) => {
+                                let last = segments.get(k).cloned();
+                                ((k + 1, last, Some(pose), warnings_len()), 1)
+                            }
+                            None => (before, run.len()),
+                        };
+                        last_kept = Some((segments.len(), state, taken));
                     } else if !own {
-                        last_own = None;
+                        last_kept = None;
                     }
                 }
             }

@@ -139,9 +139,20 @@ pub(super) fn before_last_swath(
     let tail = segments.iter().rposition(|s| !worked(s))?;
     let kept = segments[..tail].iter().rposition(worked)?;
     let s = segments.get(kept).filter(|_| kept >= from)?;
-    let n = s.points.len();
-    let heading = vec_heading(&(s.points[n.checked_sub(1)?] - s.points[n.checked_sub(2)?]));
-    Some((kept, (s.points[n - 1], heading)))
+    Some((kept, end_pose(&s.points, s.direction)?))
+}
+
+/// The vehicle's pose at the end of a segment driven along `pts` in `direction`: the last
+/// point, and the heading the vehicle faces there (against the travel when reversing); `None`
+/// under two points.
+fn end_pose(pts: &[Vec2], direction: Direction) -> Option<(Vec2, f64)> {
+    let last = *pts.last()?;
+    let travel = vec_heading(&(last - pts.get(pts.len().checked_sub(2)?)?));
+    let heading = match direction {
+        Direction::Forward => travel,
+        Direction::Reverse => wrap_angle(travel + std::f64::consts::PI),
+    };
+    Some((last, heading))
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -379,8 +390,7 @@ pub(super) fn drive_run(
             pts.drain(..cut.min(pts.len().saturating_sub(2)));
             first = false;
         }
-        let n = pts.len();
-        let travel = vec_heading(&(pts[n - 1] - pts[n - 2]));
+        *at = end_pose(&pts, direction);
         let index = segments.len();
         segments.push(PlanSegment {
             kind,
@@ -389,11 +399,6 @@ pub(super) fn drive_run(
             cell,
             points: pts.clone(),
         });
-        let heading = match direction {
-            Direction::Forward => travel,
-            Direction::Reverse => wrap_angle(travel + std::f64::consts::PI),
-        };
-        *at = Some((pts[n - 1], heading));
     }
     Ok(())
 }
