@@ -244,6 +244,7 @@ impl Config {
             tracker_kind: t.kind,
             law: LawParams {
                 predictive_ld_max: t.predictive_ld_max_m,
+                feed_forward: t.curvature_feed_forward,
                 stanley_gain: t.stanley_gain_per_s,
                 stanley_soft_speed: t.stanley_soft_speed_mps,
                 lqr: crate::track::lqr::LqrWeights {
@@ -431,6 +432,7 @@ impl Config {
                 .min(f.max_wheel_rate_deg_s)
                 .to_radians(),
             sweep: self.turn_exit_slew(),
+            vehicle_lag: 0.0,
         }
     }
     /// The wheel angle the steering still has to sweep when the planned turn's exit has been

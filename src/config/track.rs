@@ -32,6 +32,10 @@ pub struct TrackConfig {
     /// The default (`predictive`) tracker's longest look-ahead from `ld_gain_s`, m: Ld =
     /// max(ld_min_m, min(ld_gain_s · v, predictive_ld_max_m), the steering's response time · v).
     pub predictive_ld_max_m: f64,
+    /// The default (`predictive`) tracker feeds the path's curvature forward, a steering
+    /// response ahead ([`FeedForward`](crate::track::pure_pursuit::FeedForward)): turns and
+    /// curves entered and left on the path, not a look-ahead early.
+    pub curvature_feed_forward: bool,
     /// Global points before the nearest one used as local-path nodes.
     pub local_nodes_before: usize,
     /// Global points after the nearest one used as local-path nodes.
@@ -129,7 +133,8 @@ impl Default for TrackConfig {
             ld_min_m: 3.0,
             ld_gain_s: 1.2,
             predictive_ld_max_m: PREDICTIVE_LD_MAX_M,
-            local_nodes_before: 1,
+            curvature_feed_forward: true,
+            local_nodes_before: 2,
             local_nodes_after: 10,
             tangent_length_m: 0.25,
             local_spacing_m: 0.1,

@@ -327,9 +327,12 @@ impl Controller {
                 Direction::Reverse => -a,
             }
         });
+        // The vehicle's lag as learnt so far, for the law's curvature feed-forward.
+        let mut tracker = self.params.tracker.clone();
+        tracker.steering.vehicle_lag = self.estimator.vehicle_lag();
         let law = self
             .law
-            .steer(local, &pose, est.speed.abs(), wheel, &self.params.tracker);
+            .steer(local, &pose, est.speed.abs(), wheel, &tracker);
         let mut tr = steering_from_travel(law, direction);
         // Integral action: learnt on work paths driven forward, applied on every path (the
         // disturbances it cancels do not stop at a line's end).

@@ -36,6 +36,9 @@ pub struct LawParams {
     /// The default law's longest look-ahead from the growth with speed, m
     /// (`track.predictive_ld_max_m`).
     pub predictive_ld_max: f64,
+    /// The default law feeds the path's curvature forward
+    /// ([`super::pure_pursuit::FeedForward`]; `track.curvature_feed_forward`).
+    pub feed_forward: bool,
     /// Stanley cross-track gain k, 1/s.
     pub stanley_gain: f64,
     /// Stanley softening speed, m/s.

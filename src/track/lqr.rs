@@ -314,6 +314,7 @@ mod tests {
     fn law_params() -> LawParams {
         LawParams {
             predictive_ld_max: 4.5,
+            feed_forward: true,
             stanley_gain: 2.5,
             stanley_soft_speed: 1.0,
             lqr: LqrWeights::default(),

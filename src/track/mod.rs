@@ -61,6 +61,10 @@ pub struct SteeringResponse {
     /// been driven (atan(L / turn radius) for turns of arcs, 0 for continuous-curvature turns
     /// planned within the steering's rate; `Config::turn_exit_slew`), rad.
     pub sweep: f64,
+    /// The vehicle's own lag behind its wheels (tyres, yaw inertia) as learnt so far
+    /// (`estimate::yaw_lag`), s: set by the controller every period, 0 in the configuration.
+    /// Only the curvature feed-forward's lead uses it (`pure_pursuit::FeedForward`).
+    pub vehicle_lag: f64,
 }
 
 /// The lag's phase budget: a look-ahead time of at least this many times the steering's lag
@@ -405,6 +409,7 @@ mod tests {
                 dead_time: 0.0,
                 rate: rate_deg.to_radians(),
                 sweep,
+                vehicle_lag: 0.0,
             },
         }
     }
@@ -652,6 +657,7 @@ mod tests {
             dead_time: 0.0,
             rate: 30f64.to_radians(),
             sweep,
+            vehicle_lag: 0.0,
         };
         let t = p.response_time();
         assert!(

@@ -57,7 +57,10 @@ pub fn law(
     dt: f64,
 ) -> Box<dyn SteeringLaw> {
     match kind {
-        TrackerKind::Predictive => Box::new(PurePursuit::predictive(params.predictive_ld_max)),
+        TrackerKind::Predictive => Box::new(PurePursuit::predictive(
+            params.predictive_ld_max,
+            params.feed_forward,
+        )),
         TrackerKind::PurePursuit => Box::new(PurePursuit::plain()),
         TrackerKind::Stanley => Box::new(Stanley::new(params)),
         TrackerKind::Lqr => Box::new(Lqr::new(params, tracker, dt)),
@@ -85,6 +88,7 @@ mod tests {
     fn only_the_model_based_trackers_use_every_compensation() {
         let p = LawParams {
             predictive_ld_max: 4.5,
+            feed_forward: true,
             stanley_gain: 2.5,
             stanley_soft_speed: 1.0,
             lqr: Default::default(),
