@@ -156,14 +156,12 @@ fn the_vehicles_own_lag_behind_its_wheels_is_led_on() {
 /// Session 31: the path's curvature fed forward (`track.curvature_feed_forward`). Pure pursuit
 /// alone turned into and out of a turn's arcs a look-ahead early and started the next line with
 /// its swing: on firm tyres at 15 km/h the line starts kept 0.54 cm RMS over the cell (`**`
-/// against Stanley's 0.39), and tractor_b's 20 s RTK float fell on a line started 24 cm off
-/// and dead-reckoned the acquisition on soft tyres (3.20 cm, max 24.8 over its 2.5 / 15 cm
-/// bounds). Now 0.40 and 1.07 cm.
+/// against Stanley's 0.39), and at 20 km/h on R 15 m arcs 4.70 cm (bound 5). Now 0.39 and 3.66.
 #[test]
 fn turns_fed_forward_start_the_lines_on_them() {
     for (var, scenario, bound_cm) in [
         ("tyre_slip_firm", "straight_15kmh", 0.47),
-        ("tractor_b", "rtk_float_20s", 2.0),
+        ("speed_20", "curve_r15", 4.2),
     ] {
         let (finished, got) = default_on(var, scenario);
         assert!(
