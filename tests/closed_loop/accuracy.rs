@@ -260,7 +260,7 @@ fn a_job_started_on_an_arc_starts_on_it_with_the_arc_s_steering() {
 /// `track::pure_pursuit::FeedForward`): pure pursuit alone turned the wheels into and out of
 /// a turn's arcs a look-ahead early, swung about the turn and started the next line with the
 /// swing (acquisition max, the largest |XTE| over a turn's exit and the first 20 m of the line:
-/// 15–20 cm at 4–15 km/h). Fed forward the turns end on the line [1.1–2.0 cm straight, 2.0 cm
+/// 15–20 cm at 4–15 km/h). Fed forward the turns end on the line [2.5–4.8 cm straight, 4.1 cm
 /// on R 30 m arcs].
 #[test]
 fn turns_end_on_the_next_line() {
@@ -273,7 +273,7 @@ fn turns_end_on_the_next_line() {
         let fed = scenario(name, TrackerChoice::Predictive, &[]);
         assert!(fed.finished, "{name}: {fed:?}");
         assert!(
-            cm(fed.acquisition_max_m) < 5.0,
+            cm(fed.acquisition_max_m) < 7.0,
             "{name}: acquisition max {:.2} cm",
             cm(fed.acquisition_max_m)
         );
