@@ -81,6 +81,18 @@ fn default_on(var: &str, scenario: &str) -> (bool, f64) {
     (r.finished, 100.0 * r.xte_rms_m)
 }
 
+/// Every cell (variation, scenario, bound cm) finishes with the default tracker within its
+/// bound.
+fn each_within(cells: &[(&str, &str, f64)]) {
+    for &(var, scenario, bound_cm) in cells {
+        let (finished, got) = default_on(var, scenario);
+        assert!(
+            finished && got <= bound_cm,
+            "{var}/{scenario}: {got:.2} cm, bound {bound_cm}"
+        );
+    }
+}
+
 #[test]
 fn sampled_envelope_cells_stay_within_twice_their_figures() {
     let mut out = Vec::new();
@@ -101,16 +113,10 @@ fn sampled_envelope_cells_stay_within_twice_their_figures() {
 /// 20 km/h the turns between the arcs did the same (5.08 cm, over its 5 cm bound).
 #[test]
 fn the_turns_learn_what_dynamic_tyres_need_beyond_the_model() {
-    for (var, scenario, bound_cm) in [
+    each_within(&[
         ("tyre_slip_soft", "straight_15kmh", 2.0),
         ("speed_20", "curve_r15", 5.0),
-    ] {
-        let (finished, got) = default_on(var, scenario);
-        assert!(
-            finished && got <= bound_cm,
-            "{var}/{scenario}: {got:.2} cm, bound {bound_cm}"
-        );
-    }
+    ]);
 }
 
 /// A side draft's crab, as the vehicle kept it, on every line and at every speed:
@@ -125,17 +131,11 @@ fn the_turns_learn_what_dynamic_tyres_need_beyond_the_model() {
 ///   profile 2.55 cm, all disturbances 5.64 cm).
 #[test]
 fn a_side_draft_is_held_as_the_crab_the_vehicle_keeps_at_every_speed() {
-    for (scenario, bound_cm) in [
-        ("straight_15kmh", 1.4),
-        ("speed_profile_4_15", 1.64),
-        ("all_disturbances", 5.0),
-    ] {
-        let (finished, got) = default_on("side_draft_5kN", scenario);
-        assert!(
-            finished && got <= bound_cm,
-            "side_draft_5kN/{scenario}: {got:.2} cm, bound {bound_cm}"
-        );
-    }
+    each_within(&[
+        ("side_draft_5kN", "straight_15kmh", 1.4),
+        ("side_draft_5kN", "speed_profile_4_15", 1.64),
+        ("side_draft_5kN", "all_disturbances", 5.0),
+    ]);
 }
 
 /// The vehicle's own lag behind its wheels (tyres building their side force, the yaw inertia;
@@ -144,13 +144,10 @@ fn a_side_draft_is_held_as_the_crab_the_vehicle_keeps_at_every_speed() {
 /// max 20.8 over its 15 cm bound; tractor_b 2.63 cm over its 2.5 cm bound); 1.10 and 1.40 now.
 #[test]
 fn the_vehicles_own_lag_behind_its_wheels_is_led_on() {
-    for (var, bound_cm) in [("tyre_slip_soft", 1.4), ("tractor_b", 2.0)] {
-        let (finished, got) = default_on(var, "straight_15kmh");
-        assert!(
-            finished && got <= bound_cm,
-            "{var}/straight_15kmh: {got:.2} cm, bound {bound_cm}"
-        );
-    }
+    each_within(&[
+        ("tyre_slip_soft", "straight_15kmh", 1.4),
+        ("tractor_b", "straight_15kmh", 2.0),
+    ]);
 }
 
 /// Session 31: the path's curvature fed forward (`track.curvature_feed_forward`). Pure pursuit
@@ -159,14 +156,8 @@ fn the_vehicles_own_lag_behind_its_wheels_is_led_on() {
 /// against Stanley's 0.39), and at 20 km/h on R 15 m arcs 4.70 cm (bound 5). Now 0.39 and 3.66.
 #[test]
 fn turns_fed_forward_start_the_lines_on_them() {
-    for (var, scenario, bound_cm) in [
+    each_within(&[
         ("tyre_slip_firm", "straight_15kmh", 0.47),
         ("speed_20", "curve_r15", 4.2),
-    ] {
-        let (finished, got) = default_on(var, scenario);
-        assert!(
-            finished && got <= bound_cm,
-            "{var}/{scenario}: {got:.2} cm, bound {bound_cm}"
-        );
-    }
+    ]);
 }
