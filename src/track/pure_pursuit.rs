@@ -283,13 +283,23 @@ fn steerable(along: &Along, lead: f64, ld: f64, speed: f64, params: &TrackerPara
         return true;
     }
     let angle = |from: f64, to: f64| (params.wheelbase * along.mean_curvature(from, to)).atan();
-    let mut s = lead;
-    while s <= lead + ld {
-        let change = (angle(s, s + 2.0) - angle(s - 2.0, s)).abs();
-        if change * speed / 2.0 > rate {
+    // The wheel angle over the 2 m behind each metre is the one over the 2 m ahead of the metre
+    // two before: kept from there (the last two), not measured again.
+    let mut ahead = [f64::NAN; 2];
+    let mut k = 0usize;
+    while (k as f64) <= ld {
+        let s = lead + k as f64;
+        let behind = if k >= 2 {
+            ahead[k % 2]
+        } else {
+            angle(s - 2.0, s)
+        };
+        let next = angle(s, s + 2.0);
+        if (next - behind).abs() * speed / 2.0 > rate {
             return false;
         }
-        s += 1.0;
+        ahead[k % 2] = next;
+        k += 1;
     }
     true
 }
