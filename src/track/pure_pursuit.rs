@@ -144,14 +144,14 @@ impl SteeringLaw for PurePursuit {
 /// ([`Along::mean_curvature`]), so a curvature step is fed forward as a ramp over 2 m and a
 /// lateral jog in a planned path not at all. On a straight line κ_chord = κ_path = 0 and nothing
 /// changes; on a held arc both are the arc's (within 5 % wherever the vehicle is between the
-/// path's nodes, 0.3 % with 3 nodes behind it); off the path pursuit's correction (κ_pursuit − κ_chord) steers as before.
-/// Where the path within the look-ahead turns faster than the steering can follow at the speed
-/// ([`steerable`]), nothing is fed forward and pursuit steers alone. Measured on the envelope
-/// and the field jobs (docs/envelope.md, session 31): κ_path at the lead point exactly, from
-/// the nodes, fed a step forward as a step and was worse on the R 15 m arcs (0.52 against
-/// 0.40 cm nominal, 5.2 against 3.2 cm at 20 km/h); the 3-point circle through the B-spline
-/// read an R 20 m arc up to 30 % off at short leads and steered a 1 m kink at a field's
-/// headland corner.
+/// path's nodes, 0.3 % with 3 nodes behind it); off the path pursuit's correction (κ_pursuit −
+/// κ_chord) steers as before. Where the path within the look-ahead turns faster than the
+/// steering can follow at the speed ([`steerable`]), nothing is fed forward and pursuit steers
+/// alone. Measured on the envelope and the field jobs (docs/envelope.md, Session 31: the
+/// path's curvature fed forward): κ_path at the lead point exactly, from the nodes, fed a step
+/// forward as a step and was worse on the R 15 m arcs (0.52 against 0.40 cm nominal, 5.2
+/// against 3.2 cm at 20 km/h); the 3-point circle through the B-spline read an R 20 m arc up to
+/// 30 % off at short leads and steered a 1 m kink at a field's headland corner.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FeedForward {
     /// The path's nearest point to the pose.
