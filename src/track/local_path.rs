@@ -215,15 +215,7 @@ impl LocalPath {
             return 0.0;
         }
         let k = k.clamp(1, n - 2);
-        let (a, b, c) = (self.node(k - 1), self.node(k), self.node(k + 1));
-        let (ab, bc, ac) = (b - a, c - b, c - a);
-        let denom = ab.norm() * bc.norm() * ac.norm();
-        let curvature = 2.0 * crate::geo::cross(&ab, &bc) / denom;
-        if denom > 1e-12 && curvature.is_finite() {
-            curvature
-        } else {
-            0.0
-        }
+        super::curvature_through(&self.node(k - 1), &self.node(k), &self.node(k + 1))
     }
 
     /// The path's direction at the sample nearest the vehicle ([`LocalPath::nearest`]) as its

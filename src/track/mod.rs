@@ -216,6 +216,12 @@ pub fn curvature_along(points: &[Vec2], start: usize, distance: f64, half: f64) 
     let a = point_along(points, start, (distance - half).max(0.0));
     let b = point_along(points, start, distance);
     let c = point_along(points, start, distance + half);
+    curvature_through(&a, &b, &c)
+}
+
+/// The curvature of the circle through `a`, `b` and `c`, 1/m (positive turning left from a
+/// to c); 0 where they are collinear or coincide.
+pub fn curvature_through(a: &Vec2, b: &Vec2, c: &Vec2) -> f64 {
     let (ab, bc, ac) = (b - a, c - b, c - a);
     let denom = ab.norm() * bc.norm() * ac.norm();
     let k = 2.0 * crate::geo::cross(&ab, &bc) / denom;
