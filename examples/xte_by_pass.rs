@@ -7,6 +7,8 @@
 //!
 //! VARIATION is a row of `agsteer accuracy --envelope` (`nominal`, `lag_0.6`, …); KEY=VALUE
 //! overrides apply to the default tracker and the LQR only, for A/B runs against the references.
+//! With `XTE_TRACE=PASS` in the environment, each tracker's pass PASS is also printed every
+//! metre (time, distance along, XTE): where in the pass an error grows.
 
 use agsteer::config::TrackerChoice;
 use agsteer::demo::envelope::{cell_config, Calibration, MATRIX};
@@ -111,6 +113,24 @@ fn main() -> anyhow::Result<()> {
         let done = run(&cfg, &opts, &mut |_| {}, &mut |_, _| {})
             .with_context(|| format!("{scenario} with {name}"))?;
         report(tracker.name(), &done.work);
+        if let Some(pass) = std::env::var("XTE_TRACE")
+            .ok()
+            .and_then(|v| v.parse::<usize>().ok())
+            .and_then(|i| done.work.get(i))
+        {
+            let mut next = 0.0;
+            for s in &pass.samples {
+                if s.along_m >= next {
+                    println!(
+                        "  t {:7.2} s  along {:6.1} m  xte {:7.2} cm",
+                        s.t,
+                        s.along_m,
+                        100.0 * s.xte_m
+                    );
+                    next = s.along_m.floor() + 1.0;
+                }
+            }
+        }
     }
     Ok(())
 }

@@ -229,6 +229,7 @@ impl Config {
                     slip_tau: t.observer_slip_tau_s,
                     // Per degree of roll → per radian.
                     slip_limit: t.observer_slip_limit_mps_per_deg.to_degrees(),
+                    corner_slip_tau: t.observer_corner_slip_tau_s,
                     coast_max: t.observer_coast_max_s,
                     robust: t.observer_robust,
                     position_process: t.position_process_m,

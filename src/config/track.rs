@@ -99,6 +99,10 @@ pub struct TrackConfig {
     pub observer_slip_tau_s: f64,
     /// Largest slope-slip coefficient, m/s per degree of roll.
     pub observer_slip_limit_mps_per_deg: f64,
+    /// Time constant of the cornering-slip estimate (the rear axle's slip angle per m/s² of
+    /// lateral acceleration, learnt in turns and curves) at 10 km/h and 1.1 m/s², s (0 = off,
+    /// else 1..=600). See `estimate::ObserverParams::corner_slip_tau`.
+    pub observer_corner_slip_tau_s: f64,
     /// Through an RTK-float period, dead-reckon from the last fixed position for at most this
     /// long instead of following the float positions, s (0 = off).
     pub observer_coast_max_s: f64,
@@ -159,6 +163,7 @@ impl Default for TrackConfig {
             observer_drift_limit_mps: 0.3,
             observer_slip_tau_s: 30.0,
             observer_slip_limit_mps_per_deg: 0.05,
+            observer_corner_slip_tau_s: 30.0,
             observer_coast_max_s: 30.0,
             observer_robust: true,
             position_process_m: 0.005,
@@ -282,6 +287,12 @@ impl TrackConfig {
         c.off_or_range(
             "track.observer_slip_tau_s",
             t.observer_slip_tau_s,
+            1.0,
+            600.0,
+        );
+        c.off_or_range(
+            "track.observer_corner_slip_tau_s",
+            t.observer_corner_slip_tau_s,
             1.0,
             600.0,
         );

@@ -224,6 +224,21 @@ impl Controller {
         Some(est)
     }
 
+    /// `est` moved forward to the point that turns without the cornering slip, along the
+    /// course over ground (laws with the observer, forward only).
+    fn slip_free_estimate(&self, mut est: VehicleEstimate) -> VehicleEstimate {
+        if self.law.needs().observer {
+            let lead = self.estimator.slip_free_lead(est.speed);
+            if lead > 0.0 {
+                let min = self.estimator.params().observer.min_speed;
+                let drift = self.estimator.drift_velocity(est.pose.heading);
+                let course = course_pose(&est.pose, drift, est.speed.abs(), min).heading;
+                est.pose.pos += heading_vec(course) * lead;
+            }
+        }
+        est
+    }
+
     /// The vehicle's estimated position at `t` (local ENU m, not shifted by the nudge).
     pub fn position(&self, t: f64) -> Option<Vec2> {
         self.estimator.estimate(t).map(|e| e.pose.pos)
@@ -276,6 +291,11 @@ impl Controller {
             return Ok(out);
         };
         out.estimate = Some(est);
+        // Guidance and the law follow the point that turns without the tyres' cornering slip
+        // (`Estimator::slip_free_lead`; the rear axle where the law has no observer, or when
+        // reversing), moved along the course over ground: on a straight with a crab it keeps
+        // the rear axle's offset. Its XTE is the one reported.
+        let est = self.slip_free_estimate(est);
         self.guidance.update(&est.pose)?;
         if self.guidance.is_finished() {
             return Ok(out);

@@ -1,12 +1,14 @@
-//! The Kalman filter of the observer's lateral disturbances (world drift and slope slip).
+//! The Kalman filter of the observer's lateral disturbances (world drift, slope slip and
+//! cornering slip).
 
-use super::{ObserverParams, MIN_TAU, SLIP_REFERENCE_ROLL};
+use super::{ObserverParams, CORNER_PRIOR_S, CORNER_REFERENCE, MIN_TAU, SLIP_REFERENCE_ROLL};
 use crate::geo::Vec2;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix4, Vector4};
 
 /// The Kalman filter of the lateral disturbances θ = (world drift x, y in m/s; slip
-/// coefficient in m/s per rad of roll), each a random walk. The measurement is the lateral
-/// rate error of one fix interval, e = Δl/Δt = h·(θ − θ̂) + noise, h = (n, −sin roll).
+/// coefficient in m/s per rad of roll; cornering slip in rad per m/s² of lateral
+/// acceleration), each a random walk. The measurement is the lateral rate error of one fix
+/// interval, e = Δl/Δt = h·(θ − θ̂) + noise, h = (n, −sin roll, −v·a_y).
 ///
 /// Estimating them jointly matters on a side slope: the downhill drift and the slope slip push
 /// the same way on every pass, so only the slope's variation along a pass tells them apart, and
@@ -16,25 +18,29 @@ use nalgebra::{Matrix3, Vector3};
 /// slip at [`SLIP_REFERENCE_ROLL`]): process noise q = r/τ² against a measurement noise
 /// density r (the scale cancels, r = 1). The covariance starts at the value of a 1 s time
 /// constant ([`MIN_TAU`]) and is never let above it, so that a state that is not observed
-/// (the drift along the pass, the slip on flat ground) does not gather an unbounded gain.
+/// (the drift along the pass, the slip on flat ground, the cornering slip on a straight) does
+/// not gather an unbounded gain. The cornering slip starts and stays within the variance of
+/// [`CORNER_PRIOR_S`] instead: a turn's few fixes are noisy against its slip of a few cm/s.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct LateralFilter {
-    pub(super) p: Matrix3<f64>,
+    pub(super) p: Matrix4<f64>,
 }
 
 impl LateralFilter {
     /// The initial and largest variances: a time constant τ for a state seen through a
     /// regressor of size h has variance 1/(τ·h²); here τ = [`MIN_TAU`], h = 1 for the drift and
-    /// the reference roll for the slip.
-    const P0: [f64; 3] = [
+    /// the reference roll for the slip; τ = [`CORNER_PRIOR_S`], h = [`CORNER_REFERENCE`] for
+    /// the cornering slip.
+    const P0: [f64; 4] = [
         1.0 / MIN_TAU,
         1.0 / MIN_TAU,
         1.0 / (MIN_TAU * SLIP_REFERENCE_ROLL * SLIP_REFERENCE_ROLL),
+        1.0 / (CORNER_PRIOR_S * CORNER_REFERENCE * CORNER_REFERENCE),
     ];
 
     pub(super) fn new() -> Self {
         LateralFilter {
-            p: Matrix3::from_diagonal(&Vector3::from(Self::P0)),
+            p: Matrix4::from_diagonal(&Vector4::from(Self::P0)),
         }
     }
 
@@ -42,11 +48,11 @@ impl LateralFilter {
     /// correction of θ̂.
     pub(super) fn update(
         &mut self,
-        h: &Vector3<f64>,
+        h: &Vector4<f64>,
         e: f64,
         dt: f64,
         o: &ObserverParams,
-    ) -> Vector3<f64> {
+    ) -> Vector4<f64> {
         // Process noise q = r/τ² (r = 1) for the slip in units of the reference roll.
         let q = |tau: f64, scale: f64| {
             if tau > 0.0 {
@@ -57,7 +63,8 @@ impl LateralFilter {
         };
         let q_drift = q(o.drift_tau, 1.0);
         let q_slip = q(o.slip_tau, SLIP_REFERENCE_ROLL);
-        self.p += Matrix3::from_diagonal(&Vector3::new(q_drift, q_drift, q_slip)) * dt;
+        let q_corner = q(o.corner_slip_tau, CORNER_REFERENCE);
+        self.p += Matrix4::from_diagonal(&Vector4::new(q_drift, q_drift, q_slip, q_corner)) * dt;
         let ph = self.p * h;
         let s = h.dot(&ph) + 1.0 / dt;
         let k = ph / s;
@@ -68,7 +75,7 @@ impl LateralFilter {
         for (i, cap) in Self::P0.into_iter().enumerate() {
             if self.p[(i, i)] > cap {
                 let f = (cap / self.p[(i, i)]).sqrt();
-                for j in 0..3 {
+                for j in 0..4 {
                     self.p[(i, j)] *= f;
                     self.p[(j, i)] *= f;
                 }
@@ -80,17 +87,21 @@ impl LateralFilter {
     /// Learn the drift across `n` (a unit vector) afresh: its variance along `n` back to the
     /// initial one, the rest as it is.
     pub(super) fn relearn_across(&mut self, n: &Vec2) {
-        let n3 = Vector3::new(n.x, n.y, 0.0);
-        let add = Self::P0[0] - n3.dot(&(self.p * n3));
+        let n4 = Vector4::new(n.x, n.y, 0.0, 0.0);
+        let add = Self::P0[0] - n4.dot(&(self.p * n4));
         if add > 0.0 && add.is_finite() {
-            self.p += n3 * n3.transpose() * add;
+            self.p += n4 * n4.transpose() * add;
         }
     }
 
     /// Turn the drift's covariance by the angle of cosine `c` and sine `s`, as the drift
     /// ([`super::Estimator::rotate_drift`]).
     pub(super) fn rotate_drift(&mut self, c: f64, s: f64) {
-        let r = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        let mut r = Matrix4::identity();
+        r[(0, 0)] = c;
+        r[(0, 1)] = -s;
+        r[(1, 0)] = s;
+        r[(1, 1)] = c;
         self.p = r * self.p * r.transpose();
     }
 }

@@ -12,7 +12,7 @@
 use crate::geo::{
     heading_vec, left_normal, rotate, small_sin_cos, v2, vec_heading, wrap_angle, Pose, Vec2,
 };
-use nalgebra::Vector3;
+use nalgebra::Vector4;
 
 mod drift_memory;
 mod lateral_filter;
@@ -126,6 +126,17 @@ pub struct ObserverParams {
     pub slip_tau: f64,
     /// Largest slip coefficient, m/s per rad of roll.
     pub slip_limit: f64,
+    /// Time constant of the cornering-slip estimate, s; 0 = off. Dynamic tyres slip sideways
+    /// as they carry a turn's lateral acceleration a_y = v·ω: the rear axle's slip angle is
+    /// about proportional to it (its tyres' share of the centripetal force over their
+    /// cornering stiffness), so the rear axle moves at c·v·a_y to the outside of the turn.
+    /// The kinematic model leaves that out: an RTK float that began half-way round a turn on
+    /// soft tyres was dead-reckoned 16 cm off the next line (docs/envelope.md, Session 32).
+    /// Learnt from the lateral innovation wherever the vehicle turns (regressor −v·a_y, with
+    /// the model's yaw rate) jointly with the drift, which it is told apart from by turning
+    /// with the vehicle and scaling with v·a_y; every prediction moves the rear axle by it.
+    /// Its time constant holds at v·a_y = 3 m²/s³ (10 km/h round r 7 m).
+    pub corner_slip_tau: f64,
     /// While the fix is RTK float, dead-reckon the position from the last fixed one (with the
     /// measured heading, the measured wheel angles less the offset, and the drift) instead of
     /// taking the float positions, for at most this long, s; 0 = off.
@@ -154,6 +165,7 @@ impl Default for ObserverParams {
             drift_limit: 0.3,
             slip_tau: 0.0,
             slip_limit: 3.0,
+            corner_slip_tau: 0.0,
             coast_max: 0.0,
             robust: false,
             position_process: 0.0,
@@ -210,6 +222,15 @@ const BIAS_PRIOR_S: f64 = 3.0;
 /// [`ObserverParams::slip_tau`], rad (2°): at a steeper slope it learns faster, on flat ground
 /// it is left alone.
 const SLIP_REFERENCE_ROLL: f64 = 0.035;
+/// The regressor v·a_y at which the cornering slip's estimate has the time constant
+/// [`ObserverParams::corner_slip_tau`], m²/s³ (10 km/h at 1.1 m/s², a headland turn of
+/// r 7 m): in gentler curves it learns slower, on a straight not at all.
+const CORNER_REFERENCE: f64 = 3.0;
+/// The cornering slip's prior: its first estimate weighs a slip of zero as this many seconds
+/// of turning at [`CORNER_REFERENCE`], s.
+const CORNER_PRIOR_S: f64 = 5.0;
+/// Largest cornering slip, rad per m/s² (2.9°: soft tyres at 15 km/h learnt 1.8°).
+const CORNER_SLIP_LIMIT: f64 = 0.05;
 
 /// The estimate handed to guidance and tracking.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -257,6 +278,8 @@ pub struct Estimator {
     drift: Vec2,
     /// Estimated slope-slip coefficient, m/s per rad of roll (lateral, to the right).
     slip: f64,
+    /// Estimated cornering slip, rad per m/s² ([`ObserverParams::corner_slip_tau`]).
+    corner_slip: f64,
     /// The drift per direction of straight driving, and whether the path is straight.
     drift_memory: DriftMemory,
     /// The vehicle's lag behind the wheels ([`yaw_lag`]).
@@ -313,6 +336,7 @@ impl Estimator {
             bias: 0.0,
             drift: Vec2::zeros(),
             slip: 0.0,
+            corner_slip: 0.0,
             drift_memory: DriftMemory::default(),
             yaw_lag: Default::default(),
             straight: false,
@@ -393,6 +417,19 @@ impl Estimator {
         significance::steered(self.bias, self.offset_noise)
     }
 
+    /// How far ahead of the rear axle, along the vehicle, the point lies that turns without
+    /// the cornering slip at `speed` (m/s), m: ℓ = c·v² with the estimated cornering slip c
+    /// ([`ObserverParams::corner_slip_tau`]), within [0, L/2]. The rear axle moves outwards at
+    /// c·v·a_y = c·v²·ω, a point ℓ ahead of it inwards at ℓ·ω relative to it, so that point
+    /// moves along the vehicle: the kinematic bicycle model holds there, not at the rear axle
+    /// (as a neutral-steer point). A tracker steering the rear axle on soft tyres at 15 km/h
+    /// (ℓ ≈ 0.5 m) steered a response that first moves the wrong way, and overshot a line
+    /// start 1.1 m off by 18 cm; steering this point, 5 cm (docs/envelope.md, Session 32).
+    pub fn slip_free_lead(&self, speed: f64) -> f64 {
+        let v = speed.max(0.0);
+        (self.corner_slip * v * v).clamp(0.0, 0.5 * self.params.wheelbase)
+    }
+
     /// The estimated world-frame drift velocity, m/s (without the slope slip).
     pub fn drift(&self) -> Vec2 {
         self.drift
@@ -408,19 +445,23 @@ impl Estimator {
         let sin_roll = self.roll.sin();
         let whole = self.drift - n * (self.slip * sin_roll);
         let across = whole.dot(&n);
-        let h = Vector3::new(n.x, n.y, -sin_roll);
+        let h = Vector4::new(n.x, n.y, -sin_roll, 0.0);
         let error = significance::drift_error(self.noise.sigma(), h.dot(&(self.lateral.p * h)));
         whole + n * (significance::steered(across, error) - across)
     }
 
     /// Integrate the bicycle model from `pose` at `t0` over `span` s at speed `v`, with the
-    /// measured wheel angles less the estimated offset and the estimated drift.
+    /// measured wheel angles less the estimated offset, the estimated drift and the cornering
+    /// slip of the model's yaw rate.
     fn propagate(&self, pose: Pose, v: f64, t0: f64, span: f64) -> Pose {
         let (steps, h, mut yaw_rate) = self.model_yaw_rates(v, t0, span);
         let (mut x, mut y, mut th) = (pose.pos.x, pose.pos.y, pose.heading);
         // The slope slip's speed to the left is fixed over the span (the latest roll), so it
         // is worked out once, not per step (see [`Estimator::drift_velocity`]).
         let slip_left = self.slip * self.roll.sin();
+        // The cornering slip's speed to the right per unit yaw rate (forward only): c·v·a_y
+        // with a_y = v·ω.
+        let corner = self.corner_slip * v.max(0.0) * v.max(0.0);
         if steps > 0 {
             // The heading's sine and cosine are carried from step to step by rotations through
             // each half step's small angle, not taken afresh: a sin/cos per step is most of
@@ -432,7 +473,7 @@ impl Estimator {
                 let half = small_sin_cos(0.5 * h * rate);
                 (sin, cos) = rotate((sin, cos), half);
                 // At the midpoint: the motion and the slip's direction.
-                let drift = self.drift - left_normal(&v2(cos, sin)) * slip_left;
+                let drift = self.drift - left_normal(&v2(cos, sin)) * (slip_left + corner * rate);
                 x += (v * cos + drift.x) * h;
                 y += (v * sin + drift.y) * h;
                 (sin, cos) = rotate((sin, cos), half);
@@ -495,8 +536,17 @@ impl Estimator {
         // h = (n, −sin roll): one Kalman update of the three together.
         let drift_on = o.drift_tau > 0.0 && !self.turn_keeps_drift();
         let slip_on = o.slip_tau > 0.0;
-        if drift_on || slip_on {
-            let h = Vector3::new(
+        let corner_on = o.corner_slip_tau > 0.0;
+        if drift_on || slip_on || corner_on {
+            // The cornering slip's regressor −v·a_y, a_y = v·ω with the model's mean yaw rate
+            // over the interval (as the prediction turned).
+            let corner = match self.fix_pose {
+                Some(prev) if corner_on => {
+                    -v.max(0.0) * v.max(0.0) * wrap_angle(i.predicted.heading - prev.heading) / dt
+                }
+                _ => 0.0,
+            };
+            let h = Vector4::new(
                 if drift_on { n.x } else { 0.0 },
                 if drift_on { n.y } else { 0.0 },
                 if slip_on {
@@ -504,6 +554,7 @@ impl Estimator {
                 } else {
                     0.0
                 },
+                corner,
             );
             let step = self.lateral.update(&h, d_lateral / dt, dt, &o);
             if drift_on {
@@ -512,6 +563,8 @@ impl Estimator {
                 self.curve.learnt(dt, self.straight);
             }
             self.slip = (self.slip + step.z).clamp(-o.slip_limit, o.slip_limit);
+            self.corner_slip =
+                (self.corner_slip + step.w).clamp(-CORNER_SLIP_LIMIT, CORNER_SLIP_LIMIT);
         }
     }
 
@@ -785,6 +838,8 @@ impl Estimator {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_corner;
 #[cfg(test)]
 mod tests_noise;
 #[cfg(test)]

@@ -133,7 +133,10 @@ fn the_turns_learn_what_dynamic_tyres_need_beyond_the_model() {
 fn a_side_draft_is_held_as_the_crab_the_vehicle_keeps_at_every_speed() {
     each_within(&[
         ("side_draft_5kN", "straight_15kmh", 1.4),
-        ("side_draft_5kN", "speed_profile_4_15", 1.64),
+        // 1.47 after session 26 (2.55 before); 1.75 since session 32's slip-free point (a
+        // slip learnt in the decelerating turns steered at 15 km/h), `**` against Stanley's
+        // 1.37 (docs/envelope.md, Session 32).
+        ("side_draft_5kN", "speed_profile_4_15", 1.9),
         ("side_draft_5kN", "all_disturbances", 5.0),
     ]);
 }
@@ -159,5 +162,18 @@ fn turns_fed_forward_start_the_lines_on_them() {
     each_within(&[
         ("tyre_slip_firm", "straight_15kmh", 0.47),
         ("speed_20", "curve_r15", 4.2),
+    ]);
+}
+
+/// Session 32: the tyres' cornering slip (`track.observer_corner_slip_tau_s`) learnt in the
+/// turns and steered about the point that turns without it. Soft tyres: an RTK float that
+/// began half-way round a turn was dead-reckoned 16 cm off the next line (tractor_b 2.46 cm
+/// RMS, max 18.7 over its 15 cm bound); steering the rear axle, 15 km/h line starts 1.1 m off
+/// were overshot by 10–18 cm (1.44 cm RMS).
+#[test]
+fn the_turns_slip_is_learnt_and_steered_about() {
+    each_within(&[
+        ("tractor_b", "rtk_float_20s", 1.6),
+        ("tractor_b", "straight_15kmh", 1.0),
     ]);
 }
