@@ -18,6 +18,7 @@ mod drift_memory;
 mod lateral_filter;
 mod noise;
 mod significance;
+mod wheel_history;
 mod yaw_lag;
 use drift_memory::DriftMemory;
 use lateral_filter::LateralFilter;
@@ -131,7 +132,7 @@ pub struct ObserverParams {
     /// about proportional to it (its tyres' share of the centripetal force over their
     /// cornering stiffness), so the rear axle moves at c·v·a_y to the outside of the turn.
     /// The kinematic model leaves that out: an RTK float that began half-way round a turn on
-    /// soft tyres was dead-reckoned 16 cm off the next line (docs/envelope.md, Session 32).
+    /// soft tyres was dead-reckoned 16 cm off the next line (docs/envelope.md, Session 32: the tyres' cornering slip learnt and steered about).
     /// Learnt from the lateral innovation wherever the vehicle turns (regressor −v·a_y, with
     /// the model's yaw rate) jointly with the drift, which it is told apart from by turning
     /// with the vehicle and scaling with v·a_y; every prediction moves the rear axle by it.
@@ -424,7 +425,7 @@ impl Estimator {
     /// moves along the vehicle: the kinematic bicycle model holds there, not at the rear axle
     /// (as a neutral-steer point). A tracker steering the rear axle on soft tyres at 15 km/h
     /// (ℓ ≈ 0.5 m) steered a response that first moves the wrong way, and overshot a line
-    /// start 1.1 m off by 18 cm; steering this point, 5 cm (docs/envelope.md, Session 32).
+    /// start 1.1 m off by 18 cm; steering this point, 5 cm (docs/envelope.md, Session 32: the tyres' cornering slip learnt and steered about).
     pub fn slip_free_lead(&self, speed: f64) -> f64 {
         let v = speed.max(0.0);
         (self.corner_slip * v * v).clamp(0.0, 0.5 * self.params.wheelbase)
@@ -728,83 +729,6 @@ impl Estimator {
         if self.smooth.norm() > cap {
             self.smooth *= cap / self.smooth.norm();
         }
-    }
-
-    /// A measured front-wheel angle (rad) at `t` (s).
-    pub fn on_wheel_angle(&mut self, t: f64, angle: f64) {
-        if !t.is_finite() || !angle.is_finite() {
-            return;
-        }
-        // The ring stays in time order (the prediction bisects it): a sample older than the
-        // newest is dropped.
-        if self.wheel_len > 0 && t < self.wheel_sample(self.wheel_len - 1).0 {
-            return;
-        }
-        self.wheel[self.wheel_head] = (t, angle);
-        self.wheel_head = (self.wheel_head + 1) % RING;
-        self.wheel_len = (self.wheel_len + 1).min(RING);
-    }
-
-    /// The i-th oldest wheel sample.
-    fn wheel_sample(&self, i: usize) -> (f64, f64) {
-        let start = (self.wheel_head + RING - self.wheel_len) % RING;
-        self.wheel[(start + i) % RING]
-    }
-
-    /// The newest measured wheel angle, rad (`None` before the first).
-    pub fn latest_wheel_angle(&self) -> Option<f64> {
-        (self.wheel_len > 0).then(|| self.wheel_sample(self.wheel_len - 1).1)
-    }
-
-    /// The measured wheel angle at `t`, interpolated (held before the first and after the
-    /// last sample).
-    pub fn wheel_angle_at(&self, t: f64) -> f64 {
-        self.wheel_angle_from(t, &mut 1)
-    }
-
-    /// The index of the first wheel sample at or after `t` (at least 1: a start for
-    /// [`Estimator::wheel_angle_from`], every sample before it is older than `t`).
-    fn first_wheel_sample_at(&self, t: f64) -> usize {
-        let (mut lo, mut hi) = (0, self.wheel_len);
-        while lo < hi {
-            let mid = (lo + hi) / 2;
-            if self.wheel_sample(mid).0 < t {
-                lo = mid + 1;
-            } else {
-                hi = mid;
-            }
-        }
-        lo.max(1)
-    }
-
-    /// [`Estimator::wheel_angle_at`] for times that do not decrease from call to call (the
-    /// prediction's steps): the search starts at sample `*cursor` (start with 1) and leaves it
-    /// at the sample found, so the steps of one prediction scan the ring once between them
-    /// instead of once each. Every sample before the cursor is older than the previous time,
-    /// hence than `t`: the result is the same as a search from the start.
-    fn wheel_angle_from(&self, t: f64, cursor: &mut usize) -> f64 {
-        if self.wheel_len == 0 {
-            return 0.0;
-        }
-        let first = self.wheel_sample(0);
-        if t <= first.0 {
-            return first.1;
-        }
-        for i in (*cursor).max(1)..self.wheel_len {
-            let (t1, a1) = self.wheel_sample(i);
-            if t <= t1 {
-                *cursor = i;
-                let (t0, a0) = self.wheel_sample(i - 1);
-                let span = t1 - t0;
-                return if span > 0.0 {
-                    a0 + (a1 - a0) * (t - t0) / span
-                } else {
-                    a1
-                };
-            }
-        }
-        *cursor = self.wheel_len;
-        self.wheel_sample(self.wheel_len - 1).1
     }
 
     /// The estimate at `t_now` (s), or `None` before the first usable fix.

@@ -135,7 +135,7 @@ fn a_side_draft_is_held_as_the_crab_the_vehicle_keeps_at_every_speed() {
         ("side_draft_5kN", "straight_15kmh", 1.4),
         // 1.47 after session 26 (2.55 before); 1.75 since session 32's slip-free point (a
         // slip learnt in the decelerating turns steered at 15 km/h), `**` against Stanley's
-        // 1.37 (docs/envelope.md, Session 32).
+        // 1.37 (docs/envelope.md, Session 32: the tyres' cornering slip learnt and steered about).
         ("side_draft_5kN", "speed_profile_4_15", 1.9),
         ("side_draft_5kN", "all_disturbances", 5.0),
     ]);
