@@ -73,7 +73,7 @@ pub struct EstimatorParams {
 }
 
 /// The disturbance observer: Kalman-type filters on the innovation of each fix against the
-/// pose predicted from the previous fix. Three slowly varying disturbances are estimated:
+/// pose predicted from the previous fix. Four slowly varying disturbances are estimated:
 ///
 /// * a wheel-angle offset `b` (vehicle frame, rad: measured − true angle), from the heading
 ///   innovation: the predicted yaw rate uses v·tan(δ_measured − b)/L, so
@@ -85,13 +85,15 @@ pub struct EstimatorParams {
 ///   of straight driving where a large one flips with it (a side draft's crab, [`drift_memory`]),
 ///   turning with the heading on curves where it is known to be the vehicle's;
 /// * a side-slope slip coefficient `c` (vehicle frame, m/s per rad of roll), see
-///   [`ObserverParams::slip_tau`], from the same lateral innovation.
+///   [`ObserverParams::slip_tau`], from the same lateral innovation;
+/// * the tyres' cornering slip (rad per m/s² of lateral acceleration), see
+///   [`ObserverParams::corner_slip_tau`], from the same lateral innovation in turns.
 ///
 /// The offset's estimate moves by Δt/τ of the innovation's measurement of its error, a
 /// first-order filter with time constant τ; τ starts at 3 s and grows with the time learnt up
 /// to the configured value, as a Kalman filter's gain falls from its initial covariance to the
-/// steady state. The drift and the slip share one measurement and are estimated together by a
-/// three-state Kalman filter ([`LateralFilter`]) tuned to the same time constants. Innovations
+/// steady state. The drift and the two slips share one measurement and are estimated together
+/// by a four-state Kalman filter ([`LateralFilter`]) tuned to the same time constants. Innovations
 /// beyond a gate (5 cm lateral, 0.02 rad heading) are jumps, not drift: they are not learnt
 /// from, and the estimator dead-reckons through them and through RTK-float periods
 /// ([`ObserverParams::coast_max`]). The estimates enter the prediction, and the controller
@@ -132,7 +134,8 @@ pub struct ObserverParams {
     /// about proportional to it (its tyres' share of the centripetal force over their
     /// cornering stiffness), so the rear axle moves at c·v·a_y to the outside of the turn.
     /// The kinematic model leaves that out: an RTK float that began half-way round a turn on
-    /// soft tyres was dead-reckoned 16 cm off the next line (docs/envelope.md, Session 32: the tyres' cornering slip learnt and steered about).
+    /// soft tyres was dead-reckoned 16 cm off the next line (docs/envelope.md, Session 32: the
+    /// tyres' cornering slip learnt and steered about).
     /// Learnt from the lateral innovation wherever the vehicle turns (regressor −v·a_y, with
     /// the model's yaw rate) jointly with the drift, which it is told apart from by turning
     /// with the vehicle and scaling with v·a_y; every prediction moves the rear axle by it.
@@ -425,7 +428,8 @@ impl Estimator {
     /// moves along the vehicle: the kinematic bicycle model holds there, not at the rear axle
     /// (as a neutral-steer point). A tracker steering the rear axle on soft tyres at 15 km/h
     /// (ℓ ≈ 0.5 m) steered a response that first moves the wrong way, and overshot a line
-    /// start 1.1 m off by 18 cm; steering this point, 5 cm (docs/envelope.md, Session 32: the tyres' cornering slip learnt and steered about).
+    /// start 1.1 m off by 18 cm; steering this point, 5 cm (docs/envelope.md, Session 32: the
+    /// tyres' cornering slip learnt and steered about).
     pub fn slip_free_lead(&self, speed: f64) -> f64 {
         let v = speed.max(0.0);
         (self.corner_slip * v * v).clamp(0.0, 0.5 * self.params.wheelbase)

@@ -94,6 +94,12 @@ fn the_cornering_slip_is_learnt_in_turns_and_carried_through_a_float() {
         (learnt - slip).abs() < slip / 3.0,
         "learnt {learnt} of {slip}"
     );
+    // The point that turns without it lies c·v² ahead of the rear axle (at most L/2).
+    let mut e = Estimator::new(params(true));
+    e.corner_slip = learnt;
+    assert!((e.slip_free_lead(V) - learnt * V * V).abs() < 1e-12);
+    assert_eq!(e.slip_free_lead(-V), 0.0);
+    assert_eq!(e.slip_free_lead(100.0), 0.5 * e.params().wheelbase);
     assert!(error.abs() < 0.03, "dead-reckoned {error} m off");
     let (_, kinematic) = u_turns(4, slip, 0.0);
     assert!(kinematic.abs() > 0.05, "kinematic {kinematic} m off");
