@@ -225,13 +225,13 @@ impl Controller {
     }
 
     /// `est` moved forward to the point that turns without the cornering slip, along the
-    /// course over ground (laws with the observer, forward only).
-    fn slip_free_estimate(&self, mut est: VehicleEstimate) -> VehicleEstimate {
-        if self.law.needs().observer {
+    /// course over ground with the observer's drift velocity `drift` (laws with the observer,
+    /// forward only).
+    fn slip_free_estimate(&self, mut est: VehicleEstimate, drift: Option<Vec2>) -> VehicleEstimate {
+        if let Some(drift) = drift {
             let lead = self.estimator.slip_free_lead(est.speed);
             if lead > 0.0 {
                 let min = self.estimator.params().observer.min_speed;
-                let drift = self.estimator.drift_velocity(est.pose.heading);
                 let course = course_pose(&est.pose, drift, est.speed.abs(), min).heading;
                 est.pose.pos += heading_vec(course) * lead;
             }
@@ -294,8 +294,13 @@ impl Controller {
         // Guidance and the law follow the point that turns without the tyres' cornering slip
         // (`Estimator::slip_free_lead`; the rear axle where the law has no observer, or when
         // reversing), moved along the course over ground: on a straight with a crab it keeps
-        // the rear axle's offset. Its XTE is the one reported.
-        let est = self.slip_free_estimate(est);
+        // the rear axle's offset. Its XTE is the one reported. (The drift velocity, for the
+        // laws with the observer, is worked out once per period: the course below uses it too.)
+        let needs = self.law.needs();
+        let drift = needs
+            .observer
+            .then(|| self.estimator.drift_velocity(est.pose.heading));
+        let est = self.slip_free_estimate(est, drift);
         self.guidance.update(&est.pose)?;
         if self.guidance.is_finished() {
             return Ok(out);
@@ -315,12 +320,10 @@ impl Controller {
         out.direction = direction;
         // Reverse segments are tracked about the rear axle in the driving direction.
         let mut pose = travel_pose(&est.pose, direction);
-        let needs = self.law.needs();
-        if needs.observer {
+        if let Some(drift) = drift {
             // Steer the course over ground, not the heading, onto the path: the estimated
             // drift then leaves no standing error.
             let min = self.estimator.params().observer.min_speed;
-            let drift = self.estimator.drift_velocity(est.pose.heading);
             pose = course_pose(&pose, drift, est.speed.abs(), min);
         }
         let local = self.guidance.local_path();
