@@ -156,7 +156,7 @@ impl Default for TrackConfig {
             curvature_gain_per_m_s: 0.5,
             curvature_scale_limit: 0.3,
             observer_bias_tau_s: 20.0,
-            observer_drift_tau_s: 60.0,
+            observer_drift_tau_s: 30.0,
             observer_min_speed_mps: 0.2,
             observer_offset_min_speed_mps: 1.0,
             observer_bias_limit_deg: 6.0,

@@ -31,7 +31,7 @@
 //!
 //! **Curves.** A curve sweeps the heading round, so a vehicle drift turns with it while the
 //! world vector stays put (on an arc of R 15 m at 10 km/h a 5 kN side draft's 8 cm/s crab turns
-//! a radian in 5 s, the drift's time constant is a minute). Where the drift is known to be the
+//! a radian in 5 s, the drift's time constant half a minute). Where the drift is known to be the
 //! vehicle's it turns with the heading ([`CurveDrift`], [`Estimator::set_work`]):
 //! - on a curved work path, once the drift has been learnt on its curves for
 //!   [`MIN_LEARNT_S`] (or was carried in, below), when it is one the memory acts on (above
