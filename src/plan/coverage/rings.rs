@@ -10,7 +10,7 @@ use super::closed::EdgeHasher;
 #[cfg(test)]
 use super::transit::transit;
 use super::transit::{words_by_length, Csc};
-use crate::geo::{vec_heading, Vec2};
+use crate::geo::{heading_vec, vec_heading, Vec2};
 use std::hash::BuildHasherDefault;
 
 /// Points of a ring tried as the place to turn onto it (or off it), at most.
@@ -168,12 +168,36 @@ impl Rings {
     ) -> Option<Vec<Vec2>> {
         let reach = 4.0 * r;
         let mut best: Option<(f64, Vec<Vec2>)> = None;
-        for (ri, ring) in self.rings.iter().enumerate() {
-            let entries = ring.near(&p1, reach);
-            let exits = ring.near(&p2, reach);
-            if entries.is_empty() || exits.is_empty() {
-                continue;
+        // The candidates of the rings with both (the others are passed over).
+        let near: Vec<(usize, &Ring, Vec<usize>, Vec<usize>)> = self
+            .rings
+            .iter()
+            .enumerate()
+            .map(|(ri, ring)| (ri, ring, ring.near(&p1, reach), ring.near(&p2, reach)))
+            .filter(|c| !c.2.is_empty() && !c.3.is_empty())
+            .collect();
+        if near.is_empty() {
+            return None;
+        }
+        // No curve onto a ring is clear when every curve from the start pose is blocked
+        // within the distance to the nearest entry, nor any off one when every curve to the
+        // goal pose is: no join then (see [`trapped`]).
+        if let Some(margin) = ends.margin {
+            let closest = |q: &Vec2, entry: bool| {
+                near.iter()
+                    .flat_map(|(_, ring, on, off)| {
+                        let pts = if entry { on } else { off };
+                        pts.iter().map(|&i| (ring.pts[i] - q).norm())
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            if trapped(margin, (p1, h1, true), r, step, closest(&p1, true))
+                || trapped(margin, (p2, h2, false), r, step, closest(&p2, false))
+            {
+                return None;
             }
+        }
+        for (ri, ring, entries, exits) in near {
             // Every way through this ring is at least as long as the straight distances to
             // its nearest entry and from its nearest exit: none beats the best so far when
             // those do not (a micrometre of margin for the rounding of the curves' lengths).
@@ -286,6 +310,79 @@ impl Rings {
     }
 }
 
+/// Is every curve of curvature at most 1/`r` from (`p`, heading `h`) (`forward`; else every
+/// one arriving there with that heading), `length` m long at least, blocked at one of its
+/// points spaced evenly along it, at most `step` apart, the ends included (the points of
+/// [`Csc::points`]), by the test whose [`super::clear_map::ClearMap::blocked_margin`] is
+/// `margin`? `true`: every curve of [`Rings::transit_with`] onto the rings from there (or
+/// off them to there) is blocked. `false`: not known (a budget of [`TRAP_BUDGET`] margins).
+///
+/// Point `k` of such a curve of length L (n = ⌈L/step⌉ ≥ `k` pieces when k·step ≤ `length`)
+/// lies at arc length σ = k·L/n from the pose, σ between k·step·ℓ/(ℓ + step) (ℓ = `length`)
+/// and k·step; its heading has turned by at most σ/r, so it lies in the rectangle `u` from
+/// r·sin(σ_lo/r) to σ_hi ahead (behind, arriving) and within r·(1 − cos(σ_hi/r)) to either
+/// side (σ_hi ≤ r). When that rectangle is blocked throughout, so is point `k` of every
+/// curve. (Most failing headland attempts of narrow fields start facing the edge a few
+/// metres ahead, too close to turn away: every curve onto every ring, about 2100, was solved
+/// and checked to find that out.)
+fn trapped(
+    margin: &dyn Fn(&Vec2) -> f64,
+    (p, h, forward): (Vec2, f64, bool),
+    r: f64,
+    step: f64,
+    length: f64,
+) -> bool {
+    let ahead = heading_vec(h) * if forward { 1.0 } else { -1.0 };
+    let side = Vec2::new(-ahead.y, ahead.x);
+    let short = length / (length + step);
+    let mut budget = TRAP_BUDGET;
+    (1..)
+        .map(|k| k as f64 * step)
+        .take_while(|&hi| hi <= length.min(r))
+        .any(|hi| {
+            let spread = r * (1.0 - (hi / r).cos());
+            let rect = ((r * (hi * short / r).sin(), hi), (-spread, spread));
+            blocked_throughout(margin, (p, ahead, side), rect, &mut budget)
+        })
+}
+
+/// Most margins [`trapped`] asks for one pose.
+const TRAP_BUDGET: usize = 96;
+
+/// Is the rectangle `u` ahead from `u.0` to `u.1`, `v` to the side from `v.0` to `v.1`, of
+/// the frame (`p`, `ahead`, `side`) blocked throughout: every point within the margin of the
+/// middle of it, or of each half in turn (the longer side halved), as far as `budget` goes?
+fn blocked_throughout(
+    margin: &dyn Fn(&Vec2) -> f64,
+    frame: (Vec2, Vec2, Vec2),
+    (u, v): ((f64, f64), (f64, f64)),
+    budget: &mut usize,
+) -> bool {
+    if *budget == 0 {
+        return false;
+    }
+    *budget -= 1;
+    let (p, ahead, side) = frame;
+    let (um, vm) = (0.5 * (u.0 + u.1), 0.5 * (v.0 + v.1));
+    let (du, dv) = (u.1 - u.0, v.1 - v.0);
+    let m = margin(&(p + ahead * um + side * vm));
+    if m <= 0.0 {
+        return false;
+    }
+    // Half the diagonal, a millimetre more.
+    if m >= 0.5 * (du * du + dv * dv).sqrt() + 1e-3 {
+        return true;
+    }
+    let halves = if du >= dv {
+        [((u.0, um), v), ((um, u.1), v)]
+    } else {
+        [(u, (v.0, vm)), (u, (vm, v.1))]
+    };
+    halves
+        .into_iter()
+        .all(|half| blocked_throughout(margin, frame, half, budget))
+}
+
 /// Which curve an end of [`Rings::transit_with`] is: the free pose (`p1` of a curve onto a
 /// ring, `p2` of one off it), the ring, its point, the direction along it, onto or off, the
 /// radius and the spacing of the points (as bits).
@@ -333,12 +430,23 @@ struct End {
 /// next transit from or to the same pose with the same test (a transit's attempt with its
 /// target's start pulled back starts where the one before it did).
 #[derive(Default)]
-pub struct Ends {
+pub struct Ends<'a> {
     index: std::collections::HashMap<EndKey, usize, BuildHasherDefault<EdgeHasher>>,
     ends: Vec<End>,
+    /// The test's [`super::clear_map::ClearMap::blocked_margin`], when known: poses no curve
+    /// leaves or reaches are found without solving the curves ([`trapped`]).
+    margin: Option<&'a dyn Fn(&Vec2) -> f64>,
 }
 
-impl Ends {
+impl<'a> Ends<'a> {
+    /// No ends yet, with the blocked margin of the test they are used with.
+    pub fn with_margin(margin: &'a dyn Fn(&Vec2) -> f64) -> Self {
+        Ends {
+            margin: Some(margin),
+            ..Ends::default()
+        }
+    }
+
     /// The index of the end `key`, its words solved by `solve` when first asked.
     fn solve(&mut self, key: EndKey, solve: impl FnOnce() -> Vec<Csc>) -> usize {
         if let Some(&e) = self.index.get(&key) {
