@@ -244,7 +244,14 @@ impl Rings {
                     .map(|&i| (ring.pts[i] - q).norm())
                     .fold(f64::INFINITY, f64::min)
             };
-            let bound = nearest(&p1, &entries) + nearest(&p2, &exits) - 1e-6;
+            let (onto, off) = (nearest(&p1, &entries), nearest(&p2, &exits));
+            // No curve onto this ring is clear when every entry is as far as the start's trap
+            // length, nor any off it when every exit is as far as the goal's: no join of it is
+            // clear, and its curves are not solved (the others' answers are the same).
+            if onto >= trap.0 || off >= trap.1 {
+                continue;
+            }
+            let bound = onto + off - 1e-6;
             if best.as_ref().is_some_and(|b| b.0 <= bound) {
                 continue;
             }
