@@ -259,16 +259,30 @@ impl Rings {
                 // The curves on at each entry and off at each exit, shortest first (solved once,
                 // or found in `ends`: their lengths bound the joins, then the joins verified
                 // check their points): (ring point, the end's index in `ends`, its length).
-                let on: Vec<(usize, usize, f64)> = entries
-                    .iter()
-                    .filter_map(|&i| {
-                        let pose = (ring.pts[i], ring.heading(i, dir));
-                        let key = EndKey::new((p1, h1), (ri, i, dir, true), r, step);
-                        let e =
-                            ends.solve(key, trap.0, || words_by_length(p1, h1, pose.0, pose.1, r));
-                        Some((i, e, ends.length(e)?))
-                    })
-                    .collect();
+                // (Of the entries `keep` passes.)
+                let on_at = |ends: &mut Ends, keep: &dyn Fn(usize) -> bool| {
+                    entries
+                        .iter()
+                        .filter(|&&i| keep(i))
+                        .filter_map(|&i| {
+                            let pose = (ring.pts[i], ring.heading(i, dir));
+                            let key = EndKey::new((p1, h1), (ri, i, dir, true), r, step);
+                            let e = ends
+                                .solve(key, trap.0, || words_by_length(p1, h1, pose.0, pose.1, r));
+                            Some((i, e, ends.length(e)?))
+                        })
+                        .collect::<Vec<(usize, usize, f64)>>()
+                };
+                // Only an entry nearer than the start's trap length can have a clear curve
+                // onto the ring: when none of those has, none has (nor any join), and the
+                // curves to the others are not solved.
+                if trap.0.is_finite() {
+                    let maybe = on_at(ends, &|i| (ring.pts[i] - p1).norm() < trap.0);
+                    if !ends.any_clear(&maybe, step, clear) {
+                        continue;
+                    }
+                }
+                let on = on_at(ends, &|_| true);
                 // Every join costs at least the shortest way on: none beats the best so far
                 // when that does not (the bound below, with the ways off left out).
                 let least =
@@ -281,16 +295,27 @@ impl Rings {
                 if !ends.any_clear(&on, step, clear) {
                     continue;
                 }
-                let off: Vec<(usize, usize, f64)> = exits
-                    .iter()
-                    .filter_map(|&j| {
-                        let pose = (ring.pts[j], ring.heading(j, dir));
-                        let key = EndKey::new((p2, h2), (ri, j, dir, false), r, step);
-                        let e =
-                            ends.solve(key, trap.1, || words_by_length(pose.0, pose.1, p2, h2, r));
-                        Some((j, e, ends.length(e)?))
-                    })
-                    .collect();
+                let off_at = |ends: &mut Ends, keep: &dyn Fn(usize) -> bool| {
+                    exits
+                        .iter()
+                        .filter(|&&j| keep(j))
+                        .filter_map(|&j| {
+                            let pose = (ring.pts[j], ring.heading(j, dir));
+                            let key = EndKey::new((p2, h2), (ri, j, dir, false), r, step);
+                            let e = ends
+                                .solve(key, trap.1, || words_by_length(pose.0, pose.1, p2, h2, r));
+                            Some((j, e, ends.length(e)?))
+                        })
+                        .collect::<Vec<(usize, usize, f64)>>()
+                };
+                // The same for the exits and the goal's trap length.
+                if trap.1.is_finite() {
+                    let maybe = off_at(ends, &|j| (ring.pts[j] - p2).norm() < trap.1);
+                    if !ends.any_clear(&maybe, step, clear) {
+                        continue;
+                    }
+                }
+                let off = off_at(ends, &|_| true);
                 // Every join costs at least the shortest way on plus the shortest way off.
                 if best
                     .as_ref()
@@ -406,8 +431,8 @@ fn trap_length(
 const TRAP_LENGTHS: [f64; 4] = [1.0, 2.0, 4.0, 16.0];
 
 /// Most margins [`trap_length`] asks for one pose, and for one rectangle.
-const TRAP_BUDGET: usize = 128;
-const TRAP_TRY_BUDGET: usize = 16;
+const TRAP_BUDGET: usize = 256;
+const TRAP_TRY_BUDGET: usize = 32;
 
 /// Is the rectangle `u` ahead from `u.0` to `u.1`, `v` to the side from `v.0` to `v.1`, of
 /// the frame (`p`, `ahead`, `side`) blocked throughout: every point within the margin of the
