@@ -32,6 +32,28 @@ pub fn implement_clear(field: &Field, half: f64, q: &Vec2) -> bool {
 /// and may reach over the edge there): the guarantee for paths that do not work.
 pub const TRANSIT_CLEARANCE_M: f64 = 1.5;
 
+/// A test's [`ClearMap::blocked_margin`].
+pub(super) type Margin<'a> = &'a dyn Fn(&Vec2) -> f64;
+
+/// The clearance tests of one field, width, r_min and point spacing, and their waypoint grids
+/// (built on first need: most plans never need them).
+pub(super) struct Tests<'a> {
+    /// The field.
+    pub(super) field: &'a Field,
+    /// The implement clear of the edge and the obstacles.
+    pub(super) clear: &'a dyn Fn(&Vec2) -> bool,
+    /// The tractor inside the field and off the obstacles ([`TRANSIT_CLEARANCE_M`]).
+    pub(super) loose: &'a dyn Fn(&Vec2) -> bool,
+    /// The distances from the edges and obstacles the two tests keep, m.
+    pub(super) clearance: (f64, f64),
+    /// The two tests' [`ClearMap::blocked_margin`]s.
+    pub(super) margins: (Margin<'a>, Margin<'a>),
+    /// The two tests are one (w ≤ 3 m).
+    pub(super) one_test: bool,
+    pub(super) grid: &'a std::cell::OnceCell<super::transit::WaypointGrid<'a>>,
+    pub(super) loose_grid: &'a std::cell::OnceCell<super::transit::WaypointGrid<'a>>,
+}
+
 /// The edges of the rings near one cell.
 #[derive(Debug)]
 struct Local {
@@ -161,6 +183,41 @@ impl<'a> ClearMap<'a> {
                 .borrow()
                 .get((s - NEAR) as usize)
                 .is_none_or(|local| self.clear_near(local, q)),
+        }
+    }
+
+    /// How far round `q` every point is as blocked as `q`, m, less a micrometre: 0 when `q` is
+    /// clear; `half` less its distance to the nearest edge when that is under `half` (a point
+    /// nearer than that to `q` is nearer than `half` to that edge, or across it); `half` when
+    /// every edge is farther (a millimetre at least: `q` is then outside the field or in an
+    /// obstacle, and a point nearer than `half` to it that is not lies across an edge, nearer
+    /// than `half` to it). A lower bound: a transit that passes within it of `q` is blocked
+    /// there (see [`super::rings`]).
+    pub(super) fn blocked_margin(&self, q: &Vec2) -> f64 {
+        if self.clear(q) {
+            return 0.0;
+        }
+        let h = self.half - 1e-6;
+        let x = (q.x - self.origin.x) * self.inv_cell;
+        let y = (q.y - self.origin.y) * self.inv_cell;
+        // Off the grid: outside the boundary's bounding box, so outside the field.
+        if !(x >= 0.0 && y >= 0.0 && (x as usize) < self.nx && (y as usize) < self.ny) {
+            return h;
+        }
+        // Every edge within `half` of `q` is on its block's list (within `half` of its cell's
+        // centre plus the cell's half diagonal).
+        let block = self.block_edges(x as usize / BLOCK, y as usize / BLOCK);
+        let d = block
+            .edges
+            .iter()
+            .map(|(_, a, b)| point_segment_distance(q, a, b))
+            .fold(f64::INFINITY, f64::min);
+        if d < h {
+            h - d
+        } else if d >= self.half + 1e-3 {
+            h
+        } else {
+            0.0
         }
     }
 

@@ -33,7 +33,7 @@ pub use clear_map::{implement_clear, TRANSIT_CLEARANCE_M};
 pub use params::{CoverageParams, FieldPlan, HeadlandOrder, RouteOrder, SwathAngle};
 pub use runs::obstacle_size;
 
-use clear_map::ClearMap;
+use clear_map::{ClearMap, Tests};
 use runs::drive_run;
 
 use crate::geo::{v2, vec_heading, wrap_angle, Direction, Vec2};
@@ -80,12 +80,15 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
     let loose_map = (!one_test).then(|| ClearMap::new(field, loose_half));
     let clear = |q: &Vec2| clear_map.clear(q);
     let loose = |q: &Vec2| loose_map.as_ref().unwrap_or(&clear_map).clear(q);
+    let margin = |q: &Vec2| clear_map.blocked_margin(q);
+    let loose_margin = |q: &Vec2| loose_map.as_ref().unwrap_or(&clear_map).blocked_margin(q);
     let (grid, loose_grid) = (std::cell::OnceCell::new(), std::cell::OnceCell::new());
     let tests = Tests {
         field,
         clear: &clear,
         loose: &loose,
         clearance: (strict_half, loose_half),
+        margins: (&margin, &loose_margin),
         one_test,
         grid: &grid,
         loose_grid: &loose_grid,
@@ -106,23 +109,6 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         }
     }
     Ok(plan)
-}
-
-/// The clearance tests of one field, width, r_min and point spacing, and their waypoint grids
-/// (built on first need: most plans never need them).
-struct Tests<'a> {
-    /// The field.
-    field: &'a Field,
-    /// The implement clear of the edge and the obstacles.
-    clear: &'a dyn Fn(&Vec2) -> bool,
-    /// The tractor inside the field and off the obstacles ([`TRANSIT_CLEARANCE_M`]).
-    loose: &'a dyn Fn(&Vec2) -> bool,
-    /// The distances from the edges and obstacles the two tests keep, m.
-    clearance: (f64, f64),
-    /// The two tests are one (w ≤ 3 m).
-    one_test: bool,
-    grid: &'a std::cell::OnceCell<transit::WaypointGrid<'a>>,
-    loose_grid: &'a std::cell::OnceCell<transit::WaypointGrid<'a>>,
 }
 
 /// [`plan_field`] with the configured headland passes as they are, with the field's `tests`, the
@@ -316,7 +302,10 @@ fn plan_once(
         // narrow fields whose attempts all fail.)
         let mut loose_headland: Option<Option<Vec<Vec2>>> = None;
         // The curves on and off the rings of the headland attempts (strict, relaxed).
-        let mut ends = [rings::Ends::default(), rings::Ends::default()];
+        let mut ends = [
+            rings::Ends::with_margin(tests.margins.0),
+            rings::Ends::with_margin(tests.margins.1),
+        ];
         for (t, way, relaxed) in attempts {
             let (cp, cn, f, hf, q, hq) = poses(t);
             if t > 0 && cp == 0 && cn == 0 {

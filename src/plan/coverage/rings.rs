@@ -10,7 +10,7 @@ use super::closed::EdgeHasher;
 #[cfg(test)]
 use super::transit::transit;
 use super::transit::{words_by_length, Csc};
-use crate::geo::{vec_heading, Vec2};
+use crate::geo::{heading_vec, vec_heading, Vec2};
 use std::hash::BuildHasherDefault;
 
 /// Points of a ring tried as the place to turn onto it (or off it), at most.
@@ -28,7 +28,13 @@ struct Ring {
     cum: Vec<f64>,
     /// `blocked[i]`: points among `pts[..i]` that are not clear (prefix counts).
     blocked: Vec<u32>,
+    /// Per run of [`CHUNK`] points (the last may be shorter): a disc holding them (centre,
+    /// radius), to pass over the runs far from a point ([`Ring::near`]).
+    chunks: Vec<(Vec2, f64)>,
 }
+
+/// Points of a ring per disc of [`Ring::chunks`].
+const CHUNK: usize = 16;
 
 impl Ring {
     fn new(track: &[Vec2], clear: &dyn Fn(&Vec2) -> bool) -> Option<Self> {
@@ -54,7 +60,19 @@ impl Ring {
         if b as usize == n {
             return None;
         }
-        Some(Ring { pts, cum, blocked })
+        let chunks = pts
+            .chunks(CHUNK)
+            .map(|run| {
+                let c = run.iter().fold(Vec2::new(0.0, 0.0), |a, p| a + p) / run.len() as f64;
+                (c, run.iter().map(|p| (p - c).norm()).fold(0.0, f64::max))
+            })
+            .collect();
+        Some(Ring {
+            pts,
+            cum,
+            blocked,
+            chunks,
+        })
     }
 
     fn len(&self) -> usize {
@@ -113,12 +131,31 @@ impl Ring {
     }
 
     /// Clear points near `q`: within `reach` m of the nearest, evenly thinned to at most
-    /// [`CANDIDATES_PER_END`].
+    /// [`CANDIDATES_PER_END`]. The distances are those of the points of the runs
+    /// ([`Self::chunks`]) that could hold the nearest point, then of those that could hold a
+    /// point within `reach` of it: a run whose disc is farther is passed over (its points are
+    /// at least that far, a micrometre allowed for the rounding), with the same answer as
+    /// from every point's distance.
     fn near(&self, q: &Vec2, reach: f64) -> Vec<usize> {
-        let d: Vec<f64> = self.pts.iter().map(|p| (p - q).norm()).collect();
-        let nearest = d.iter().copied().fold(f64::INFINITY, f64::min);
-        let all: Vec<usize> = (0..self.len())
-            .filter(|&i| d[i] <= nearest + reach && self.blocked[i + 1] == self.blocked[i])
+        let distance = |i: usize| (self.pts[i] - q).norm();
+        let run = |k: usize| k * CHUNK..((k + 1) * CHUNK).min(self.len());
+        // The distance of each run's disc (less its radius: its points are no nearer) and
+        // the farthest the nearest point can be (the nearest disc's far side).
+        let (mut least, mut most) = (Vec::with_capacity(self.chunks.len()), f64::INFINITY);
+        for (c, radius) in &self.chunks {
+            let d = (c - q).norm();
+            least.push(d - radius - 1e-6);
+            most = most.min(d + radius + 1e-6);
+        }
+        let nearest = (0..least.len())
+            .filter(|&k| least[k] <= most)
+            .flat_map(run)
+            .map(distance)
+            .fold(f64::INFINITY, f64::min);
+        let all: Vec<usize> = (0..least.len())
+            .filter(|&k| least[k] <= nearest + reach)
+            .flat_map(run)
+            .filter(|&i| distance(i) <= nearest + reach && self.blocked[i + 1] == self.blocked[i])
             .collect();
         let step = all.len().div_ceil(CANDIDATES_PER_END).max(1);
         all.into_iter().step_by(step).collect()
@@ -168,12 +205,37 @@ impl Rings {
     ) -> Option<Vec<Vec2>> {
         let reach = 4.0 * r;
         let mut best: Option<(f64, Vec<Vec2>)> = None;
-        for (ri, ring) in self.rings.iter().enumerate() {
-            let entries = ring.near(&p1, reach);
-            let exits = ring.near(&p2, reach);
-            if entries.is_empty() || exits.is_empty() {
-                continue;
-            }
+        // The candidates of the rings with both (the others are passed over).
+        let near: Vec<(usize, &Ring, Vec<usize>, Vec<usize>)> = self
+            .rings
+            .iter()
+            .enumerate()
+            .map(|(ri, ring)| (ri, ring, ring.near(&p1, reach), ring.near(&p2, reach)))
+            .filter(|c| !c.2.is_empty() && !c.3.is_empty())
+            .collect();
+        if near.is_empty() {
+            return None;
+        }
+        // Every curve from the start pose at least `trap.0` m long is blocked, and every one
+        // to the goal pose at least `trap.1` long (see [`trap_length`]): none onto a ring is
+        // clear when every entry is that far, nor any off one when every exit is, and no join
+        // is then clear; the others' words that long are not checked.
+        let trap = (
+            ends.trap_length((p1, h1, true), r, step),
+            ends.trap_length((p2, h2, false), r, step),
+        );
+        let closest = |q: &Vec2, entry: bool| {
+            near.iter()
+                .flat_map(|(_, ring, on, off)| {
+                    let pts = if entry { on } else { off };
+                    pts.iter().map(|&i| (ring.pts[i] - q).norm())
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        if closest(&p1, true) >= trap.0 || closest(&p2, false) >= trap.1 {
+            return None;
+        }
+        for (ri, ring, entries, exits) in near {
             // Every way through this ring is at least as long as the straight distances to
             // its nearest entry and from its nearest exit: none beats the best so far when
             // those do not (a micrometre of margin for the rounding of the curves' lengths).
@@ -182,7 +244,14 @@ impl Rings {
                     .map(|&i| (ring.pts[i] - q).norm())
                     .fold(f64::INFINITY, f64::min)
             };
-            let bound = nearest(&p1, &entries) + nearest(&p2, &exits) - 1e-6;
+            let (onto, off) = (nearest(&p1, &entries), nearest(&p2, &exits));
+            // No curve onto this ring is clear when every entry is as far as the start's trap
+            // length, nor any off it when every exit is as far as the goal's: no join of it is
+            // clear, and its curves are not solved (the others' answers are the same).
+            if onto >= trap.0 || off >= trap.1 {
+                continue;
+            }
+            let bound = onto + off - 1e-6;
             if best.as_ref().is_some_and(|b| b.0 <= bound) {
                 continue;
             }
@@ -190,15 +259,30 @@ impl Rings {
                 // The curves on at each entry and off at each exit, shortest first (solved once,
                 // or found in `ends`: their lengths bound the joins, then the joins verified
                 // check their points): (ring point, the end's index in `ends`, its length).
-                let on: Vec<(usize, usize, f64)> = entries
-                    .iter()
-                    .filter_map(|&i| {
-                        let pose = (ring.pts[i], ring.heading(i, dir));
-                        let key = EndKey::new((p1, h1), (ri, i, dir, true), r, step);
-                        let e = ends.solve(key, || words_by_length(p1, h1, pose.0, pose.1, r));
-                        Some((i, e, ends.length(e)?))
-                    })
-                    .collect();
+                // (Of the entries `keep` passes.)
+                let on_at = |ends: &mut Ends, keep: &dyn Fn(usize) -> bool| {
+                    entries
+                        .iter()
+                        .filter(|&&i| keep(i))
+                        .filter_map(|&i| {
+                            let pose = (ring.pts[i], ring.heading(i, dir));
+                            let key = EndKey::new((p1, h1), (ri, i, dir, true), r, step);
+                            let e = ends
+                                .solve(key, trap.0, || words_by_length(p1, h1, pose.0, pose.1, r));
+                            Some((i, e, ends.length(e)?))
+                        })
+                        .collect::<Vec<(usize, usize, f64)>>()
+                };
+                // Only an entry nearer than the start's trap length can have a clear curve
+                // onto the ring: when none of those has, none has (nor any join), and the
+                // curves to the others are not solved.
+                if trap.0.is_finite() {
+                    let maybe = on_at(ends, &|i| (ring.pts[i] - p1).norm() < trap.0);
+                    if !ends.any_clear(&maybe, step, clear) {
+                        continue;
+                    }
+                }
+                let on = on_at(ends, &|_| true);
                 // Every join costs at least the shortest way on: none beats the best so far
                 // when that does not (the bound below, with the ways off left out).
                 let least =
@@ -211,15 +295,27 @@ impl Rings {
                 if !ends.any_clear(&on, step, clear) {
                     continue;
                 }
-                let off: Vec<(usize, usize, f64)> = exits
-                    .iter()
-                    .filter_map(|&j| {
-                        let pose = (ring.pts[j], ring.heading(j, dir));
-                        let key = EndKey::new((p2, h2), (ri, j, dir, false), r, step);
-                        let e = ends.solve(key, || words_by_length(pose.0, pose.1, p2, h2, r));
-                        Some((j, e, ends.length(e)?))
-                    })
-                    .collect();
+                let off_at = |ends: &mut Ends, keep: &dyn Fn(usize) -> bool| {
+                    exits
+                        .iter()
+                        .filter(|&&j| keep(j))
+                        .filter_map(|&j| {
+                            let pose = (ring.pts[j], ring.heading(j, dir));
+                            let key = EndKey::new((p2, h2), (ri, j, dir, false), r, step);
+                            let e = ends
+                                .solve(key, trap.1, || words_by_length(pose.0, pose.1, p2, h2, r));
+                            Some((j, e, ends.length(e)?))
+                        })
+                        .collect::<Vec<(usize, usize, f64)>>()
+                };
+                // The same for the exits and the goal's trap length.
+                if trap.1.is_finite() {
+                    let maybe = off_at(ends, &|j| (ring.pts[j] - p2).norm() < trap.1);
+                    if !ends.any_clear(&maybe, step, clear) {
+                        continue;
+                    }
+                }
+                let off = off_at(ends, &|_| true);
                 // Every join costs at least the shortest way on plus the shortest way off.
                 if best
                     .as_ref()
@@ -286,6 +382,92 @@ impl Rings {
     }
 }
 
+/// A length from which every curve of curvature at most 1/`r` from (`p`, heading `h`)
+/// (`forward`; else every one arriving there with that heading) is blocked at one of its
+/// points spaced evenly along it, at most `step` apart, the ends included (the points of
+/// [`Csc::points`]), by the test whose [`super::clear_map::ClearMap::blocked_margin`] is
+/// `margin`: every curve of [`Rings::transit_with`] that long from there onto a ring (or off
+/// one to there) is blocked. Infinite when none is found (a budget of [`TRAP_BUDGET`]
+/// margins).
+///
+/// Point `k` of such a curve of length L ≥ ℓ ≥ k·step (n = ⌈L/step⌉ ≥ `k` pieces) lies at arc
+/// length σ = k·L/n from the pose, σ between k·step·ℓ/(ℓ + step) and k·step; its heading has
+/// turned by at most σ/r, so it lies in the rectangle from r·sin(σ_lo/r) to σ_hi ahead
+/// (behind, arriving) and within r·(1 − cos(σ_hi/r)) to either side (σ_hi ≤ r). When that
+/// rectangle is blocked throughout, so is point `k` of every curve at least ℓ long; the pairs
+/// (k, ℓ) are tried by ℓ. (Most failing headland attempts of narrow fields start facing the
+/// edge a few metres ahead, too close to turn away: every curve onto every ring, about 2100,
+/// was solved and checked to find that out.)
+fn trap_length(
+    margin: &dyn Fn(&Vec2) -> f64,
+    (p, h, forward): (Vec2, f64, bool),
+    r: f64,
+    step: f64,
+) -> f64 {
+    let ahead = heading_vec(h) * if forward { 1.0 } else { -1.0 };
+    let side = Vec2::new(-ahead.y, ahead.x);
+    let most = (r / step).floor().max(0.0) as usize;
+    let mut tries: Vec<(f64, usize)> = (1..=most)
+        .flat_map(|k| TRAP_LENGTHS.map(|m| (k as f64 * step * m, k)))
+        .collect();
+    tries.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut budget = TRAP_BUDGET;
+    tries
+        .into_iter()
+        .find(|&(length, k)| {
+            let hi = k as f64 * step;
+            let lo = hi * length / (length + step);
+            let spread = r * (1.0 - (hi / r).cos());
+            let rect = ((r * (lo / r).sin(), hi), (-spread, spread));
+            let mut tries = TRAP_TRY_BUDGET.min(budget);
+            let blocked = blocked_throughout(margin, (p, ahead, side), rect, &mut tries);
+            budget -= TRAP_TRY_BUDGET.min(budget) - tries;
+            blocked
+        })
+        .map_or(f64::INFINITY, |t| t.0)
+}
+
+/// The lengths tried by [`trap_length`] for point `k`, in k·step.
+const TRAP_LENGTHS: [f64; 4] = [1.0, 2.0, 4.0, 16.0];
+
+/// Most margins [`trap_length`] asks for one pose, and for one rectangle.
+const TRAP_BUDGET: usize = 256;
+const TRAP_TRY_BUDGET: usize = 32;
+
+/// Is the rectangle `u` ahead from `u.0` to `u.1`, `v` to the side from `v.0` to `v.1`, of
+/// the frame (`p`, `ahead`, `side`) blocked throughout: every point within the margin of the
+/// middle of it, or of each half in turn (the longer side halved), as far as `budget` goes?
+fn blocked_throughout(
+    margin: &dyn Fn(&Vec2) -> f64,
+    frame: (Vec2, Vec2, Vec2),
+    (u, v): ((f64, f64), (f64, f64)),
+    budget: &mut usize,
+) -> bool {
+    if *budget == 0 {
+        return false;
+    }
+    *budget -= 1;
+    let (p, ahead, side) = frame;
+    let (um, vm) = (0.5 * (u.0 + u.1), 0.5 * (v.0 + v.1));
+    let (du, dv) = (u.1 - u.0, v.1 - v.0);
+    let m = margin(&(p + ahead * um + side * vm));
+    if m <= 0.0 {
+        return false;
+    }
+    // Half the diagonal, a millimetre more.
+    if m >= 0.5 * (du * du + dv * dv).sqrt() + 1e-3 {
+        return true;
+    }
+    let halves = if du >= dv {
+        [((u.0, um), v), ((um, u.1), v)]
+    } else {
+        [(u, (v.0, vm)), (u, (vm, v.1))]
+    };
+    halves
+        .into_iter()
+        .all(|half| blocked_throughout(margin, frame, half, budget))
+}
+
 /// Which curve an end of [`Rings::transit_with`] is: the free pose (`p1` of a curve onto a
 /// ring, `p2` of one off it), the ring, its point, the direction along it, onto or off, the
 /// radius and the spacing of the points (as bits).
@@ -327,26 +509,62 @@ impl EndKey {
 struct End {
     words: Vec<Csc>,
     clear: Option<Option<Vec<Vec2>>>,
+    /// The words at least this long are blocked ([`trap_length`] of its free pose).
+    blocked_from: f64,
 }
 
 /// The curves onto and off the rings that [`Rings::transit_with`] solved and checked, for the
 /// next transit from or to the same pose with the same test (a transit's attempt with its
 /// target's start pulled back starts where the one before it did).
 #[derive(Default)]
-pub struct Ends {
+pub struct Ends<'a> {
     index: std::collections::HashMap<EndKey, usize, BuildHasherDefault<EdgeHasher>>,
     ends: Vec<End>,
+    /// The test's [`super::clear_map::ClearMap::blocked_margin`], when known: poses no curve
+    /// leaves or reaches are found without solving the curves ([`trap_length`]).
+    margin: Option<&'a dyn Fn(&Vec2) -> f64>,
+    /// [`trap_length`] of the poses asked: (position, heading, forward, radius, spacing).
+    traps: std::collections::HashMap<[u64; 6], f64>,
 }
 
-impl Ends {
+impl<'a> Ends<'a> {
+    /// No ends yet, with the blocked margin of the test they are used with.
+    pub fn with_margin(margin: &'a dyn Fn(&Vec2) -> f64) -> Self {
+        Ends {
+            margin: Some(margin),
+            ..Ends::default()
+        }
+    }
+
+    /// [`trap_length`] of a pose with the test's margin (infinite without it), found once.
+    fn trap_length(&mut self, (p, h, forward): (Vec2, f64, bool), r: f64, step: f64) -> f64 {
+        let Some(margin) = self.margin else {
+            return f64::INFINITY;
+        };
+        let key = [
+            p.x.to_bits(),
+            p.y.to_bits(),
+            h.to_bits(),
+            u64::from(forward),
+            r.to_bits(),
+            step.to_bits(),
+        ];
+        *self
+            .traps
+            .entry(key)
+            .or_insert_with(|| trap_length(margin, (p, h, forward), r, step))
+    }
+
     /// The index of the end `key`, its words solved by `solve` when first asked.
-    fn solve(&mut self, key: EndKey, solve: impl FnOnce() -> Vec<Csc>) -> usize {
+    /// Words at least `blocked_from` m long are known blocked.
+    fn solve(&mut self, key: EndKey, blocked_from: f64, solve: impl FnOnce() -> Vec<Csc>) -> usize {
         if let Some(&e) = self.index.get(&key) {
             return e;
         }
         self.ends.push(End {
             words: solve(),
             clear: None,
+            blocked_from,
         });
         self.index.insert(key, self.ends.len() - 1);
         self.ends.len() - 1
@@ -370,9 +588,13 @@ impl Ends {
         let Some(end) = self.ends.get_mut(e) else {
             return false;
         };
-        let words = &end.words;
+        let (words, from) = (&end.words, end.blocked_from);
         end.clear
-            .get_or_insert_with(|| words.iter().find_map(|c| c.points(step, clear)))
+            .get_or_insert_with(|| {
+                words
+                    .iter()
+                    .find_map(|c| (c.length < from).then(|| c.points(step, clear)).flatten())
+            })
             .is_some()
     }
 
