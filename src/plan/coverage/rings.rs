@@ -256,33 +256,45 @@ impl Rings {
                 continue;
             }
             for dir in [1, -1] {
-                // The curves on at each entry and off at each exit, shortest first (solved once,
-                // or found in `ends`: their lengths bound the joins, then the joins verified
-                // check their points): (ring point, the end's index in `ends`, its length).
-                // (Of the entries `keep` passes.)
-                let on_at = |ends: &mut Ends, keep: &dyn Fn(usize) -> bool| {
-                    entries
-                        .iter()
-                        .filter(|&&i| keep(i))
-                        .filter_map(|&i| {
-                            let pose = (ring.pts[i], ring.heading(i, dir));
-                            let key = EndKey::new((p1, h1), (ri, i, dir, true), r, step);
-                            let e = ends
-                                .solve(key, trap.0, || words_by_length(p1, h1, pose.0, pose.1, r));
-                            Some((i, e, ends.length(e)?))
-                        })
-                        .collect::<Vec<(usize, usize, f64)>>()
-                };
+                // The curves on at each entry (`onto`) or off at each exit, shortest first
+                // (solved once, or found in `ends`: their lengths bound the joins, then the
+                // joins verified check their points): (ring point, the end's index in `ends`,
+                // its length). (Of the ring points `at` that `keep` passes.)
+                let curves_at =
+                    |ends: &mut Ends, at: &[usize], onto: bool, keep: &dyn Fn(usize) -> bool| {
+                        let ((p, h), budget) = if onto {
+                            ((p1, h1), trap.0)
+                        } else {
+                            ((p2, h2), trap.1)
+                        };
+                        at.iter()
+                            .filter(|&&i| keep(i))
+                            .filter_map(|&i| {
+                                let pose = (ring.pts[i], ring.heading(i, dir));
+                                let key = EndKey::new((p, h), (ri, i, dir, onto), r, step);
+                                let e = ends.solve(key, budget, || {
+                                    if onto {
+                                        words_by_length(p, h, pose.0, pose.1, r)
+                                    } else {
+                                        words_by_length(pose.0, pose.1, p, h, r)
+                                    }
+                                });
+                                Some((i, e, ends.length(e)?))
+                            })
+                            .collect::<Vec<(usize, usize, f64)>>()
+                    };
                 // Only an entry nearer than the start's trap length can have a clear curve
                 // onto the ring: when none of those has, none has (nor any join), and the
                 // curves to the others are not solved.
                 if trap.0.is_finite() {
-                    let maybe = on_at(ends, &|i| (ring.pts[i] - p1).norm() < trap.0);
+                    let maybe = curves_at(ends, &entries, true, &|i| {
+                        (ring.pts[i] - p1).norm() < trap.0
+                    });
                     if !ends.any_clear(&maybe, step, clear) {
                         continue;
                     }
                 }
-                let on = on_at(ends, &|_| true);
+                let on = curves_at(ends, &entries, true, &|_| true);
                 // Every join costs at least the shortest way on: none beats the best so far
                 // when that does not (the bound below, with the ways off left out).
                 let least =
@@ -295,27 +307,15 @@ impl Rings {
                 if !ends.any_clear(&on, step, clear) {
                     continue;
                 }
-                let off_at = |ends: &mut Ends, keep: &dyn Fn(usize) -> bool| {
-                    exits
-                        .iter()
-                        .filter(|&&j| keep(j))
-                        .filter_map(|&j| {
-                            let pose = (ring.pts[j], ring.heading(j, dir));
-                            let key = EndKey::new((p2, h2), (ri, j, dir, false), r, step);
-                            let e = ends
-                                .solve(key, trap.1, || words_by_length(pose.0, pose.1, p2, h2, r));
-                            Some((j, e, ends.length(e)?))
-                        })
-                        .collect::<Vec<(usize, usize, f64)>>()
-                };
                 // The same for the exits and the goal's trap length.
                 if trap.1.is_finite() {
-                    let maybe = off_at(ends, &|j| (ring.pts[j] - p2).norm() < trap.1);
+                    let maybe =
+                        curves_at(ends, &exits, false, &|j| (ring.pts[j] - p2).norm() < trap.1);
                     if !ends.any_clear(&maybe, step, clear) {
                         continue;
                     }
                 }
-                let off = off_at(ends, &|_| true);
+                let off = curves_at(ends, &exits, false, &|_| true);
                 // Every join costs at least the shortest way on plus the shortest way off.
                 if best
                     .as_ref()
