@@ -10,7 +10,7 @@ use super::closed::EdgeHasher;
 #[cfg(test)]
 use super::transit::transit;
 use super::transit::{words_by_length, Csc};
-use crate::geo::{heading_vec, vec_heading, Vec2};
+use crate::geo::{heading_vec, left_normal, vec_heading, Vec2};
 use std::hash::BuildHasherDefault;
 
 /// Points of a ring tried as the place to turn onto it (or off it), at most.
@@ -405,7 +405,7 @@ fn trap_length(
     step: f64,
 ) -> f64 {
     let ahead = heading_vec(h) * if forward { 1.0 } else { -1.0 };
-    let side = Vec2::new(-ahead.y, ahead.x);
+    let side = left_normal(&ahead);
     let most = (r / step).floor().max(0.0) as usize;
     let mut tries: Vec<(f64, usize)> = (1..=most)
         .flat_map(|k| TRAP_LENGTHS.map(|m| (k as f64 * step * m, k)))
@@ -626,6 +626,9 @@ impl<'a> Ends<'a> {
         self.ends.get(e)?.clear.as_ref()?.as_deref()
     }
 }
+
+#[cfg(test)]
+mod trap_tests;
 
 #[cfg(test)]
 mod tests {
