@@ -160,6 +160,12 @@ pub enum FieldError {
     SeveralFields { count: usize, fields: String },
     #[error("no field \"{wanted}\" in the file (by PFD id or name); the file holds: {available}")]
     NoSuchField { wanted: String, available: String },
+    #[error("\"{wanted}\" is the name of several fields ({fields}); choose one by its PFD id (agsteer plan --list shows them, --field-id chooses)")]
+    AmbiguousName { wanted: String, fields: String },
+    #[error("no partfield with a boundary in the file ({partfields} partfield(s) (PFD), none with a boundary PLN A=\"1\"); agsteer plan --list shows them")]
+    NoPartfield { partfields: usize },
+    #[error("{field}: no field boundary polygon (a PLN A=\"1\" with an exterior LSG A=\"1\"); agsteer plan --list shows the file's fields")]
+    PartfieldWithoutBoundary { field: String },
     #[error("text encoding: {0}")]
     Encoding(String),
     #[error("TASKDATA.XML names the external file {name}.XML (XFR), which is missing")]

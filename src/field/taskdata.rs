@@ -21,6 +21,47 @@ const PLN_OBSTACLES: [&str; 4] = ["3", "4", "6", "12"];
 const LSG_EXTERIOR: &str = "1";
 const LSG_INTERIOR: &str = "2";
 const LSG_GUIDANCE: &str = "5";
+const LSG_OBSTACLE: &str = "9";
+
+/// First and last points of an obstacle LSG (type 9) at most this far apart make it a closed
+/// ring, an area to keep off (CNH terminals write impassable areas so); farther, it is a line, m.
+const CLOSED_RING_M: f64 = 0.1;
+
+/// Is `ring` closed (its last point back on its first, within [`CLOSED_RING_M`]) round at
+/// least three distinct points?
+fn closed_area(ring: &[LatLon]) -> bool {
+    let (Some(first), Some(last)) = (ring.first(), ring.last()) else {
+        return false;
+    };
+    // Metres per degree of latitude, and of longitude at this latitude (a spherical Earth is
+    // close enough for a 10 cm test).
+    let m_per_deg = 111_195.0;
+    let dy = (last.lat_deg - first.lat_deg) * m_per_deg;
+    let dx = (last.lon_deg - first.lon_deg) * m_per_deg * first.lat_deg.to_radians().cos();
+    let mut distinct: Vec<&LatLon> = Vec::new();
+    for q in ring {
+        if !distinct
+            .iter()
+            .any(|d| d.lat_deg == q.lat_deg && d.lon_deg == q.lon_deg)
+        {
+            distinct.push(q);
+        }
+        if distinct.len() >= 3 {
+            break;
+        }
+    }
+    dx.hypot(dy) <= CLOSED_RING_M && distinct.len() >= 3
+}
+
+/// How a PLN or LSG is named in a warning: its id in the file (PLN E, LSG F) where it has one,
+/// else its kind and place among its siblings.
+fn element_name(node: &Node, tag: &str, id_attribute: &str, index: usize) -> String {
+    match node.attribute(id_attribute).map(str::trim) {
+        Some(id) if id.to_ascii_uppercase().starts_with(tag) => id.to_string(),
+        Some(id) if !id.is_empty() => format!("{tag} {id}"),
+        _ => format!("{tag} {index}"),
+    }
+}
 
 fn pln_type_name(t: &str) -> &'static str {
     match t {
@@ -123,17 +164,21 @@ fn ring(feature: &str, lsg: &Node) -> Result<Vec<LatLon>, FieldError> {
         .collect()
 }
 
-/// The polygon of a PLN: its exterior and interior LSGs; other LSG types are skipped with a
-/// warning. `None` (with a warning) when it has no exterior.
-fn polygon(
+/// The rings of a PLN: its exterior and interior LSGs; in an obstacle PLN (`obstacle`) a
+/// closed obstacle LSG (type 9) is its exterior when it has no type 1. Other LSG types, and
+/// obstacle LSGs that are lines, are skipped with a warning naming them.
+fn rings(
     feature: &str,
     pln: &Node,
+    obstacle: bool,
     warnings: &mut Vec<String>,
-) -> Result<Option<RawPolygon>, FieldError> {
+) -> Result<(Option<Vec<LatLon>>, Vec<Vec<LatLon>>), FieldError> {
     let mut exterior = None;
+    let mut obstacle_ring = None;
     let mut holes = Vec::new();
     for (k, lsg) in pln.children().filter(|n| n.has_tag_name("LSG")).enumerate() {
         let t = lsg.attribute("A").unwrap_or("").trim();
+        let name = element_name(&lsg, "LSG", "F", k);
         match t {
             LSG_EXTERIOR if exterior.is_none() => exterior = Some(ring(feature, &lsg)?),
             LSG_EXTERIOR => {
@@ -143,23 +188,23 @@ fn polygon(
                 })
             }
             LSG_INTERIOR => holes.push(ring(feature, &lsg)?),
+            LSG_OBSTACLE if obstacle && obstacle_ring.is_none() => {
+                let r = ring(feature, &lsg)?;
+                if closed_area(&r) {
+                    obstacle_ring = Some(r);
+                } else {
+                    warnings.push(format!(
+                        "{feature}: {name} of type 9 (obstacle) is a line, not a closed area: skipped (drive round it by hand)"
+                    ));
+                }
+            }
             other => warnings.push(format!(
-                "{feature}: LSG {k} of type {other} ({}) skipped",
+                "{feature}: {name} of type {other} ({}) skipped",
                 lsg_type_name(other)
             )),
         }
     }
-    let Some(exterior) = exterior else {
-        warnings.push(format!(
-            "{feature}: no polygon exterior (LSG A=\"1\"), skipped"
-        ));
-        return Ok(None);
-    };
-    Ok(Some(RawPolygon {
-        label: feature.to_string(),
-        exterior,
-        holes,
-    }))
+    Ok((exterior.or(obstacle_ring), holes))
 }
 
 fn pfd_label(pfd: &Node) -> String {
@@ -213,12 +258,18 @@ pub fn list(text: &str, externals: &[(String, String)]) -> Result<Vec<PartfieldI
     for (file, doc) in &docs {
         for pfd in doc.descendants().filter(|n| n.has_tag_name("PFD")) {
             let plns: Vec<Node> = pfd.children().filter(|n| n.has_tag_name("PLN")).collect();
-            let with_exterior = |types: &[&str]| {
+            let with_exterior = |types: &[&str], also: Option<&str>| {
                 plns.iter()
                     .filter(|p| types.contains(&p.attribute("A").unwrap_or("").trim()))
                     .filter(|p| {
-                        p.children()
-                            .any(|l| l.has_tag_name("LSG") && l.attribute("A") == Some("1"))
+                        p.children().any(|l| {
+                            let t = l.attribute("A").map(str::trim);
+                            l.has_tag_name("LSG")
+                                && (t == Some(LSG_EXTERIOR)
+                                    || (also.is_some() && t == also && {
+                                        ring("", &l).is_ok_and(|r| closed_area(&r))
+                                    }))
+                        })
                     })
                     .count()
             };
@@ -227,13 +278,21 @@ pub fn list(text: &str, externals: &[(String, String)]) -> Result<Vec<PartfieldI
                 designator: pfd.attribute("C").map(str::to_string),
                 stated_area_m2: pfd.attribute("D").and_then(|d| d.trim().parse().ok()),
                 file: file.clone(),
-                boundaries: with_exterior(&[PLN_BOUNDARY]),
-                obstacles: with_exterior(&PLN_OBSTACLES),
-                guidance_patterns: pfd.descendants().filter(|n| n.has_tag_name("GPN")).count(),
+                boundaries: with_exterior(&[PLN_BOUNDARY], None),
+                obstacles: with_exterior(&PLN_OBSTACLES, Some(LSG_OBSTACLE)),
+                guidance_patterns: pfd.descendants().filter(|n| n.has_tag_name("GPN")).count()
+                    + direct_guidance(&pfd).count(),
             });
         }
     }
     Ok(out)
+}
+
+/// Guidance lines written as LSGs of type 5 directly under the PFD, as ISO 11783-10 version 3
+/// files have them (version 4 puts them in GGP → GPN).
+fn direct_guidance<'a, 'input>(pfd: &Node<'a, 'input>) -> impl Iterator<Item = Node<'a, 'input>> {
+    pfd.children()
+        .filter(|n| n.has_tag_name("LSG") && n.attribute("A").map(str::trim) == Some(LSG_GUIDANCE))
 }
 
 fn guidance(pfd: &Node, label: &str) -> Result<Vec<RawGuidance>, FieldError> {
@@ -260,6 +319,27 @@ fn guidance(pfd: &Node, label: &str) -> Result<Vec<RawGuidance>, FieldError> {
             });
         }
     }
+    // Version 3: two points are an AB line, more a reference curve.
+    for (k, lsg) in direct_guidance(pfd).enumerate() {
+        let name = format!(
+            "{label} {}{}",
+            element_name(&lsg, "LSG", "F", k),
+            lsg.attribute("B")
+                .map(|b| format!(" \"{b}\""))
+                .unwrap_or_default()
+        );
+        let points = ring(&name, &lsg)?;
+        let kind = match points.len() {
+            0 | 1 => continue,
+            2 => GuidanceKind::AbLine,
+            _ => GuidanceKind::Curve,
+        };
+        out.push(RawGuidance {
+            label: name,
+            kind,
+            points,
+        });
+    }
     Ok(out)
 }
 
@@ -283,23 +363,44 @@ pub(crate) fn parse(
         it.map(pfd_label).collect::<Vec<_>>().join(", ")
     };
     let chosen = match select.map(str::trim) {
-        Some(want) => pfds
+        Some(want) => match pfds
             .iter()
             .find(|p| p.attribute("A").map(str::trim) == Some(want))
-            .or_else(|| {
-                pfds.iter().find(|p| {
-                    p.attribute("C")
-                        .is_some_and(|c| c.trim().eq_ignore_ascii_case(want))
-                })
-            })
-            .ok_or_else(|| FieldError::NoSuchField {
-                wanted: want.to_string(),
-                available: names(&mut pfds.iter()),
-            })?,
+        {
+            Some(by_id) => by_id,
+            None => {
+                let named: Vec<&Node> = pfds
+                    .iter()
+                    .filter(|p| {
+                        p.attribute("C")
+                            .is_some_and(|c| c.trim().eq_ignore_ascii_case(want))
+                    })
+                    .collect();
+                match named.as_slice() {
+                    [] => {
+                        return Err(FieldError::NoSuchField {
+                            wanted: want.to_string(),
+                            available: names(&mut pfds.iter()),
+                        })
+                    }
+                    [one] => *one,
+                    many => {
+                        return Err(FieldError::AmbiguousName {
+                            wanted: want.to_string(),
+                            fields: names(&mut many.iter().copied()),
+                        })
+                    }
+                }
+            }
+        },
         None => {
             let with: Vec<&Node> = pfds.iter().filter(|p| has_boundary(p)).collect();
             match with.as_slice() {
-                [] => return Err(FieldError::NoBoundary),
+                [] => {
+                    return Err(FieldError::NoPartfield {
+                        partfields: pfds.len(),
+                    })
+                }
                 [one] => *one,
                 many => {
                     return Err(FieldError::SeveralFields {
@@ -318,27 +419,121 @@ pub(crate) fn parse(
         guidance: guidance(chosen, &label)?,
         warnings: Vec::new(),
     };
+    // Interiors written in boundary PLNs of their own, without an exterior (CNH terminals
+    // write each hole so): (the PLN's name, the ring).
+    let mut loose_holes: Vec<(String, Vec<LatLon>)> = Vec::new();
+    // Each boundary's own name (PLN id), for the holes joined to it.
+    let mut boundary_names: Vec<String> = Vec::new();
     for (j, pln) in chosen
         .children()
         .filter(|n| n.has_tag_name("PLN"))
         .enumerate()
     {
         let t = pln.attribute("A").unwrap_or("").trim();
-        let mut feature = format!("{label} PLN {j} (type {t}, {})", pln_type_name(t));
+        let pln_name = element_name(&pln, "PLN", "E", j);
+        let mut feature = format!("{label} {pln_name} (type {t}, {})", pln_type_name(t));
         if let Some(name) = pln.attribute("B") {
             feature.push_str(&format!(" \"{name}\""));
         }
-        if t == PLN_BOUNDARY {
-            if let Some(p) = polygon(&feature, &pln, &mut out.warnings)? {
-                out.boundaries.push(p);
-            }
-        } else if PLN_OBSTACLES.contains(&t) {
-            if let Some(p) = polygon(&feature, &pln, &mut out.warnings)? {
-                out.obstacles.push(p);
-            }
-        } else {
+        let obstacle = PLN_OBSTACLES.contains(&t);
+        if t != PLN_BOUNDARY && !obstacle {
             out.warnings.push(format!("{feature}: not used, skipped"));
+            continue;
         }
+        match rings(&feature, &pln, obstacle, &mut out.warnings)? {
+            (Some(exterior), holes) => {
+                let polygon = RawPolygon {
+                    label: feature,
+                    exterior,
+                    holes,
+                };
+                if obstacle {
+                    out.obstacles.push(polygon);
+                } else {
+                    out.boundaries.push(polygon);
+                    boundary_names.push(pln_name);
+                }
+            }
+            (None, holes) if !obstacle && !holes.is_empty() => {
+                loose_holes.extend(holes.into_iter().map(|h| (pln_name.clone(), h)));
+            }
+            (None, _) => out.warnings.push(format!(
+                "{feature}: no polygon exterior (LSG A=\"1\"{}), skipped",
+                if obstacle {
+                    ", or a closed obstacle LSG A=\"9\""
+                } else {
+                    ""
+                }
+            )),
+        }
+    }
+    // LSGs directly under the PFD (version 3 files, CNH's impassable lines): guidance is read
+    // above; a closed obstacle ring is an obstacle; anything else is named and skipped.
+    for (k, lsg) in chosen
+        .children()
+        .filter(|n| n.has_tag_name("LSG"))
+        .enumerate()
+    {
+        let t = lsg.attribute("A").unwrap_or("").trim();
+        if t == LSG_GUIDANCE {
+            continue;
+        }
+        let mut feature = format!("{label} {}", element_name(&lsg, "LSG", "F", k));
+        if let Some(name) = lsg.attribute("B") {
+            feature.push_str(&format!(" \"{name}\""));
+        }
+        if t == LSG_OBSTACLE {
+            let exterior = ring(&feature, &lsg)?;
+            if closed_area(&exterior) {
+                out.obstacles.push(RawPolygon {
+                    label: feature,
+                    exterior,
+                    holes: Vec::new(),
+                });
+                continue;
+            }
+            out.warnings.push(format!(
+                "{feature}: type 9 (obstacle) is a line, not a closed area: skipped (drive round it by hand)"
+            ));
+            continue;
+        }
+        out.warnings.push(format!(
+            "{feature}: type {t} ({}) skipped",
+            lsg_type_name(t)
+        ));
+    }
+    // Each such interior is a hole of the boundary whose exterior holds it.
+    for (pln_name, hole) in loose_holes {
+        let plane = |ring: &[LatLon]| -> Vec<crate::geo::Vec2> {
+            ring.iter()
+                .map(|q| crate::geo::v2(q.lon_deg, q.lat_deg))
+                .collect()
+        };
+        let inner = plane(&hole);
+        let owner = out
+            .boundaries
+            .iter_mut()
+            .zip(&boundary_names)
+            .find(|(b, _)| {
+                let outer = plane(&b.exterior);
+                inner
+                    .iter()
+                    .all(|q| crate::geo::polygon::contains_point(&outer, q))
+            });
+        match owner {
+            Some((boundary, owner_name)) => {
+                out.warnings.push(format!(
+                    "{label} {pln_name}: an interior without an exterior, taken as a hole of {owner_name}"
+                ));
+                boundary.holes.push(hole);
+            }
+            None => out.warnings.push(format!(
+                "{label} {pln_name}: a polygon interior (LSG A=\"2\") inside no boundary of the field, skipped"
+            )),
+        }
+    }
+    if out.boundaries.is_empty() {
+        return Err(FieldError::PartfieldWithoutBoundary { field: label });
     }
     Ok(out)
 }
