@@ -198,3 +198,37 @@ mod end_to_end {
         assert!(failures.is_empty(), "{}", failures.join("\n"));
     }
 }
+
+/// A refused plan's "largest implement width that plans swaths" is one the planner does plan
+/// swaths at, the widest below the refused one. On this hold-out parcel (18.4 m at its widest)
+/// the strip test with the configured headland passes had said 4.5 m, but 6 m plans swaths
+/// (in the ground the passes leave).
+#[test]
+fn a_refusals_largest_width_is_the_widest_that_plans_swaths() {
+    use agsteer::plan::coverage::{narrow::no_swath_reason, plan_field};
+    let path = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tools/fields/holdout2/fi_61_small_concave.geojson"
+    ));
+    let field = load(&path).field;
+    let mut p = agsteer::config::Config::default().coverage_params();
+    (p.line_width, p.r_min) = (12.0, 5.0);
+    assert_eq!(plan_field(&field, &p).unwrap().swaths, 0);
+    let why = no_swath_reason(&field, &p).expect("refused");
+    assert!(why.planned, "{why}");
+    let largest = why.largest_width.expect("a width plans swaths");
+    assert!(largest >= 6.0, "{why}");
+    let swaths_at = |w: f64| {
+        let q = agsteer::plan::coverage::CoverageParams {
+            line_width: w,
+            ..p.clone()
+        };
+        plan_field(&field, &q).map_or(0, |plan| plan.swaths)
+    };
+    assert!(swaths_at(largest) > 0);
+    let mut w = largest + 0.5;
+    while w < p.line_width {
+        assert_eq!(swaths_at(w), 0, "{w} m plans swaths: {why}");
+        w += 0.5;
+    }
+}

@@ -11,7 +11,7 @@ use agsteer::field::{
 };
 use agsteer::plan::coverage::metrics::checks::{check_plan, ViolationKind};
 use agsteer::plan::coverage::metrics::{area_and_pieces, plan_metrics};
-use agsteer::plan::coverage::{headland, CoverageParams, Field, FieldPlan};
+use agsteer::plan::coverage::{CoverageParams, Field, FieldPlan};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -339,17 +339,18 @@ fn refusal(
         ),
         None => String::new(),
     };
-    let area = (field.boundary.clone(), field.obstacles.clone());
-    let width = agsteer::plan::coverage::geometry::inscribed_width(&area);
-    let reason = headland::no_swath_fits(width, params)
-        .map(|n| n.to_string())
-        .unwrap_or_else(|| {
+    let reason = match agsteer::plan::coverage::narrow::no_swath_reason(field, params) {
+        Some(why) => why.to_string(),
+        None => {
+            let area = (field.boundary.clone(), field.obstacles.clone());
+            let width = agsteer::plan::coverage::geometry::inscribed_width(&area);
             format!(
                 "no swath fits the field ({width:.1} m wide at its widest, implement {:.1} m, turn diameter {:.1} m)",
                 params.line_width,
                 2.0 * params.r_min
             )
-        });
+        }
+    };
     Some(format!("{reason}{short}"))
 }
 

@@ -80,9 +80,13 @@ pub struct NoSwathFits {
     /// Headland passes the turns need at this width ([`passes`]) and their width, m.
     pub passes: usize,
     pub headland_width: f64,
-    /// The largest implement width (0.5 m steps) at which a swath fits inside the headland
-    /// (`None` below 0.5 m).
+    /// The largest implement width (0.5 m steps) at which a swath may fit inside the fewest
+    /// headland passes the turns need (`None` below 0.5 m): no wider one, below this one,
+    /// leaves room for a swath.
     pub largest_width: Option<f64>,
+    /// `largest_width` was planned and has swaths ([`super::narrow::largest_planned_width`]);
+    /// else it is only the width above which none fits.
+    pub planned: bool,
 }
 
 impl std::fmt::Display for NoSwathFits {
@@ -98,20 +102,26 @@ impl std::fmt::Display for NoSwathFits {
                 self.field_width, self.passes, self.headland_width, self.turn_diameter, self.line_width
             )
         };
-        match self.largest_width {
-            Some(w) => write!(f, "no swath fits: {why}; the largest implement width that leaves room for swaths here is {w:.1} m"),
-            None => write!(f, "no swath fits: {why}; no implement width of 0.5 m or more leaves room for swaths here"),
+        match (self.largest_width, self.planned) {
+            (Some(w), true) => write!(f, "no swath fits: {why}; the largest implement width that plans swaths here is {w:.1} m"),
+            (Some(w), false) => write!(f, "no swath fits: {why}; no implement width above {w:.1} m leaves room for swaths here"),
+            (None, _) => write!(f, "no swath fits: {why}; no implement width of 0.5 m or more leaves room for swaths here"),
         }
     }
 }
 
 /// `Some` when the field is too narrow for any swath inside the headland at these parameters.
+/// The largest width is searched with the fewest headland passes the turns need, as the
+/// planner tries them when the configured ones leave no room ([`super::narrow`]).
 pub fn no_swath_fits(field_width: f64, p: &CoverageParams) -> Option<NoSwathFits> {
     let room = |q: &CoverageParams| field_width > 2.0 * passes(q) as f64 * q.pass_spacing() + 1e-6;
     if room(p) {
         return None;
     }
-    let mut q = p.clone();
+    let mut q = CoverageParams {
+        headland_passes: 0,
+        ..p.clone()
+    };
     let mut largest = None;
     let mut w = (p.line_width * 2.0).floor() / 2.0;
     while w >= 0.5 && w > 2.0 * p.overlap {
@@ -129,6 +139,7 @@ pub fn no_swath_fits(field_width: f64, p: &CoverageParams) -> Option<NoSwathFits
         passes: passes(p),
         headland_width: passes(p) as f64 * p.pass_spacing(),
         largest_width: largest,
+        planned: false,
     })
 }
 

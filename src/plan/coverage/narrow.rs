@@ -72,6 +72,50 @@ pub fn plan_field(
 /// The parts of a field that a tractor cannot drive between inside the boundary (joined only
 /// by necks narrower than twice [`super::TRANSIT_CLEARANCE_M`]), when there are several: the
 /// field with its holes shrunk by that clearance, as areas, largest first.
+/// Why no swath fits `field` at `p` ([`headland::no_swath_fits`] at its widest strip), with
+/// the largest width that plans swaths found by planning, 0.5 m narrower each time from `p`'s
+/// ([`largest_planned_width`]: the strip test alone is no bound, as ground the passes leave
+/// can hold swaths of a width whose passes leave the strip no room); `None` when the strip
+/// leaves room for one.
+pub fn no_swath_reason(field: &Field, p: &CoverageParams) -> Option<headland::NoSwathFits> {
+    let area = (field.boundary.clone(), field.obstacles.clone());
+    let mut why = headland::no_swath_fits(super::geometry::inscribed_width(&area), p)?;
+    let tries = (2.0 * p.line_width).ceil() as usize;
+    match largest_planned_width(field, p, p.line_width - 0.5, tries) {
+        Some(planned) => {
+            why.largest_width = Some(planned);
+            why.planned = true;
+        }
+        None => why.largest_width = None,
+    }
+    Some(why)
+}
+
+/// The largest implement width at which [`super::plan_field`] plans swaths, trying `start` and
+/// then 0.5 m narrower each time, at most `tries` plans; `None` when none of them has a swath.
+pub fn largest_planned_width(
+    field: &Field,
+    p: &CoverageParams,
+    start: f64,
+    tries: usize,
+) -> Option<f64> {
+    let mut w = (start * 2.0).floor() / 2.0;
+    for _ in 0..tries {
+        if w < 0.5 || w <= 2.0 * p.overlap {
+            return None;
+        }
+        let q = CoverageParams {
+            line_width: w,
+            ..p.clone()
+        };
+        if super::plan_field(field, &q).is_ok_and(|plan| plan.swaths > 0) {
+            return Some(w);
+        }
+        w -= 0.5;
+    }
+    None
+}
+
 pub fn parts(field: &Field) -> Vec<super::geometry::Area> {
     let whole = (field.boundary.clone(), field.obstacles.clone());
     let mut parts = super::geometry::offset(&[whole], -super::TRANSIT_CLEARANCE_M);
