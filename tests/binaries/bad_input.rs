@@ -395,7 +395,7 @@ fn taskdata_entity_expansion_and_deep_nesting_are_refused() {
     // recursion (which then holds no boundary).
     for (text, why) in [
         (laughs, "XML with DTD detected"),
-        (deep, "no field boundary"),
+        (deep, "no partfield with a boundary"),
     ] {
         let dir = tempfile::tempdir().unwrap();
         let f = write(dir.path(), "TASKDATA.XML", &text);

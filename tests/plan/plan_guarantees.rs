@@ -488,7 +488,9 @@ fn plan_file(
 /// width and turning radius of `agsteer plan --sweep` (3, 6, 12, 36 m; 5, 8 m), without
 /// sections and with 8 (the swaths then run on to the cell's extent): every plan keeps the
 /// guarantees (by these checks and by `check_plan`). Only the guarantees: the
-/// coverage figures of this set are measured and reported (README, Session 30), not asserted.
+/// coverage figures of this set are measured and reported (README, Real fields: where the
+/// planner stands; docs/coverage-history.md, Session 30: a hold-out set of parcels; runs that
+/// strand the vehicle put back), not asserted.
 #[test]
 fn every_hold_out_parcel_keeps_the_guarantees() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/fields/holdout");
