@@ -90,7 +90,8 @@ pub struct TrackConfig {
     /// the sensor's zero error (calibration leaves ≤ 0.1°) plus the steady steer a side force
     /// needs: a 5 kN implement side draft at 1.5 m behind the axle learns −2.97°, and with the
     /// former 3° limit 6.5 kN put the straights 3 cm off, 8 kN 6 cm; at 6°, 10 kN holds
-    /// (0.79 cm) and the envelope is unchanged (README, Robustness envelope).
+    /// (0.79 cm) and the envelope is unchanged (docs/envelope.md, Session 17: the observer's
+    /// priors).
     pub observer_bias_limit_deg: f64,
     /// Largest drift speed the observer may estimate, m/s.
     pub observer_drift_limit_mps: f64,
