@@ -235,16 +235,25 @@ impl Rings {
         if closest(&p1, true) >= trap.0 || closest(&p2, false) >= trap.1 {
             return None;
         }
-        for (ri, ring, entries, exits) in near {
-            // Every way through this ring is at least as long as the straight distances to
-            // its nearest entry and from its nearest exit: none beats the best so far when
-            // those do not (a micrometre of margin for the rounding of the curves' lengths).
-            let nearest = |q: &Vec2, pts: &[usize]| {
-                pts.iter()
-                    .map(|&i| (ring.pts[i] - q).norm())
-                    .fold(f64::INFINITY, f64::min)
-            };
-            let (onto, off) = (nearest(&p1, &entries), nearest(&p2, &exits));
+        // Every way through a ring is at least as long as the straight distances to its
+        // nearest entry and from its nearest exit: the rings are tried by that bound, so the
+        // best way is found early and the rings that cannot beat it are passed over.
+        let nearest = |ring: &Ring, q: &Vec2, pts: &[usize]| {
+            pts.iter()
+                .map(|&i| (ring.pts[i] - q).norm())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut near: Vec<_> = near
+            .into_iter()
+            .map(|(ri, ring, entries, exits)| {
+                let (onto, off) = (nearest(ring, &p1, &entries), nearest(ring, &p2, &exits));
+                (onto + off, (ri, ring, entries, exits, onto, off))
+            })
+            .collect();
+        near.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (_, (ri, ring, entries, exits, onto, off)) in near {
+            // None beats the best so far when the bound does not (a micrometre of margin for
+            // the rounding of the curves' lengths).
             // No curve onto this ring is clear when every entry is as far as the start's trap
             // length, nor any off it when every exit is as far as the goal's: no join of it is
             // clear, and its curves are not solved (the others' answers are the same).
