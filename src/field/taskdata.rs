@@ -164,6 +164,9 @@ fn ring(feature: &str, lsg: &Node) -> Result<Vec<LatLon>, FieldError> {
         .collect()
 }
 
+/// A PLN's exterior ring (if it has one) and its interior rings.
+type PlnRings = (Option<Vec<LatLon>>, Vec<Vec<LatLon>>);
+
 /// The rings of a PLN: its exterior and interior LSGs; in an obstacle PLN (`obstacle`) a
 /// closed obstacle LSG (type 9) is its exterior when it has no type 1. Other LSG types, and
 /// obstacle LSGs that are lines, are skipped with a warning naming them.
@@ -172,7 +175,7 @@ fn rings(
     pln: &Node,
     obstacle: bool,
     warnings: &mut Vec<String>,
-) -> Result<(Option<Vec<LatLon>>, Vec<Vec<LatLon>>), FieldError> {
+) -> Result<PlnRings, FieldError> {
     let mut exterior = None;
     let mut obstacle_ring = None;
     let mut holes = Vec::new();
