@@ -232,3 +232,35 @@ fn a_refusals_largest_width_is_the_widest_that_plans_swaths() {
         w += 0.5;
     }
 }
+
+/// Hold-out parcels where the plan went on without a transit although there was a way:
+/// a headland ring in the bay of a hole started at one of the 3 of its 40 points no transit
+/// reaches (`de_bb_13_holes16`, twice: to it and on from it), and a stub of a swath, 2 m and
+/// 5 m long, between the turn onto it and an obstacle with no detour round it, from whose end
+/// there is no room to turn (`bg_86_holes15_40ha`, `bg_3_holes18_73ha`). Each plan now has a
+/// transit everywhere, and keeps the guarantees.
+#[test]
+fn open_ground_leaves_no_transit_gap() {
+    use agsteer::plan::coverage::{metrics::checks::check_plan, plan_field};
+    let root = env!("CARGO_MANIFEST_DIR");
+    for (name, w, r) in [
+        ("de_bb_13_holes16", 3.0, 5.0),
+        ("bg_86_holes15_40ha", 6.0, 8.0),
+        ("bg_3_holes18_73ha", 3.0, 5.0),
+    ] {
+        let sets = [
+            format!("job.line_width_m={w}"),
+            format!("vehicle.r_min_m={r}"),
+        ];
+        let config_path = PathBuf::from(format!("{root}/config/demo.toml"));
+        let p = agsteer::config::Config::load(&config_path, &sets)
+            .expect("the demo config")
+            .coverage_params();
+        let path = PathBuf::from(format!("{root}/tools/fields/holdout2/{name}.geojson"));
+        let field = load(&path).field;
+        let plan = plan_field(&field, &p).expect("planned");
+        assert_eq!(plan.transit_gaps, 0, "{name}: {:#?}", plan.warnings);
+        let violations = check_plan(&field, &plan, p.line_width, p.r_min);
+        assert!(violations.is_empty(), "{name}: {violations:?}");
+    }
+}

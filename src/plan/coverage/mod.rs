@@ -21,8 +21,10 @@ pub mod narrow;
 mod params;
 mod regions;
 mod reverse;
+mod ring_start;
 pub mod rings;
 mod runs;
+mod stub;
 pub mod swath_angle;
 pub mod swaths;
 mod to_goal;
@@ -560,13 +562,21 @@ fn plan_once(
                         continue;
                     }
                     if (ring[n - 1] - ring[0]).norm() > 1e-9 {
-                        // An open stretch of a cut pass: driven from its end nearer the vehicle.
+                        // An open stretch of a cut pass: driven from its end nearer the vehicle
+                        // (from the other where no transit reaches that one).
                         let here = at.map(|a| a.0).unwrap_or(ring[0]);
-                        let mut track = ring;
-                        if (track[n - 1] - here).norm() < (track[0] - here).norm() {
-                            track.reverse();
+                        let mut near_end = ring;
+                        let far_end = |t: &Vec<Vec2>| t.iter().rev().copied().collect();
+                        if (near_end[n - 1] - here).norm() < (near_end[0] - here).norm() {
+                            near_end = far_end(&near_end);
                         }
-                        let cut = go_to(&mut segments, &mut at, &track, 0);
+                        let ends = [far_end(&near_end), near_end];
+                        let ends = ends.into_iter().rev();
+                        let (track, cut) =
+                            ring_start::first_reached(ends, &transit_gaps, &warnings, |t| {
+                                go_to(&mut segments, &mut at, t, 0)
+                            })
+                            .unwrap_or_default();
                         let track = track[cut..].to_vec();
                         let n = track.len();
                         if n >= 2 {
@@ -582,56 +592,18 @@ fn plan_once(
                         }
                         continue;
                     }
-                    // Start the closed track where the transit from the vehicle is clear: a little ahead
-                    // of it (the first pass: mid the longest boundary edge).
+                    // Start the closed track a little ahead of the vehicle where a transit
+                    // reaches it; where none does, at another point of it (see `ring_start`).
                     let open = &ring[..n - 1];
-                    let target = match at {
-                        Some((q, h)) => q + crate::geo::heading_vec(h) * (2.5 * p.r_min),
-                        None => {
-                            let b = &field.boundary;
-                            let i = (0..b.len())
-                                .max_by(|&i, &j| {
-                                    let li = (b[(i + 1) % b.len()] - b[i]).norm();
-                                    let lj = (b[(j + 1) % b.len()] - b[j]).norm();
-                                    li.total_cmp(&lj)
-                                })
-                                .unwrap_or(0);
-                            0.5 * (b[i] + b[(i + 1) % b.len()])
-                        }
-                    };
-                    let nearest = (0..open.len())
-                        .min_by(|&i, &j| {
-                            (open[i] - target)
-                                .norm()
-                                .total_cmp(&(open[j] - target).norm())
-                        })
-                        .unwrap_or(0);
                     let m = open.len();
-                    let mut start = nearest;
-                    if let Some((q, h)) = at {
-                        // At most about 48 candidate starts around the track (each try is a whole curve).
-                        for k in (0..m).step_by((m / 48).max(1)) {
-                            let i = (nearest + k) % m;
-                            let hi = vec_heading(&(open[(i + 1) % m] - open[i]));
-                            if transit::clear_transit(
-                                q,
-                                h,
-                                open[i],
-                                hi,
-                                p.r_min,
-                                p.point_spacing,
-                                &clear,
-                            )
-                            .is_some()
-                            {
-                                start = i;
-                                break;
-                            }
-                        }
-                    }
-                    let mut track: Vec<Vec2> = (0..m).map(|k| open[(start + k) % m]).collect();
-                    track.push(open[start]);
-                    let cut = go_to(&mut segments, &mut at, &track, 0);
+                    let first = ring_start::first_start(open, at, &field.boundary, p, &clear);
+                    let starts = std::iter::once(first).chain(ring_start::other_starts(m, first));
+                    let (start, cut) =
+                        ring_start::first_reached(starts, &transit_gaps, &warnings, |&s| {
+                            go_to(&mut segments, &mut at, &ring_start::track_from(open, s), 0)
+                        })
+                        .unwrap_or((first, 0));
+                    let track = ring_start::track_from(open, start);
                     // A start pulled back (no way to it): the pass goes on past its start over the
                     // stretch cut, so the whole ring is still worked once.
                     let mut track = track[cut..].to_vec();
@@ -691,6 +663,7 @@ fn plan_once(
                             &mut go_to,
                             &detour,
                             &small_discs,
+                            (&transit_gaps, &warnings),
                         )?;
                         let undo = if transit_gaps.get() == gaps || attempt > 0 {
                             None

@@ -172,6 +172,7 @@ pub(super) fn drive_run(
     go_to: &mut GoTo<'_>,
     detour: &Detour<'_>,
     small_discs: &[(Vec2, f64)],
+    (gaps, warnings): (&std::cell::Cell<usize>, &std::cell::RefCell<Vec<String>>),
 ) -> Result<(), PlanError> {
     let order = run_order(run.len(), lines.spacing, p, orders);
     let here = at.map(|a| a.0);
@@ -376,19 +377,49 @@ pub(super) fn drive_run(
         .collect();
     // Drive: transit to the first swath, then the pieces in order.
     let mut first = true;
+    // Is the next transit past a blocked stretch (not the one onto the run)?
+    let mut past_blocked = false;
     for (kind, direction, mut pts) in pieces {
         if kind == SegmentKind::Transit && pts.is_empty() {
             // A stretch left unworked: the next piece is reached by a transit.
-            first = true;
+            (first, past_blocked) = (true, true);
             continue;
         }
         if pts.len() < 2 {
             continue;
         }
         if first {
-            let cut = go_to(segments, at, &pts, cell);
+            let (g, w) = (gaps.get(), warnings.borrow().len());
+            let mut cut = go_to(segments, at, &pts, cell);
+            // No way on past a blocked stretch from a stub of a swath before it: from the swath
+            // before the turn onto it, without the stub (see `stub`); kept where that finds none
+            // either.
+            let stub = (past_blocked && gaps.get() > g)
+                .then(|| super::stub::stub_at_end(segments, lead as f64 * p.point_spacing))
+                .flatten();
+            if let Some(from) = stub {
+                let kept = (
+                    segments.split_off(from),
+                    *at,
+                    warnings.borrow().clone(),
+                    gaps.get(),
+                );
+                let last = &segments[from - 1];
+                *at = end_pose(&last.points, last.direction);
+                gaps.set(g);
+                warnings.borrow_mut().truncate(w);
+                let c = go_to(segments, at, &pts, cell);
+                if gaps.get() > g {
+                    segments.truncate(from);
+                    segments.extend(kept.0);
+                    (*at, *warnings.borrow_mut()) = (kept.1, kept.2);
+                    gaps.set(kept.3);
+                } else {
+                    cut = c;
+                }
+            }
             pts.drain(..cut.min(pts.len().saturating_sub(2)));
-            first = false;
+            (first, past_blocked) = (false, false);
         }
         *at = end_pose(&pts, direction);
         let index = segments.len();
