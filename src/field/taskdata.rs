@@ -10,7 +10,7 @@
 //! 2 A+, 3 curve, 4 pivot, 5 spiral.
 
 use super::{check_coordinate, FieldError, Parsed, RawGuidance, RawPolygon};
-use crate::geo::wgs84::LatLon;
+use crate::geo::wgs84::{EnuFrame, LatLon};
 use roxmltree::{Document, Node};
 
 /// PLN type A: partfield boundary.
@@ -30,27 +30,33 @@ const CLOSED_RING_M: f64 = 0.1;
 /// Is `ring` closed (its last point back on its first, within [`CLOSED_RING_M`]) round at
 /// least three distinct points?
 fn closed_area(ring: &[LatLon]) -> bool {
-    let (Some(first), Some(last)) = (ring.first(), ring.last()) else {
+    let (Some(&first), Some(&last)) = (ring.first(), ring.last()) else {
         return false;
     };
-    // Metres per degree of latitude, and of longitude at this latitude (a spherical Earth is
-    // close enough for a 10 cm test).
-    let m_per_deg = 111_195.0;
-    let dy = (last.lat_deg - first.lat_deg) * m_per_deg;
-    let dx = (last.lon_deg - first.lon_deg) * m_per_deg * first.lat_deg.to_radians().cos();
-    let mut distinct: Vec<&LatLon> = Vec::new();
-    for q in ring {
-        if !distinct
-            .iter()
-            .any(|d| d.lat_deg == q.lat_deg && d.lon_deg == q.lon_deg)
-        {
-            distinct.push(q);
-        }
-        if distinct.len() >= 3 {
-            break;
-        }
+    let frame = EnuFrame::new(first);
+    let local: Vec<_> = ring.iter().map(|q| frame.to_enu(*q)).collect();
+    let apart = |q: &&crate::geo::Vec2| q.norm() > 1e-3;
+    let second = local.iter().find(apart);
+    let third = second.and_then(|b| local.iter().filter(apart).find(|q| (*q - b).norm() > 1e-3));
+    frame.to_enu(last).norm() <= CLOSED_RING_M && third.is_some()
+}
+
+/// An obstacle LSG (type 9) of `feature` as an area: its ring when closed ([`closed_area`]);
+/// `None` when it is a line, with a warning that begins with `who` (the LSG named).
+fn obstacle_area(
+    feature: &str,
+    who: &str,
+    lsg: &Node,
+    warnings: &mut Vec<String>,
+) -> Result<Option<Vec<LatLon>>, FieldError> {
+    let r = ring(feature, lsg)?;
+    if closed_area(&r) {
+        return Ok(Some(r));
     }
-    dx.hypot(dy) <= CLOSED_RING_M && distinct.len() >= 3
+    warnings.push(format!(
+        "{who} type 9 (obstacle) is a line, not a closed area: skipped (drive round it by hand)"
+    ));
+    Ok(None)
 }
 
 /// How a PLN or LSG is named in a warning: its id in the file (PLN E, LSG F) where it has one,
@@ -192,14 +198,8 @@ fn rings(
             }
             LSG_INTERIOR => holes.push(ring(feature, &lsg)?),
             LSG_OBSTACLE if obstacle && obstacle_ring.is_none() => {
-                let r = ring(feature, &lsg)?;
-                if closed_area(&r) {
-                    obstacle_ring = Some(r);
-                } else {
-                    warnings.push(format!(
-                        "{feature}: {name} of type 9 (obstacle) is a line, not a closed area: skipped (drive round it by hand)"
-                    ));
-                }
+                let who = format!("{feature}: {name} of");
+                obstacle_ring = obstacle_area(feature, &who, &lsg, warnings)?;
             }
             other => warnings.push(format!(
                 "{feature}: {name} of type {other} ({}) skipped",
@@ -261,19 +261,20 @@ pub fn list(text: &str, externals: &[(String, String)]) -> Result<Vec<PartfieldI
     for (file, doc) in &docs {
         for pfd in doc.descendants().filter(|n| n.has_tag_name("PFD")) {
             let plns: Vec<Node> = pfd.children().filter(|n| n.has_tag_name("PLN")).collect();
-            let with_exterior = |types: &[&str], also: Option<&str>| {
+            // PLNs of `types` with an exterior: an LSG of type 1, or (`obstacle`) a closed one of
+            // type 9, as `parse` reads them.
+            let with_exterior = |types: &[&str], obstacle: bool| {
+                let exterior = |l: &Node| {
+                    let t = l.attribute("A").map(str::trim);
+                    l.has_tag_name("LSG")
+                        && (t == Some(LSG_EXTERIOR)
+                            || (obstacle
+                                && t == Some(LSG_OBSTACLE)
+                                && ring("", l).is_ok_and(|r| closed_area(&r))))
+                };
                 plns.iter()
                     .filter(|p| types.contains(&p.attribute("A").unwrap_or("").trim()))
-                    .filter(|p| {
-                        p.children().any(|l| {
-                            let t = l.attribute("A").map(str::trim);
-                            l.has_tag_name("LSG")
-                                && (t == Some(LSG_EXTERIOR)
-                                    || (also.is_some() && t == also && {
-                                        ring("", &l).is_ok_and(|r| closed_area(&r))
-                                    }))
-                        })
-                    })
+                    .filter(|p| p.children().any(|l| exterior(&l)))
                     .count()
             };
             out.push(PartfieldInfo {
@@ -281,8 +282,8 @@ pub fn list(text: &str, externals: &[(String, String)]) -> Result<Vec<PartfieldI
                 designator: pfd.attribute("C").map(str::to_string),
                 stated_area_m2: pfd.attribute("D").and_then(|d| d.trim().parse().ok()),
                 file: file.clone(),
-                boundaries: with_exterior(&[PLN_BOUNDARY], None),
-                obstacles: with_exterior(&PLN_OBSTACLES, Some(LSG_OBSTACLE)),
+                boundaries: with_exterior(&[PLN_BOUNDARY], false),
+                obstacles: with_exterior(&PLN_OBSTACLES, true),
                 guidance_patterns: pfd.descendants().filter(|n| n.has_tag_name("GPN")).count()
                     + direct_guidance(&pfd).count(),
             });
@@ -482,46 +483,38 @@ pub(crate) fn parse(
             continue;
         }
         let mut feature = format!("{label} {}", element_name(&lsg, "LSG", "F", k));
-        if let Some(name) = lsg.attribute("B") {
-            feature.push_str(&format!(" \"{name}\""));
+        if let Some(b) = lsg.attribute("B") {
+            feature.push_str(&format!(" \"{b}\""));
         }
-        if t == LSG_OBSTACLE {
-            let exterior = ring(&feature, &lsg)?;
-            if closed_area(&exterior) {
-                out.obstacles.push(RawPolygon {
-                    label: feature,
-                    exterior,
-                    holes: Vec::new(),
-                });
-                continue;
-            }
+        if t != LSG_OBSTACLE {
             out.warnings.push(format!(
-                "{feature}: type 9 (obstacle) is a line, not a closed area: skipped (drive round it by hand)"
+                "{feature}: type {t} ({}) skipped",
+                lsg_type_name(t)
             ));
-            continue;
+        } else if let Some(exterior) =
+            obstacle_area(&feature, &format!("{feature}:"), &lsg, &mut out.warnings)?
+        {
+            out.obstacles.push(RawPolygon {
+                label: feature,
+                exterior,
+                holes: Vec::new(),
+            });
         }
-        out.warnings.push(format!(
-            "{feature}: type {t} ({}) skipped",
-            lsg_type_name(t)
-        ));
     }
-    // Each such interior is a hole of the boundary whose exterior holds it.
+    // Each such interior is a hole of the boundary whose exterior holds it (tested on the plane
+    // tangent at that boundary's centre, as the field is planned: across the antimeridian too).
     for (pln_name, hole) in loose_holes {
-        let plane = |ring: &[LatLon]| -> Vec<crate::geo::Vec2> {
-            ring.iter()
-                .map(|q| crate::geo::v2(q.lon_deg, q.lat_deg))
-                .collect()
-        };
-        let inner = plane(&hole);
         let owner = out
             .boundaries
             .iter_mut()
             .zip(&boundary_names)
             .find(|(b, _)| {
-                let outer = plane(&b.exterior);
-                inner
-                    .iter()
-                    .all(|q| crate::geo::polygon::contains_point(&outer, q))
+                let Some(frame) = crate::geo::wgs84::centre(&b.exterior).map(EnuFrame::new) else {
+                    return false;
+                };
+                let outer: Vec<_> = b.exterior.iter().map(|q| frame.to_enu(*q)).collect();
+                hole.iter()
+                    .all(|q| crate::geo::polygon::contains_point(&outer, &frame.to_enu(*q)))
             });
         match owner {
             Some((boundary, owner_name)) => {

@@ -80,12 +80,11 @@ pub struct NoSwathFits {
     /// Headland passes the turns need at this width ([`passes`]) and their width, m.
     pub passes: usize,
     pub headland_width: f64,
-    /// The largest implement width (0.5 m steps) at which a swath may fit inside the fewest
-    /// headland passes the turns need (`None` below 0.5 m): no wider one, below this one,
-    /// leaves room for a swath.
+    /// The largest implement width (0.5 m steps, below this one) at which the planner plans
+    /// swaths (`None`: none of 0.5 m or more), when searched (`planned`).
     pub largest_width: Option<f64>,
-    /// `largest_width` was planned and has swaths ([`super::narrow::largest_planned_width`]);
-    /// else it is only the width above which none fits.
+    /// `largest_width` was searched by planning ([`super::narrow::no_swath_reason`]); the strip
+    /// test alone does not bound it (the ground the passes leave can hold swaths).
     pub planned: bool,
 }
 
@@ -104,33 +103,17 @@ impl std::fmt::Display for NoSwathFits {
         };
         match (self.largest_width, self.planned) {
             (Some(w), true) => write!(f, "no swath fits: {why}; the largest implement width that plans swaths here is {w:.1} m"),
-            (Some(w), false) => write!(f, "no swath fits: {why}; no implement width above {w:.1} m leaves room for swaths here"),
-            (None, _) => write!(f, "no swath fits: {why}; no implement width of 0.5 m or more leaves room for swaths here"),
+            (None, true) => write!(f, "no swath fits: {why}; no implement width of 0.5 m or more leaves room for swaths here"),
+            (_, false) => write!(f, "no swath fits: {why}"),
         }
     }
 }
 
-/// `Some` when the field is too narrow for any swath inside the headland at these parameters.
-/// The largest width is searched with the fewest headland passes the turns need, as the
-/// planner tries them when the configured ones leave no room ([`super::narrow`]).
+/// `Some` when the field is too narrow for any swath inside the headland at these parameters
+/// (the largest width that plans swaths not yet searched: [`super::narrow::no_swath_reason`]).
 pub fn no_swath_fits(field_width: f64, p: &CoverageParams) -> Option<NoSwathFits> {
-    let room = |q: &CoverageParams| field_width > 2.0 * passes(q) as f64 * q.pass_spacing() + 1e-6;
-    if room(p) {
+    if field_width > 2.0 * passes(p) as f64 * p.pass_spacing() + 1e-6 {
         return None;
-    }
-    let mut q = CoverageParams {
-        headland_passes: 0,
-        ..p.clone()
-    };
-    let mut largest = None;
-    let mut w = (p.line_width * 2.0).floor() / 2.0;
-    while w >= 0.5 && w > 2.0 * p.overlap {
-        q.line_width = w;
-        if room(&q) && w <= field_width {
-            largest = Some(w);
-            break;
-        }
-        w -= 0.5;
     }
     Some(NoSwathFits {
         field_width,
@@ -138,7 +121,7 @@ pub fn no_swath_fits(field_width: f64, p: &CoverageParams) -> Option<NoSwathFits
         turn_diameter: 2.0 * p.r_min,
         passes: passes(p),
         headland_width: passes(p) as f64 * p.pass_spacing(),
-        largest_width: largest,
+        largest_width: None,
         planned: false,
     })
 }

@@ -69,9 +69,6 @@ pub fn plan_field(
     Ok(plan)
 }
 
-/// The parts of a field that a tractor cannot drive between inside the boundary (joined only
-/// by necks narrower than twice [`super::TRANSIT_CLEARANCE_M`]), when there are several: the
-/// field with its holes shrunk by that clearance, as areas, largest first.
 /// Why no swath fits `field` at `p` ([`headland::no_swath_fits`] at its widest strip), with
 /// the largest width that plans swaths found by planning, 0.5 m narrower each time from `p`'s
 /// ([`largest_planned_width`]: the strip test alone is no bound, as ground the passes leave
@@ -81,13 +78,8 @@ pub fn no_swath_reason(field: &Field, p: &CoverageParams) -> Option<headland::No
     let area = (field.boundary.clone(), field.obstacles.clone());
     let mut why = headland::no_swath_fits(super::geometry::inscribed_width(&area), p)?;
     let tries = (2.0 * p.line_width).ceil() as usize;
-    match largest_planned_width(field, p, p.line_width - 0.5, tries) {
-        Some(planned) => {
-            why.largest_width = Some(planned);
-            why.planned = true;
-        }
-        None => why.largest_width = None,
-    }
+    why.largest_width = largest_planned_width(field, p, p.line_width - 0.5, tries);
+    why.planned = true;
     Some(why)
 }
 
@@ -116,6 +108,9 @@ pub fn largest_planned_width(
     None
 }
 
+/// The parts of a field that a tractor cannot drive between inside the boundary (joined only
+/// by necks narrower than twice [`super::TRANSIT_CLEARANCE_M`]), when there are several: the
+/// field with its holes shrunk by that clearance, as areas, largest first.
 pub fn parts(field: &Field) -> Vec<super::geometry::Area> {
     let whole = (field.boundary.clone(), field.obstacles.clone());
     let mut parts = super::geometry::offset(&[whole], -super::TRANSIT_CLEARANCE_M);
