@@ -252,6 +252,11 @@ fn plan_once(
     // Returns how many points were cut from the start of `target`.
     // Has a relaxed headland attempt found no way (see `loose_headland` below)?
     let loose_failed = &mut false;
+    // The curves on and off the rings of the headland attempts (strict, relaxed), kept from
+    // one transit to the next asked from the same pose (the starts of a ring tried in turn,
+    // see `ring_start`; each transit's answer is the one it finds with new ones, see
+    // `rings::Ends`), dropped when the vehicle has moved on.
+    let mut kept_ends: Option<((Vec2, f64), [rings::Ends; 2])> = None;
     let mut go_to = |segments: &mut Vec<PlanSegment>,
                      at: &mut Option<(Vec2, f64)>,
                      target: &[Vec2],
@@ -303,11 +308,19 @@ fn plan_once(
         // every plan, it cost the plans whose strict attempts succeed as much as it saved the
         // narrow fields whose attempts all fail.)
         let mut loose_headland: Option<Option<Vec<Vec2>>> = None;
-        // The curves on and off the rings of the headland attempts (strict, relaxed).
-        let mut ends = [
-            rings::Ends::with_margin(tests.margins.0),
-            rings::Ends::with_margin(tests.margins.1),
-        ];
+        if kept_ends.as_ref().is_some_and(|k| k.0 != (from, h0)) {
+            kept_ends = None;
+        }
+        let ends = &mut kept_ends
+            .get_or_insert_with(|| {
+                let margins = &tests.margins;
+                let ends = [
+                    rings::Ends::with_margin(margins.0),
+                    rings::Ends::with_margin(margins.1),
+                ];
+                ((from, h0), ends)
+            })
+            .1;
         for (t, way, relaxed) in attempts {
             let (cp, cn, f, hf, q, hq) = poses(t);
             if t > 0 && cp == 0 && cn == 0 {

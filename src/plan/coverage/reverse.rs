@@ -6,7 +6,7 @@
 use crate::geo::{Direction, Pose, Vec2};
 use crate::plan::maneuver::cc_reeds_shepp::cc_reeds_shepp_shortest;
 use crate::plan::maneuver::path::CurveParams;
-use crate::plan::maneuver::{drive::split_at_cusps, reeds_shepp::reeds_shepp_paths};
+use crate::plan::maneuver::{drive::split_at_cusps_while, reeds_shepp::reeds_shepp_paths};
 
 /// Words longer than the shortest by more than this many full circles of radius r_min are not
 /// tried: no farmer backs out that way, and sampling every word of a gap that stays cost more
@@ -72,13 +72,16 @@ pub fn transit(
                 && crate::geo::polygon::polyline_length(&part.points) < lead_in
         })
     };
+    // Each path's points checked as they are sampled: a path blocked anywhere is not sampled
+    // past its first blocked point.
     paths
         .iter()
         .take_while(|path| path.1.length() <= longest)
-        .map(|(plain, path)| (*plain, split_at_cusps(path, spacing)))
-        .filter(|(plain, parts)| !(*plain && short_lead_in(parts)))
+        .filter_map(|(plain, path)| {
+            Some((*plain, split_at_cusps_while(path, spacing, &mut |q| ok(q))?))
+        })
+        .find(|(plain, parts)| !(*plain && short_lead_in(parts)))
         .map(|(_, parts)| parts)
-        .find(|parts| parts.iter().all(|part| part.points.iter().all(ok)))
         .map(|parts| {
             parts
                 .into_iter()

@@ -31,6 +31,9 @@ struct Ring {
     /// Per run of [`CHUNK`] points (the last may be shorter): a disc holding them (centre,
     /// radius), to pass over the runs far from a point ([`Ring::near`]).
     chunks: Vec<(Vec2, f64)>,
+    /// A disc holding every point (centre, radius): no point is nearer a position than its
+    /// distance less the radius.
+    disc: (Vec2, f64),
 }
 
 /// Points of a ring per disc of [`Ring::chunks`].
@@ -67,12 +70,20 @@ impl Ring {
                 (c, run.iter().map(|p| (p - c).norm()).fold(0.0, f64::max))
             })
             .collect();
+        let centre = pts.iter().fold(Vec2::new(0.0, 0.0), |a, p| a + p) / n as f64;
+        let radius = pts.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
         Some(Ring {
             pts,
             cum,
             blocked,
             chunks,
+            disc: (centre, radius),
         })
+    }
+
+    /// No point of the ring is nearer `q` than this, m (a micrometre allowed for rounding).
+    fn least_distance(&self, q: &Vec2) -> f64 {
+        ((self.disc.0 - q).norm() - self.disc.1 - 1e-6).max(0.0)
     }
 
     fn len(&self) -> usize {
@@ -205,17 +216,6 @@ impl Rings {
     ) -> Option<Vec<Vec2>> {
         let reach = 4.0 * r;
         let mut best: Option<(f64, Vec<Vec2>)> = None;
-        // The candidates of the rings with both (the others are passed over).
-        let near: Vec<(usize, &Ring, Vec<usize>, Vec<usize>)> = self
-            .rings
-            .iter()
-            .enumerate()
-            .map(|(ri, ring)| (ri, ring, ring.near(&p1, reach), ring.near(&p2, reach)))
-            .filter(|c| !c.2.is_empty() && !c.3.is_empty())
-            .collect();
-        if near.is_empty() {
-            return None;
-        }
         // Every curve from the start pose at least `trap.0` m long is blocked, and every one
         // to the goal pose at least `trap.1` long (see [`trap_length`]): none onto a ring is
         // clear when every entry is that far, nor any off one when every exit is, and no join
@@ -224,34 +224,42 @@ impl Rings {
             ends.trap_length((p1, h1, true), r, step),
             ends.trap_length((p2, h2, false), r, step),
         );
-        let closest = |q: &Vec2, entry: bool| {
-            near.iter()
-                .flat_map(|(_, ring, on, off)| {
-                    let pts = if entry { on } else { off };
-                    pts.iter().map(|&i| (ring.pts[i] - q).norm())
-                })
-                .fold(f64::INFINITY, f64::min)
-        };
-        if closest(&p1, true) >= trap.0 || closest(&p2, false) >= trap.1 {
-            return None;
-        }
         // Every way through a ring is at least as long as the straight distances to its
-        // nearest entry and from its nearest exit: the rings are tried by that bound, so the
-        // best way is found early and the rings that cannot beat it are passed over.
+        // nearest entry and from its nearest exit, and those at least the distances to the
+        // ring's disc: the rings are taken by that least bound, each one's candidates found
+        // only when it is taken, so the best way is found early and the rings that cannot
+        // beat it (nor reach a trap's length) are passed over without looking at their points.
         let nearest = |ring: &Ring, q: &Vec2, pts: &[usize]| {
             pts.iter()
                 .map(|&i| (ring.pts[i] - q).norm())
                 .fold(f64::INFINITY, f64::min)
         };
-        let mut near: Vec<_> = near
-            .into_iter()
-            .map(|(ri, ring, entries, exits)| {
-                let (onto, off) = (nearest(ring, &p1, &entries), nearest(ring, &p2, &exits));
-                (onto + off, (ri, ring, entries, exits, onto, off))
+        let mut order: Vec<(f64, f64, f64, usize)> = self
+            .rings
+            .iter()
+            .enumerate()
+            .map(|(ri, ring)| {
+                let (a, b) = (ring.least_distance(&p1), ring.least_distance(&p2));
+                (a + b, a, b, ri)
             })
+            .filter(|&(_, a, b, _)| a < trap.0 && b < trap.1)
             .collect();
-        near.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for (_, (ri, ring, entries, exits, onto, off)) in near {
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.3.cmp(&b.3)));
+        for (least, _, _, ri) in order {
+            if best.as_ref().is_some_and(|b| b.0 <= least - 1e-6) {
+                break;
+            }
+            let ring = &self.rings[ri];
+            // The candidates of a ring with both (the others are passed over).
+            let entries = ring.near(&p1, reach);
+            if entries.is_empty() {
+                continue;
+            }
+            let exits = ring.near(&p2, reach);
+            if exits.is_empty() {
+                continue;
+            }
+            let (onto, off) = (nearest(ring, &p1, &entries), nearest(ring, &p2, &exits));
             // None beats the best so far when the bound does not (a micrometre of margin for
             // the rounding of the curves' lengths).
             // No curve onto this ring is clear when every entry is as far as the start's trap

@@ -18,6 +18,16 @@ pub struct DrivenPart {
 /// The parts of `path` between its cusps (segments of zero length are skipped), each sampled
 /// every `spacing_m` metres.
 pub fn split_at_cusps(path: &CurvePath, spacing_m: f64) -> Vec<DrivenPart> {
+    split_at_cusps_while(path, spacing_m, &mut |_| true).unwrap_or_default()
+}
+
+/// [`split_at_cusps`] when every point passes `keep`, else `None`, found at the first point
+/// refused without sampling the rest of the path.
+pub fn split_at_cusps_while(
+    path: &CurvePath,
+    spacing_m: f64,
+    keep: &mut dyn FnMut(&Vec2) -> bool,
+) -> Option<Vec<DrivenPart>> {
     let mut parts = Vec::new();
     let mut samples: Vec<PathSample> = Vec::new();
     let mut pose = path.start;
@@ -37,7 +47,9 @@ pub fn split_at_cusps(path: &CurvePath, spacing_m: f64) -> Vec<DrivenPart> {
             start: pose,
             segments: segs[i..j].to_vec(),
         };
-        part.sample(spacing_m, &mut samples);
+        if !part.sample_while(spacing_m, &mut samples, keep) {
+            return None;
+        }
         let end = part.end_pose();
         parts.push(DrivenPart {
             direction,
@@ -47,5 +59,5 @@ pub fn split_at_cusps(path: &CurvePath, spacing_m: f64) -> Vec<DrivenPart> {
         pose = end;
         i = j;
     }
-    parts
+    Some(parts)
 }

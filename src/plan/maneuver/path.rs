@@ -304,6 +304,18 @@ impl CurvePath {
     /// segment that ends there; a cusp shows as a direction change between consecutive
     /// samples). Spacing restarts at each segment boundary.
     pub fn sample(&self, spacing_m: f64, out: &mut Vec<PathSample>) {
+        self.sample_while(spacing_m, out, &mut |_| true);
+    }
+
+    /// [`CurvePath::sample`], stopping at the first sample whose position `keep` refuses
+    /// (false then; `out` holds the samples up to that one): the samples `sample` makes, in
+    /// its order, so a path refused anywhere is refused without sampling the rest of it.
+    pub fn sample_while(
+        &self,
+        spacing_m: f64,
+        out: &mut Vec<PathSample>,
+        keep: &mut dyn FnMut(&crate::geo::Vec2) -> bool,
+    ) -> bool {
         out.clear();
         let spacing = spacing_m.max(1e-3);
         let first_dir = self
@@ -318,6 +330,9 @@ impl CurvePath {
             direction: first_dir,
             segment: 0,
         });
+        if !keep(&self.start.pos) {
+            return false;
+        }
         let mut pose = self.start;
         let mut s0 = 0.0;
         for (i, seg) in self.segments.iter().enumerate() {
@@ -326,18 +341,23 @@ impl CurvePath {
                 let step = seg.length / n as f64;
                 for k in 1..=n {
                     let s = if k == n { seg.length } else { step * k as f64 };
+                    let at = seg.pose_at(&pose, s);
                     out.push(PathSample {
-                        pose: seg.pose_at(&pose, s),
+                        pose: at,
                         s: s0 + s,
                         kappa: seg.kappa_at(s),
                         direction: seg.direction,
                         segment: i,
                     });
+                    if !keep(&at.pos) {
+                        return false;
+                    }
                 }
             }
             pose = seg.end_pose(&pose);
             s0 += seg.length;
         }
+        true
     }
 
     /// Concatenation: `other` is driven after `self` (its start should be `self`'s end; the
