@@ -156,6 +156,81 @@ pub fn scan_intervals(area: &Area, y: f64) -> Vec<(f64, f64)> {
     xs.chunks_exact(2).map(|c| (c[0], c[1])).collect()
 }
 
+/// An area's edges sorted into bands of y, for many [`scan_intervals`] of one area (the lines
+/// of a cell): a line looks only at the edges of its band, with the same answer.
+pub struct Scanner {
+    /// Per band of `height` m from `bottom` up: the edges (in ring order, as
+    /// [`scan_intervals`] takes them) whose y-extent meets it.
+    bands: Vec<Vec<(Vec2, Vec2)>>,
+    bottom: f64,
+    height: f64,
+}
+
+/// Most bands of a [`Scanner`].
+const SCAN_BANDS: usize = 256;
+
+impl Scanner {
+    pub fn new(area: &Area) -> Self {
+        let edges: Vec<(Vec2, Vec2)> = std::iter::once(&area.0)
+            .chain(area.1.iter())
+            .flat_map(|ring| (0..ring.len()).map(move |i| (ring[i], ring[(i + 1) % ring.len()])))
+            .collect();
+        let (bottom, top) = edges
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), e| {
+                (l.min(e.0.y), h.max(e.0.y))
+            });
+        let count = edges.len().clamp(1, SCAN_BANDS);
+        let height = if top > bottom {
+            (top - bottom) / count as f64
+        } else {
+            1.0
+        };
+        let mut scanner = Scanner {
+            bands: vec![Vec::new(); count],
+            bottom,
+            height,
+        };
+        for e in edges {
+            let (lo, hi) = (
+                scanner.band(e.0.y.min(e.1.y)),
+                scanner.band(e.0.y.max(e.1.y)),
+            );
+            for band in &mut scanner.bands[lo..=hi] {
+                band.push(e);
+            }
+        }
+        scanner
+    }
+
+    /// The band holding `y` (the nearest end band beyond them). Monotone in `y` (each
+    /// operation is correctly rounded), so an edge from y₀ to y₁ lies in every band of the
+    /// y between them.
+    fn band(&self, y: f64) -> usize {
+        let k = ((y - self.bottom) / self.height).floor();
+        if k >= 0.0 {
+            (k as usize).min(self.bands.len() - 1)
+        } else {
+            0
+        }
+    }
+
+    /// [`scan_intervals`] of the area at `y`.
+    pub fn intervals(&self, y: f64) -> Vec<(f64, f64)> {
+        if !(y >= self.bottom) {
+            // Below every vertex (or NaN): no edge crosses.
+            return Vec::new();
+        }
+        let mut xs: Vec<f64> = self.bands[self.band(y)]
+            .iter()
+            .filter(|(a, b)| (a.y <= y) != (b.y <= y))
+            .map(|(a, b)| a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y))
+            .collect();
+        xs.sort_by(|a, b| a.total_cmp(b));
+        xs.chunks_exact(2).map(|c| (c[0], c[1])).collect()
+    }
+}
+
 /// Is `q` inside `area`: in its outer ring and in none of its holes?
 pub fn in_area((outer, holes): &Area, q: &Vec2) -> bool {
     use crate::geo::polygon::contains_point;

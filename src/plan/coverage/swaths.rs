@@ -2,7 +2,7 @@
 //! balanced so their w-wide footprints cover the whole cell, then grouped into runs that a
 //! boustrophedon can sweep (a large obstacle splits the lines, and both sides are covered).
 
-use super::geometry::{rotate_area, scan_intervals, Area};
+use super::geometry::{rotate_area, Area, Scanner};
 use crate::geo::Vec2;
 
 /// The swath lines of one cell, in the rotated frame (swaths along +x).
@@ -73,11 +73,13 @@ pub fn swath_lines(
     let span = (hi - lo).max(0.0);
     let n = (span / line_width - 1e-9).ceil().max(1.0) as usize;
     let overlap_m = (n as f64 * line_width - span).max(0.0);
+    let scan = (&rot, Scanner::new(&rot));
+    let safe_scans: Vec<Scanner> = safe_rot.iter().map(Scanner::new).collect();
     let lines_from = |base: f64, spacing: f64| {
         let ys: Vec<f64> = (0..n).map(|k| base + spacing * (k as f64 + 0.5)).collect();
         let intervals = ys
             .iter()
-            .map(|&y| line_intervals(&rot, &safe_rot, y, spacing, (lo, hi), widening))
+            .map(|&y| line_intervals(&scan, &safe_scans, y, spacing, (lo, hi), widening))
             .collect();
         SwathLines {
             angle,
@@ -108,11 +110,12 @@ pub fn swath_lines(
 }
 
 /// The x-intervals of the line at `y`, `spacing` from its neighbours, across the rotated cell
-/// `rot` spanning `lo_hi` in y (see [`swath_lines`]): the cell is scanned at the middle of the
-/// part of the line's band it holds (an exact outer line's band runs on beyond the cell).
+/// `rot` (with its scanner) spanning `lo_hi` in y (see [`swath_lines`]), cut back to the
+/// areas of `safe_scans`: the cell is scanned at the middle of the part of the line's band it
+/// holds (an exact outer line's band runs on beyond the cell).
 fn line_intervals(
-    rot: &Area,
-    safe_rot: &[Area],
+    rot: &(&Area, Scanner),
+    safe_scans: &[Scanner],
     y: f64,
     spacing: f64,
     (lo, hi): (f64, f64),
@@ -126,7 +129,12 @@ fn line_intervals(
         (0.5 * (b0 + b1), 0.5 * (b1 - b0).max(0.0))
     };
     let band = band_extent(rot, at, widening * half);
-    let ivs = scan_intervals(rot, at)
+    let ivs = rot.1.intervals(at);
+    if ivs.is_empty() {
+        return ivs;
+    }
+    let safe: Vec<(f64, f64)> = safe_scans.iter().flat_map(|s| s.intervals(y)).collect();
+    let ivs = ivs
         .into_iter()
         .filter_map(|(a, b)| {
             // Widen to the band's extent over this piece, then keep inside `safe`.
@@ -138,10 +146,7 @@ fn line_intervals(
                 }
             }
             let mid = 0.5 * (a + b);
-            let s = safe_rot
-                .iter()
-                .flat_map(|s| scan_intervals(s, y))
-                .find(|&(c, d)| c <= mid && mid <= d)?;
+            let s = *safe.iter().find(|&&(c, d)| c <= mid && mid <= d)?;
             let (x0, x1) = (x0.max(s.0), x1.min(s.1));
             (x1 - x0 > 1e-3).then_some((x0, x1))
         })
@@ -167,12 +172,12 @@ pub(super) fn merge_overlapping(mut ivs: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
 
 /// The x-extent of `rot` within the band [y − half, y + half]: intervals at both band edges and
 /// at every vertex inside the band, merged where they overlap.
-fn band_extent(rot: &Area, y: f64, half: f64) -> Vec<(f64, f64)> {
+fn band_extent((rot, scan): &(&Area, Scanner), y: f64, half: f64) -> Vec<(f64, f64)> {
     let mut ys = vec![y - half + 1e-6, y, y + half - 1e-6];
     for ring in std::iter::once(&rot.0).chain(rot.1.iter()) {
         ys.extend(ring.iter().map(|p| p.y).filter(|v| (v - y).abs() < half));
     }
-    merge_overlapping(ys.iter().flat_map(|&v| scan_intervals(rot, v)).collect())
+    merge_overlapping(ys.iter().flat_map(|&v| scan.intervals(v)).collect())
 }
 
 /// One swath of a run: line index and x-interval, rotated frame.
