@@ -279,6 +279,51 @@ pub fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
 mod tests {
     use super::*;
 
+    /// [`Scanner::intervals`] gives [`scan_intervals`]'s answer, to the bit: on random star
+    /// polygons with holes (some edges long, some flat), at random heights, at every vertex's
+    /// height (the half-open rule), and below and above the area.
+    #[test]
+    fn the_scanner_scans_as_every_edge_does() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for case in 0..200 {
+            let star = |rng: &mut rand_chacha::ChaCha8Rng, c: Vec2, r: f64, n: usize| {
+                (0..n)
+                    .map(|k| {
+                        let a = std::f64::consts::TAU * k as f64 / n as f64;
+                        let rr = r * rng.gen_range(0.3..1.0);
+                        // Some vertices share a height (flat edges).
+                        let y = if k % 7 == 3 { c.y } else { c.y + rr * a.sin() };
+                        v2(c.x + rr * a.cos(), y)
+                    })
+                    .collect::<Vec<Vec2>>()
+            };
+            let n = rng.gen_range(3..(if case % 10 == 0 { 600 } else { 40 }));
+            let outer = star(&mut rng, v2(0.0, 0.0), 100.0, n);
+            let holes: Vec<Vec<Vec2>> = (0..rng.gen_range(0..3))
+                .map(|_| {
+                    let c = v2(rng.gen_range(-20.0..20.0), rng.gen_range(-20.0..20.0));
+                    let k = rng.gen_range(3..12);
+                    star(&mut rng, c, 8.0, k)
+                })
+                .collect();
+            let area: Area = (outer, holes);
+            let scanner = Scanner::new(&area);
+            let mut ys: Vec<f64> = (0..50).map(|_| rng.gen_range(-120.0..120.0)).collect();
+            ys.extend(area.0.iter().chain(area.1.iter().flatten()).map(|q| q.y));
+            ys.extend([-1e9, 1e9, f64::NAN]);
+            for y in ys {
+                let (a, b) = (scanner.intervals(y), scan_intervals(&area, y));
+                let bits = |v: &[(f64, f64)]| -> Vec<(u64, u64)> {
+                    v.iter()
+                        .map(|(x0, x1)| (x0.to_bits(), x1.to_bits()))
+                        .collect()
+                };
+                assert_eq!(bits(&a), bits(&b), "case {case}, y {y}");
+            }
+        }
+    }
+
     #[test]
     fn offset_square_and_scan() {
         let sq: Area = (

@@ -61,3 +61,44 @@ pub fn split_at_cusps_while(
     }
     Some(parts)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geo::v2;
+    use crate::plan::maneuver::reeds_shepp::reeds_shepp_paths;
+
+    /// With every point kept, [`split_at_cusps_while`] gives [`split_at_cusps`]'s parts; with
+    /// one point refused it gives none, having asked no point after that one.
+    #[test]
+    fn a_path_refused_at_a_point_is_not_sampled_past_it() {
+        let start = Pose {
+            pos: v2(0.0, 0.0),
+            heading: 0.0,
+        };
+        let goal = Pose {
+            pos: v2(2.0, 6.0),
+            heading: std::f64::consts::PI,
+        };
+        let paths = reeds_shepp_paths(&start, &goal, 5.0);
+        assert!(!paths.is_empty());
+        for path in &paths {
+            let all = split_at_cusps(path, 0.5);
+            let kept = split_at_cusps_while(path, 0.5, &mut |_| true);
+            assert_eq!(kept.as_ref(), Some(&all));
+            let points: Vec<Vec2> = all.iter().flat_map(|p| p.points.clone()).collect();
+            let refused = points[points.len() / 2];
+            let mut asked = 0;
+            let none = split_at_cusps_while(path, 0.5, &mut |q| {
+                asked += 1;
+                (q - refused).norm() > 1e-12
+            });
+            assert!(none.is_none());
+            let first = points
+                .iter()
+                .position(|q| (q - refused).norm() <= 1e-12)
+                .unwrap_or(points.len());
+            assert_eq!(asked, first + 1, "{} points", points.len());
+        }
+    }
+}
