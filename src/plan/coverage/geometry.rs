@@ -217,7 +217,7 @@ impl Scanner {
 
     /// [`scan_intervals`] of the area at `y`.
     pub fn intervals(&self, y: f64) -> Vec<(f64, f64)> {
-        if !(y >= self.bottom) {
+        if y.is_nan() || y < self.bottom {
             // Below every vertex (or NaN): no edge crosses.
             return Vec::new();
         }
