@@ -164,6 +164,23 @@ fn taskdata_fields_are_listed_and_chosen_by_id_or_name() {
     let run = agsteer(&["plan", "--field", &file, "--field-id", "PFD99"]);
     assert_eq!(run.code, 1);
     assert!(run.stderr.contains("no field \"PFD99\""), "{}", run.stderr);
+    // A task file without a partfield: --list says so and fails, as planning it does.
+    let dir = tempfile::tempdir().unwrap();
+    let none = dir.path().join("TASKDATA.XML");
+    std::fs::write(
+        &none,
+        r#"<ISO11783_TaskData VersionMajor="4"><CTR A="CTR1"/></ISO11783_TaskData>"#,
+    )
+    .unwrap();
+    let none = none.to_string_lossy().to_string();
+    let run = agsteer(&["plan", "--field", &none, "--list"]);
+    assert_eq!(run.code, 1, "{}", run.stdout);
+    assert!(
+        run.stderr.contains("no partfield (PFD) in the file"),
+        "{}",
+        run.stderr
+    );
+    assert!(run.stdout.is_empty(), "{}", run.stdout);
 }
 
 #[test]

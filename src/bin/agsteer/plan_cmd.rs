@@ -91,6 +91,12 @@ fn list(path: &Path) -> Result<u8> {
     let text = read_text(path)?;
     let externals = read_externals(path, &text)?;
     let fields = list_fields(&text, &externals).with_context(|| format!("{}", path.display()))?;
+    if fields.is_empty() {
+        anyhow::bail!(
+            "{}: no partfield (PFD) in the file: no field to list or plan",
+            path.display()
+        );
+    }
     println!(
         "{:<12} {:<36} {:>10} {:>10} {:>9} {:>8}  file",
         "id", "name", "stated ha", "boundaries", "obstacles", "guidance"
