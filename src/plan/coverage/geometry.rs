@@ -141,17 +141,23 @@ pub fn rotate_area(area: &Area, angle: f64) -> Area {
 /// The x-intervals where the horizontal line at `y` is inside `area` (even-odd over the outer
 /// ring and the holes), sorted.
 pub fn scan_intervals(area: &Area, y: f64) -> Vec<(f64, f64)> {
-    let mut xs: Vec<f64> = Vec::new();
-    for ring in std::iter::once(&area.0).chain(area.1.iter()) {
-        let n = ring.len();
-        for i in 0..n {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
-            // Half-open rule so a vertex on the line counts once.
-            if (a.y <= y) != (b.y <= y) {
-                xs.push(a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y));
-            }
-        }
-    }
+    crossings(edges(area), y)
+}
+
+/// The edges of an area's rings, each from a vertex to the next, in ring order.
+fn edges(area: &Area) -> impl Iterator<Item = (Vec2, Vec2)> + '_ {
+    std::iter::once(&area.0)
+        .chain(area.1.iter())
+        .flat_map(|ring| (0..ring.len()).map(move |i| (ring[i], ring[(i + 1) % ring.len()])))
+}
+
+/// The x-intervals between the crossings of `edges` with the line at `y`, sorted.
+fn crossings(edges: impl Iterator<Item = (Vec2, Vec2)>, y: f64) -> Vec<(f64, f64)> {
+    // Half-open rule so a vertex on the line counts once.
+    let mut xs: Vec<f64> = edges
+        .filter(|(a, b)| (a.y <= y) != (b.y <= y))
+        .map(|(a, b)| a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y))
+        .collect();
     xs.sort_by(|a, b| a.total_cmp(b));
     xs.chunks_exact(2).map(|c| (c[0], c[1])).collect()
 }
@@ -164,6 +170,8 @@ pub struct Scanner {
     bands: Vec<Vec<(Vec2, Vec2)>>,
     bottom: f64,
     height: f64,
+    /// Every vertex's y, sorted.
+    heights: Vec<f64>,
 }
 
 /// Most bands of a [`Scanner`].
@@ -171,16 +179,13 @@ const SCAN_BANDS: usize = 256;
 
 impl Scanner {
     pub fn new(area: &Area) -> Self {
-        let edges: Vec<(Vec2, Vec2)> = std::iter::once(&area.0)
-            .chain(area.1.iter())
-            .flat_map(|ring| (0..ring.len()).map(move |i| (ring[i], ring[(i + 1) % ring.len()])))
-            .collect();
-        let (bottom, top) = edges
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), e| {
-                (l.min(e.0.y), h.max(e.0.y))
-            });
-        let count = edges.len().clamp(1, SCAN_BANDS);
+        let mut heights: Vec<f64> = edges(area).map(|e| e.0.y).collect();
+        heights.sort_by(f64::total_cmp);
+        let (bottom, top) = match (heights.first(), heights.last()) {
+            (Some(&b), Some(&t)) => (b, t),
+            _ => (0.0, 0.0),
+        };
+        let count = heights.len().clamp(1, SCAN_BANDS);
         let height = if top > bottom {
             (top - bottom) / count as f64
         } else {
@@ -190,8 +195,9 @@ impl Scanner {
             bands: vec![Vec::new(); count],
             bottom,
             height,
+            heights,
         };
-        for e in edges {
+        for e in edges(area) {
             let (lo, hi) = (
                 scanner.band(e.0.y.min(e.1.y)),
                 scanner.band(e.0.y.max(e.1.y)),
@@ -205,7 +211,7 @@ impl Scanner {
 
     /// The band holding `y` (the nearest end band beyond them). Monotone in `y` (each
     /// operation is correctly rounded), so an edge from y₀ to y₁ lies in every band of the
-    /// y between them.
+    /// y between them; a line below every vertex (or at NaN) crosses no edge of band 0.
     fn band(&self, y: f64) -> usize {
         let k = ((y - self.bottom) / self.height).floor();
         if k >= 0.0 {
@@ -217,17 +223,18 @@ impl Scanner {
 
     /// [`scan_intervals`] of the area at `y`.
     pub fn intervals(&self, y: f64) -> Vec<(f64, f64)> {
-        if y.is_nan() || y < self.bottom {
-            // Below every vertex (or NaN): no edge crosses.
-            return Vec::new();
-        }
-        let mut xs: Vec<f64> = self.bands[self.band(y)]
+        crossings(self.bands[self.band(y)].iter().copied(), y)
+    }
+
+    /// The vertices' heights `v` with |v − y| < `half`, ascending.
+    pub fn heights_within(&self, y: f64, half: f64) -> impl Iterator<Item = f64> + '_ {
+        // A metre of slack round the band for the search; the exact test on each.
+        let from = self.heights.partition_point(|&v| v < y - half - 1.0);
+        let to = self.heights.partition_point(|&v| v <= y + half + 1.0);
+        self.heights[from..to.max(from)]
             .iter()
-            .filter(|(a, b)| (a.y <= y) != (b.y <= y))
-            .map(|(a, b)| a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y))
-            .collect();
-        xs.sort_by(|a, b| a.total_cmp(b));
-        xs.chunks_exact(2).map(|c| (c[0], c[1])).collect()
+            .copied()
+            .filter(move |v| (v - y).abs() < half)
     }
 }
 

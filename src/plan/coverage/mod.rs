@@ -579,12 +579,11 @@ fn plan_once(
                         // (from the other where no transit reaches that one).
                         let here = at.map(|a| a.0).unwrap_or(ring[0]);
                         let mut near_end = ring;
-                        let far_end = |t: &Vec<Vec2>| t.iter().rev().copied().collect();
                         if (near_end[n - 1] - here).norm() < (near_end[0] - here).norm() {
-                            near_end = far_end(&near_end);
+                            near_end.reverse();
                         }
-                        let ends = [far_end(&near_end), near_end];
-                        let ends = ends.into_iter().rev();
+                        let far_end: Vec<Vec2> = near_end.iter().rev().copied().collect();
+                        let ends = [near_end, far_end].into_iter();
                         let (track, cut) =
                             ring_start::first_reached(ends, &transit_gaps, &warnings, |t| {
                                 go_to(&mut segments, &mut at, t, 0)

@@ -63,21 +63,19 @@ impl Ring {
         if b as usize == n {
             return None;
         }
-        let chunks = pts
-            .chunks(CHUNK)
-            .map(|run| {
-                let c = run.iter().fold(Vec2::new(0.0, 0.0), |a, p| a + p) / run.len() as f64;
-                (c, run.iter().map(|p| (p - c).norm()).fold(0.0, f64::max))
-            })
-            .collect();
-        let centre = pts.iter().fold(Vec2::new(0.0, 0.0), |a, p| a + p) / n as f64;
-        let radius = pts.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
+        // A disc holding `run` (not empty): its centroid and the farthest point's distance.
+        let disc = |run: &[Vec2]| {
+            let c = run.iter().fold(Vec2::new(0.0, 0.0), |a, p| a + p) / run.len() as f64;
+            (c, run.iter().map(|p| (p - c).norm()).fold(0.0, f64::max))
+        };
+        let chunks = pts.chunks(CHUNK).map(disc).collect();
+        let disc = disc(&pts);
         Some(Ring {
             pts,
             cum,
             blocked,
             chunks,
-            disc: (centre, radius),
+            disc,
         })
     }
 
@@ -234,18 +232,17 @@ impl Rings {
                 .map(|&i| (ring.pts[i] - q).norm())
                 .fold(f64::INFINITY, f64::min)
         };
-        let mut order: Vec<(f64, f64, f64, usize)> = self
+        let mut order: Vec<(f64, usize)> = self
             .rings
             .iter()
             .enumerate()
-            .map(|(ri, ring)| {
+            .filter_map(|(ri, ring)| {
                 let (a, b) = (ring.least_distance(&p1), ring.least_distance(&p2));
-                (a + b, a, b, ri)
+                (a < trap.0 && b < trap.1).then_some((a + b, ri))
             })
-            .filter(|&(_, a, b, _)| a < trap.0 && b < trap.1)
             .collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.3.cmp(&b.3)));
-        for (least, _, _, ri) in order {
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        for (least, ri) in order {
             if best.as_ref().is_some_and(|b| b.0 <= least - 1e-6) {
                 break;
             }
@@ -260,14 +257,14 @@ impl Rings {
                 continue;
             }
             let (onto, off) = (nearest(ring, &p1, &entries), nearest(ring, &p2, &exits));
-            // None beats the best so far when the bound does not (a micrometre of margin for
-            // the rounding of the curves' lengths).
             // No curve onto this ring is clear when every entry is as far as the start's trap
             // length, nor any off it when every exit is as far as the goal's: no join of it is
             // clear, and its curves are not solved (the others' answers are the same).
             if onto >= trap.0 || off >= trap.1 {
                 continue;
             }
+            // None beats the best so far when the bound does not (a micrometre of margin for
+            // the rounding of the curves' lengths).
             let bound = onto + off - 1e-6;
             if best.as_ref().is_some_and(|b| b.0 <= bound) {
                 continue;

@@ -73,7 +73,7 @@ pub fn swath_lines(
     let span = (hi - lo).max(0.0);
     let n = (span / line_width - 1e-9).ceil().max(1.0) as usize;
     let overlap_m = (n as f64 * line_width - span).max(0.0);
-    let scan = (&rot, Scanner::new(&rot));
+    let scan = Scanner::new(&rot);
     let safe_scans: Vec<Scanner> = safe_rot.iter().map(Scanner::new).collect();
     let lines_from = |base: f64, spacing: f64| {
         let ys: Vec<f64> = (0..n).map(|k| base + spacing * (k as f64 + 0.5)).collect();
@@ -110,11 +110,11 @@ pub fn swath_lines(
 }
 
 /// The x-intervals of the line at `y`, `spacing` from its neighbours, across the rotated cell
-/// `rot` (with its scanner) spanning `lo_hi` in y (see [`swath_lines`]), cut back to the
-/// areas of `safe_scans`: the cell is scanned at the middle of the part of the line's band it
+/// of `scan` spanning `lo_hi` in y (see [`swath_lines`]), cut back to the areas of
+/// `safe_scans`: the cell is scanned at the middle of the part of the line's band it
 /// holds (an exact outer line's band runs on beyond the cell).
 fn line_intervals(
-    rot: &(&Area, Scanner),
+    scan: &Scanner,
     safe_scans: &[Scanner],
     y: f64,
     spacing: f64,
@@ -128,11 +128,11 @@ fn line_intervals(
         let (b0, b1) = (b0.max(lo), b1.min(hi));
         (0.5 * (b0 + b1), 0.5 * (b1 - b0).max(0.0))
     };
-    let band = band_extent(rot, at, widening * half);
-    let ivs = rot.1.intervals(at);
+    let ivs = scan.intervals(at);
     if ivs.is_empty() {
         return ivs;
     }
+    let band = band_extent(scan, at, widening * half);
     let safe: Vec<(f64, f64)> = safe_scans.iter().flat_map(|s| s.intervals(y)).collect();
     let ivs = ivs
         .into_iter()
@@ -170,13 +170,11 @@ pub(super) fn merge_overlapping(mut ivs: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     merged
 }
 
-/// The x-extent of `rot` within the band [y − half, y + half]: intervals at both band edges and
-/// at every vertex inside the band, merged where they overlap.
-fn band_extent((rot, scan): &(&Area, Scanner), y: f64, half: f64) -> Vec<(f64, f64)> {
+/// The x-extent of the area of `scan` within the band [y − half, y + half]: intervals at both
+/// band edges and at every vertex inside the band, merged where they overlap.
+fn band_extent(scan: &Scanner, y: f64, half: f64) -> Vec<(f64, f64)> {
     let mut ys = vec![y - half + 1e-6, y, y + half - 1e-6];
-    for ring in std::iter::once(&rot.0).chain(rot.1.iter()) {
-        ys.extend(ring.iter().map(|p| p.y).filter(|v| (v - y).abs() < half));
-    }
+    ys.extend(scan.heights_within(y, half));
     merge_overlapping(ys.iter().flat_map(|&v| scan.intervals(v)).collect())
 }
 
