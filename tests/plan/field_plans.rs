@@ -296,10 +296,11 @@ fn a_strip_narrower_than_a_turn_is_worked_in_lanes_along_it() {
         "{:#?}",
         plan.warnings
     );
+    let headland = |s: &&agsteer::plan::coverage::PlanSegment| s.kind == SegmentKind::Headland;
     let lanes: Vec<f64> = plan
         .segments
         .iter()
-        .filter(|s| s.kind == SegmentKind::Headland)
+        .filter(headland)
         .map(|s| s.length())
         .collect();
     let long = lanes.iter().filter(|&&l| l > 0.9 * radius * span).count();
