@@ -312,12 +312,10 @@ where
     Ok(0)
 }
 
-/// A plan without swaths worked by headland passes (or a strip's lanes) alone is accepted when
-/// they work at least this fraction of the field (issue 17's "every plan ≥ 97 %"); below it,
-/// and for a plan with no working pass at all, `agsteer plan` refuses with the reason and the
-/// numbers (exit 5).
-pub const HEADLAND_ONLY_MIN_WORKED: f64 =
-    agsteer::plan::coverage::narrow::MIN_WORKED_WITHOUT_SWATHS;
+/// A plan without swaths worked by headland passes alone is accepted when they work at least
+/// this fraction of the field (issue 17's "every plan ≥ 97 %"); below it, and for a plan with
+/// no working pass at all, `agsteer plan` refuses with the reason and the numbers (exit 5).
+pub const HEADLAND_ONLY_MIN_WORKED: f64 = 0.97;
 
 /// Why `plan` is refused, if it is: no swath and no headland pass; or no swath, and the
 /// headland passes work less than [`HEADLAND_ONLY_MIN_WORKED`] of the field (`worked`, when

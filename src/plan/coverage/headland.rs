@@ -264,7 +264,7 @@ fn difference_of_union(a: &[Area], b: &[Area]) -> Vec<Area> {
 }
 
 /// Closed tracks (first point repeated last) along every ring of `areas`, resampled.
-pub(super) fn tracks_of(areas: &[Area], spacing: f64) -> Vec<Vec<Vec2>> {
+fn tracks_of(areas: &[Area], spacing: f64) -> Vec<Vec<Vec2>> {
     areas
         .iter()
         .flat_map(|(outer, holes)| std::iter::once(outer).chain(holes.iter()))
@@ -541,9 +541,8 @@ fn concave_kinks(areas: &[Area], spacing: f64, r_min: f64) -> Vec<(Vec2, Vec2)> 
 /// The closed tracks, each whole when every point is clear and no curve is tighter than
 /// `r_min` (the guarantees' three-point curvature and slack, `metrics::checks`), else cut into
 /// its stretches that are (open, at least 3 points), each cut reported in `warnings` with its
-/// place; open tracks (first point not repeated last) likewise, without a warning. (A kink the
-/// openings left, 1.2 /m over half a metre at r_min 5.7 m on a random field with a hole, had
-/// been returned and refused by the checks.)
+/// place. (A kink the openings left, 1.2 /m over half a metre at r_min 5.7 m on a random field
+/// with a hole, had been returned and refused by the checks.)
 pub fn clear_stretches(
     tracks: Vec<Vec<Vec2>>,
     clear: &dyn Fn(&Vec2) -> bool,
@@ -554,30 +553,6 @@ pub fn clear_stretches(
     let limit = (1.0 + CURVATURE_SLACK) / r_min + CURVATURE_SLACK_ABS;
     let mut out = Vec::new();
     for track in tracks {
-        if track.first() != track.last() {
-            // An open track (a strip's middle lane): cut where it is not clear, without warning.
-            let ok = |i: usize| {
-                let inner = i > 0 && i + 1 < track.len();
-                clear(&track[i])
-                    && (!inner
-                        || super::metrics::three_point_curvature(
-                            &track[i - 1],
-                            &track[i],
-                            &track[i + 1],
-                        ) <= limit)
-            };
-            let mut stretch = Vec::new();
-            for i in 0..=track.len() {
-                if i < track.len() && ok(i) {
-                    stretch.push(track[i]);
-                } else if stretch.len() >= 3 {
-                    out.push(std::mem::take(&mut stretch));
-                } else {
-                    stretch.clear();
-                }
-            }
-            continue;
-        }
         // Closed: the last point repeats the first.
         let m = track.len().saturating_sub(1);
         let ok: Vec<bool> = track

@@ -24,7 +24,6 @@ mod reverse;
 mod ring_start;
 pub mod rings;
 mod runs;
-mod strip;
 mod stub;
 pub mod swath_angle;
 pub mod swaths;
@@ -96,11 +95,8 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
         grid: &grid,
         loose_grid: &loose_grid,
     };
-    let plan_with = |widening| {
-        narrow::plan_field(field, p, |f, q, strip| {
-            plan_once(f, q, &tests, (widening, strip))
-        })
-    };
+    let plan_with =
+        |widening| narrow::plan_field(field, p, |f, q| plan_once(f, q, &tests, widening));
     let plan = plan_with(swaths::band_widening(p.sections))?;
     if p.sections > 1 && plan.transit_gaps > 0 {
         // Swaths run on over their whole band can end too deep in a corner for any way on:
@@ -118,13 +114,12 @@ pub fn plan_field(field: &Field, p: &CoverageParams) -> Result<FieldPlan, PlanEr
 }
 
 /// [`plan_field`] with the configured headland passes as they are, with the field's `tests`, the
-/// swaths run on over the share `widening` of their band ([`swaths::band_widening`]); or, with
-/// `strip`, lanes along the field and no swaths ([`strip::lanes`]).
+/// swaths run on over the share `widening` of their band ([`swaths::band_widening`]).
 fn plan_once(
     field: &Field,
     p: &CoverageParams,
     tests: &Tests,
-    (widening, strip): (f64, bool),
+    widening: f64,
 ) -> Result<FieldPlan, PlanError> {
     p.validate()?;
     if field.boundary.len() < 3 || crate::geo::polygon::signed_area(&field.boundary) <= 0.0 {
@@ -140,11 +135,7 @@ fn plan_once(
     // Small obstacles (seed 001) stay in the working area: the swaths run through them and
     // each blocked stretch becomes a detour. Large ones get a headland and split the swaths.
     // Small ones within reach of a headland pass get a headland too (the passes bend round).
-    let (small, large) = if strip {
-        (Vec::new(), field.obstacles.clone())
-    } else {
-        headland::split_obstacles(&field.boundary, &field.obstacles, p)
-    };
+    let (small, large) = headland::split_obstacles(&field.boundary, &field.obstacles, p);
     // Each small obstacle as a disc (centre, radius + w/2 + 1 m), to find the swaths that pass
     // near one without checking every point of every swath.
     let small_discs: Vec<(Vec2, f64)> = small
@@ -165,15 +156,13 @@ fn plan_once(
         &large,
         margin,
     );
-    let (passes, leftover::Worked { working, own }) = if strip {
-        let lanes = strip::lanes(&field.boundary, &large, p);
-        (lanes, leftover::Worked::default())
-    } else {
-        let passes = headland::passes_around(&field.boundary, &large, p);
-        let working = headland::working_area(&field.boundary, &large, p);
-        let worked = leftover::with_leftover(working, (&field.boundary, &large), &passes, p);
-        (passes, worked)
-    };
+    let passes = headland::passes_around(&field.boundary, &large, p);
+    let leftover::Worked { working, own } = leftover::with_leftover(
+        headland::working_area(&field.boundary, &large, p),
+        (&field.boundary, &large),
+        &passes,
+        p,
+    );
     // Points are checked; the chords between them may cut a little inside the arcs
     // (`tests.clear`). Transits that find no way with the implement clear of the edge keep the
     // tractor inside the field and off the obstacles (`tests.loose`; the guarantee for
@@ -215,37 +204,29 @@ fn plan_once(
         obstacles: obstacle_passes,
         ..
     } = passes;
-    // Transits may follow the headland passes (field and obstacles) where they are clear (not
-    // a strip plan's rings, which turn sharply at the strip's ends).
-    let ring_tracks = match strip {
-        true => Vec::new(),
-        false => field_passes
+    // Transits may follow the headland passes (field and obstacles) where they are clear.
+    let rings = rings::Rings::new(
+        &field_passes
             .iter()
-            .chain(&obstacle_passes)
+            .chain(obstacle_passes.iter())
             .cloned()
-            .collect(),
-    };
-    let rings = rings::Rings::new(&ring_tracks, &clear);
+            .collect::<Vec<_>>(),
+        &clear,
+    );
     // Pieces of the field that no transit with the implement clear joins (see `apart`).
     let gap = p.point_spacing.max(rings.max_gap());
     let pieces = apart::Apart::new(field, tests.clearance.0, gap);
     // A pass is worked only where its implement is clear and it turns no tighter than r_min
     // (the guarantees): a pass that is not so throughout is cut into its stretches that are,
     // and the cut is reported.
-    // (A strip plan's rings are cut at every end of the strip by design: not each reported.)
-    let cut_warnings = if strip {
-        &Default::default()
-    } else {
-        &warnings
-    };
     let mut field_tracks: std::collections::VecDeque<Vec<Vec2>> =
-        headland::clear_stretches(field_passes, &clear, p.r_min, cut_warnings).into();
+        headland::clear_stretches(field_passes, &clear, p.r_min, &warnings).into();
     if p.headland_order == HeadlandOrder::Last {
         // Worked last, from the inside out: the outermost pass along the edge ends the job.
         field_tracks.make_contiguous().reverse();
     }
     let mut obstacle_tracks =
-        headland::clear_stretches(obstacle_passes, &clear, p.r_min, cut_warnings);
+        headland::clear_stretches(obstacle_passes, &clear, p.r_min, &warnings);
 
     let tp = p.turn_params();
     let mut cache = crate::plan::turns::TurnCache::default();

@@ -1,9 +1,6 @@
 //! Fields too narrow for a swath inside the configured headland (issue 17 point 3): a farmer
 //! with a wide implement on a small field first drops headland passes his turns do not need,
 //! and where no swath fits even then, works the field round and round from the edge in.
-//! A field (or most of it) narrower than a turn, where those passes and swaths work little, is
-//! worked in lanes along its length, joined by reversing where no turn fits
-//! ([`super::strip::lanes`]), as a farmer works a strip between a ditch and a hedge.
 //! Whatever is planned says so in the plan's warnings; a plan with no working pass at all is
 //! refused by the caller with the numbers of [`super::headland::no_swath_fits`].
 
@@ -16,58 +13,7 @@ const MAX_FILL_PASSES: usize = 64;
 /// `plan_once` with `p`; when that plan has no swath: with the fewest headland passes the turns
 /// need ([`headland::passes`] of no configured passes) if that lets swaths fit; else with as many
 /// headland passes as fit in the field (each pass that no longer fits is simply absent).
-/// Then, when that plan's working passes are shorter than [`STRIP_TRIGGER`] of the field's
-/// area over the implement width (it works less than that share of the field however they
-/// lie), the strip plan (`plan_once` with `true`): kept when it works at least
-/// [`MIN_WORKED_WITHOUT_SWATHS`] of the field (a plan without swaths is refused below that).
 pub fn plan_field(
-    field: &Field,
-    p: &CoverageParams,
-    plan_once: impl Fn(&Field, &CoverageParams, bool) -> Result<FieldPlan, PlanError>,
-) -> Result<FieldPlan, PlanError> {
-    let plan = with_passes(field, p, |f, q| plan_once(f, q, false))?;
-    let area = {
-        use geo::Area as _;
-        super::metrics::field_polygon(field).unsigned_area()
-    };
-    let worked_at_most = |plan: &FieldPlan| -> f64 {
-        use SegmentKind::*;
-        let passes = plan.segments.iter();
-        let working = passes.filter(|s| matches!(s.kind, Work | Detour | Headland));
-        working.map(|s| s.length()).sum::<f64>() * p.line_width
-    };
-    if worked_at_most(&plan) >= STRIP_TRIGGER * area {
-        return Ok(plan);
-    }
-    let Ok(mut lanes) = plan_once(field, p, true) else {
-        return Ok(plan);
-    };
-    let unworked = |plan: &FieldPlan| {
-        use geo::Area as _;
-        super::metrics::unworked_ground(field, plan, p.line_width).unsigned_area()
-    };
-    let (before, after) = (unworked(&plan), unworked(&lanes));
-    if after >= before || after > (1.0 - MIN_WORKED_WITHOUT_SWATHS) * area {
-        return Ok(plan);
-    }
-    lanes.warnings.push(format!(
-        "the field is worked in lanes along its length, joined by reversing where no turn fits: its headland passes and swaths at {:.1} m and r_min {:.1} m left {:.0} m² of {:.0} m² unworked, the lanes {:.0} m²",
-        p.line_width, p.r_min, before, area, after
-    ));
-    Ok(lanes)
-}
-
-/// Share of the field a plan without swaths (headland passes or lanes alone) must work to be
-/// driven: below it `agsteer plan` refuses the field with the reason (issue 17's "every plan
-/// ≥ 97 %").
-pub const MIN_WORKED_WITHOUT_SWATHS: f64 = 0.97;
-
-/// Share of a field's area under which a plan's working passes (their length times the
-/// implement width, an upper bound of what they work) make [`plan_field`] try the strip plan.
-const STRIP_TRIGGER: f64 = 0.5;
-
-/// [`plan_field`] without the strip plan.
-fn with_passes(
     field: &Field,
     p: &CoverageParams,
     plan_once: impl Fn(&Field, &CoverageParams) -> Result<FieldPlan, PlanError>,

@@ -89,8 +89,7 @@ pub struct FieldPlan {
     pub cells: usize,
     /// Swath direction of each cell, rad CCW from East.
     pub swath_angles: Vec<f64>,
-    /// Number of work swaths (none in a strip plan, whose lanes are headland segments: see
-    /// [`super::narrow`]).
+    /// Number of work swaths.
     pub swaths: usize,
     /// Overlap of adjacent swath footprints from balancing, m² (estimate: the extra width
     /// times the mean swath length).
