@@ -43,6 +43,9 @@ pub struct SafetyConfig {
     pub off_line_time_s: f64,
     /// The line must be acquired (|XTE| below off_line_m once) within this distance, m.
     pub off_line_acquire_m: f64,
+    /// Off work lines (turns, transits, approaches, reversing): farther than this from the
+    /// path for off_line_time_s is `off_path`, m (0 = off).
+    pub off_path_m: f64,
     /// A weave is `tracking_unstable`: unstable_swings alternate swings (0 = off) within
     /// unstable_window_s of the XTE beyond ±unstable_xte_m (0 = not watched) or of the wheel
     /// angle beyond ±unstable_wheel_deg (0 = not watched) about its moving mean (time
@@ -82,6 +85,7 @@ impl Default for SafetyConfig {
             off_line_m: 2.0,
             off_line_time_s: 0.5,
             off_line_acquire_m: 30.0,
+            off_path_m: 3.0,
             unstable_xte_m: 0.2,
             unstable_wheel_deg: 3.0,
             unstable_swings: 4,
@@ -106,6 +110,7 @@ impl SafetyConfig {
             unstable_swings: self.unstable_swings as usize,
             unstable_window: self.unstable_window_s,
             wheel_mean_tau: self.unstable_wheel_mean_s,
+            off_path: self.off_path_m,
         }
     }
 
@@ -187,6 +192,7 @@ impl SafetyConfig {
             1.0,
             1000.0,
         );
+        c.range("safety.off_path_m", f.off_path_m, 0.0, 50.0);
         c.range("safety.unstable_xte_m", f.unstable_xte_m, 0.0, 10.0);
         c.range("safety.unstable_wheel_deg", f.unstable_wheel_deg, 0.0, 45.0);
         c.range(

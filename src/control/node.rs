@@ -4,6 +4,7 @@
 
 mod calibration;
 mod commands;
+mod supervision;
 
 pub use calibration::CalibrationProgress;
 
@@ -585,29 +586,6 @@ impl ControllerNode {
         }
     }
 
-    /// Tells the supervisor which work line is driven (work lines driven forward; not turns,
-    /// approaches or reversing) and, when it changes, the line's sharpest curvature.
-    fn supervise_line(&mut self) {
-        let g = self.ctrl.guidance();
-        let line = (g.tag() == crate::geo::Tag::Work
-            && !g.is_approaching()
-            && !g.is_finished()
-            && g.direction() == Direction::Forward)
-            .then(|| g.current_line());
-        if line != self.supervised_line {
-            self.supervised_line = line;
-            let k = if line.is_some() {
-                crate::safety::tracking::sharpest_curvature(
-                    g.global_path().iter().map(|p| p.pos),
-                    1.0,
-                )
-            } else {
-                0.0
-            };
-            self.supervisor.set_line(line, k);
-        }
-    }
-
     /// One control period at `t`: appends the frames to send.
     pub fn tick(&mut self, t: f64, out: &mut Vec<Frame>) -> Cmd {
         // A period more than LATE_PERIOD·dt after the previous one: the loop could not run
@@ -681,7 +659,7 @@ impl ControllerNode {
             }
         }
         if calibration.is_none() {
-            self.supervise_line();
+            self.supervise_path(c.estimate.as_ref());
         }
         if !self.operator.replies.is_empty() {
             let nudge = self.ctrl.guidance().nudge_m();

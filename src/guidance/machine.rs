@@ -502,6 +502,38 @@ impl Guidance {
         Some((xte, wrap_angle(pose.heading - facing)))
     }
 
+    /// Distance from `pose` to the current global path, m: to the nearest of the segments
+    /// either side of the nearest point, not to a segment's extension as the cross-track error
+    /// is (off a short curved path that would read small far from it), except beyond the
+    /// path's ends: there the vehicle rolls on along it before a cusp or after the end of a
+    /// line, and the distance is to the first or last segment's extension. `None` without a
+    /// path.
+    pub fn distance_from_path(&self, pose: &Pose) -> Option<f64> {
+        let n = self.path.len();
+        if n < 2 || self.phase == Phase::Finished {
+            return None;
+        }
+        let i = self.index_global.min(n - 1);
+        (i.saturating_sub(1)..(i + 1).min(n - 1))
+            .filter_map(|k| {
+                let (a, b) = (self.path[k].pos, self.path[k + 1].pos);
+                let d = b - a;
+                let len2 = d.norm_squared();
+                if len2 <= 0.0 {
+                    return None;
+                }
+                let mut along = (pose.pos - a).dot(&d) / len2;
+                if k > 0 {
+                    along = along.max(0.0);
+                }
+                if k + 2 < n {
+                    along = along.min(1.0);
+                }
+                Some((pose.pos - (a + d * along)).norm())
+            })
+            .reduce(f64::min)
+    }
+
     /// The AB plan, when this is an AB job.
     pub fn plan(&self) -> Option<&AbPlan> {
         self.ab()

@@ -13,96 +13,18 @@
 //! `tracking_unstable`, a persistent offset `off_line`, both held until the line changes or the
 //! operator disengages; a line the vehicle cannot follow at its speed is refused at engage
 //! and, engaged, given back as soon as the line (or the speed on it) makes it so
-//! (`line_unfollowable`, held like the tracking faults).
+//! (`line_unfollowable`, held like the tracking faults). On every other path (a turn, a transit,
+//! an approach, reversing) it watches the distance from the path: `off_path`, held the same way.
 
+mod fault;
 pub mod heading;
 pub mod pauses;
 pub mod tracking;
 
+pub use fault::FaultCode;
 pub use heading::{HeadingCheck, HeadingCheckParams};
 use serde::Serialize;
 pub use tracking::{TrackingMonitor, TrackingParams, TrackingVerdict};
-
-/// Why the supervisor will not steer. The numeric value goes on the bus.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
-#[repr(u8)]
-pub enum FaultCode {
-    None = 0,
-    GnssTimeout = 1,
-    FixQuality = 2,
-    WheelAngleTimeout = 3,
-    WheelAngleInvalid = 4,
-    SpeedOutOfRange = 5,
-    OperatorOverride = 6,
-    XteTooLarge = 7,
-    HeadingErrorTooLarge = 8,
-    NoGuidance = 9,
-    BusDown = 10,
-    OperatorInvalid = 11,
-    ActuatorFault = 12,
-    /// The rate limit cannot bring the angle within the lateral-acceleration limit (the speed
-    /// rose too fast): steering is given back rather than break either limit.
-    LateralAccelLimit = 13,
-    /// No ISO 11783-5 source address: not claimed yet, lost to a device with a lower NAME, or
-    /// none free (Cannot Claim). Nothing but address claims is sent meanwhile.
-    AddressLost = 14,
-    /// The steering ECU reports it is not ready for guidance (Guidance Machine Info readiness).
-    SteeringNotReady = 15,
-    /// The steering ECU reports its mechanical system lockout active (ISO 11783-7).
-    SteeringLockout = 16,
-    /// The steering ECU requests a reset of the command status (ISO 11783-7 request reset):
-    /// the command goes to "not intended to steer" until the request clears and the operator
-    /// engages again.
-    SteeringResetRequested = 17,
-    /// A sustained oscillation of the cross-track error or the wheel angle on a work line (a
-    /// limit cycle): steering is given back rather than weave.
-    TrackingUnstable = 18,
-    /// |XTE| beyond `safety.off_line_m` for `safety.off_line_time_s` on a work line.
-    OffLine = 19,
-    /// The line's sharpest curve cannot be followed at this speed with these limits and this
-    /// steering rate: engage refused, or, engaged, steering given back (a line that starts while
-    /// engaged, or a speed-up on it).
-    LineUnfollowable = 20,
-    /// Moving above `safety.heading_mismatch_min_speed_kmh`, the GNSS heading's course over
-    /// ground (crab in turns and reversing allowed for) is more than
-    /// `safety.heading_mismatch_deg` off for `safety.heading_mismatch_time_s`: the heading is
-    /// wrong, and every steering decision with it ([`heading`]).
-    HeadingMismatch = 21,
-    /// An engage beyond the engage gate found no approach path to the line (every one would
-    /// leave the field or cross an obstacle): refused. Never a fault of the running system;
-    /// only an engage's refusal reason (OperatorReply, `engage_refusal` in the status).
-    NoApproachPath = 22,
-}
-
-impl FaultCode {
-    /// Every code, in bus order.
-    pub const ALL: [FaultCode; 23] = [
-        FaultCode::None,
-        FaultCode::GnssTimeout,
-        FaultCode::FixQuality,
-        FaultCode::WheelAngleTimeout,
-        FaultCode::WheelAngleInvalid,
-        FaultCode::SpeedOutOfRange,
-        FaultCode::OperatorOverride,
-        FaultCode::XteTooLarge,
-        FaultCode::HeadingErrorTooLarge,
-        FaultCode::NoGuidance,
-        FaultCode::BusDown,
-        FaultCode::OperatorInvalid,
-        FaultCode::ActuatorFault,
-        FaultCode::LateralAccelLimit,
-        FaultCode::AddressLost,
-        FaultCode::SteeringNotReady,
-        FaultCode::SteeringLockout,
-        FaultCode::SteeringResetRequested,
-        FaultCode::TrackingUnstable,
-        FaultCode::OffLine,
-        FaultCode::LineUnfollowable,
-        FaultCode::HeadingMismatch,
-        FaultCode::NoApproachPath,
-    ];
-}
 
 /// Supervisor state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -276,6 +198,8 @@ pub struct Supervisor {
     line_curvature: f64,
     /// The path's curvature at the vehicle, 1/m (positive left; [`Supervisor::set_path_curvature`]).
     path_curvature: f64,
+    /// The vehicle's distance from the path this period, m ([`Supervisor::set_path_distance`]).
+    path_distance: Option<f64>,
     tracking: TrackingMonitor,
     /// A tracking fault held until the line changes or the operator disengages.
     tracking_latch: Option<FaultCode>,
@@ -316,6 +240,7 @@ impl Supervisor {
             work_line: None,
             line_curvature: 0.0,
             path_curvature: 0.0,
+            path_distance: None,
             tracking: TrackingMonitor::new(),
             tracking_latch: None,
             heading_check: HeadingCheck::new(),
@@ -346,6 +271,13 @@ impl Supervisor {
         } else {
             0.0
         };
+    }
+
+    /// The vehicle's distance from the path it is steered along this period (to the path's
+    /// nearest segment), m; `None` when there is no path or no pose. Watched off work lines:
+    /// `off_path` (see [`tracking`]).
+    pub fn set_path_distance(&mut self, distance: Option<f64>) {
+        self.path_distance = distance.filter(|d| d.is_finite());
     }
 
     /// The path's curvature at the vehicle this period, 1/m (positive left): a swing of the
@@ -684,10 +616,20 @@ impl Supervisor {
                 TrackingVerdict::Ok => FaultCode::None,
                 TrackingVerdict::Unstable => FaultCode::TrackingUnstable,
                 TrackingVerdict::OffLine => FaultCode::OffLine,
+                TrackingVerdict::OffPath => FaultCode::OffPath,
             };
             if code != FaultCode::None {
                 self.tracking_latch = Some(code);
                 fault = code;
+            }
+        } else if self.state == SafetyState::Engaged && fault == FaultCode::None {
+            // Off work lines (turns, transits, approaches, reversing): the path lost.
+            let verdict =
+                self.tracking
+                    .update_manoeuvre(&self.params.tracking, t, self.path_distance);
+            if verdict == TrackingVerdict::OffPath {
+                self.tracking_latch = Some(FaultCode::OffPath);
+                fault = FaultCode::OffPath;
             }
         }
 

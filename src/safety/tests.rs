@@ -322,7 +322,9 @@ fn an_offset_on_a_work_line_is_off_line_and_the_operator_acknowledges_it() {
 }
 
 #[test]
-fn tracking_is_not_supervised_off_work_lines() {
+fn the_work_line_checks_do_not_watch_other_paths() {
+    // A weave and an offset of 2.5 m (beyond off_line, within off_path) in a turn: its own
+    // design, not a fault.
     let (mut s, mut t) = engaged_on_a_line(SafetyParams::default());
     s.set_line(None, 0.0);
     let start = t;
@@ -330,7 +332,79 @@ fn tracking_is_not_supervised_off_work_lines() {
         t += DT;
         feed_good(&mut s, t);
         let x = 0.8 * (std::f64::consts::TAU * (t - start) / 8.0).sin();
+        s.set_path_distance(Some(if t - start < 30.0 { x.abs() } else { 2.5 }));
         assert!(s.step(t, Some(0.0), Some(x), Some(0.0)).engaged, "{t}");
+    }
+}
+
+#[test]
+fn a_turn_lost_is_off_path_held_until_a_line_or_the_operator() {
+    let (mut s, mut t) = engaged_on_a_line(SafetyParams::default());
+    // On the work line the path distance is not what is watched (off_line is).
+    s.set_path_distance(Some(10.0));
+    for _ in 0..20 {
+        t += DT;
+        feed_good(&mut s, t);
+        assert!(s.step(t, Some(0.0), Some(0.1), Some(0.0)).engaged);
+    }
+    s.set_line(None, 0.0);
+    let start = t;
+    let mut fault_at = None;
+    while t < start + 10.0 {
+        t += DT;
+        feed_good(&mut s, t);
+        // 1 m off for 2 s, then drifting away at 1 m/s: beyond 3 m from 4 s.
+        let d = if t - start < 2.0 {
+            1.0
+        } else {
+            1.0 + (t - start - 2.0)
+        };
+        s.set_path_distance(Some(d));
+        // An unknown distance (no pose) for one period restarts the timing.
+        if (t - start - 4.2).abs() < 0.5 * DT {
+            s.set_path_distance(None);
+        }
+        let c = s.step(t, Some(0.0), Some(0.0), Some(0.0));
+        if !c.engaged {
+            assert_eq!(c.fault, FaultCode::OffPath);
+            fault_at = Some(t - start);
+            break;
+        }
+    }
+    let at = fault_at.expect("a lost turn must disengage");
+    assert!((at - 4.72).abs() <= 2.0 * DT + 1e-9, "{at}");
+    // Held: back near the path, an engage is refused.
+    s.set_path_distance(Some(0.1));
+    t += DT;
+    feed_good(&mut s, t);
+    s.request_engage();
+    let c = s.step(t, Some(0.0), Some(0.0), Some(0.0));
+    assert!(!c.engaged);
+    assert_eq!(s.last_refusal(), FaultCode::OffPath);
+    // The next work line clears it.
+    s.set_line(Some(7), 0.0);
+    t += DT;
+    feed_good(&mut s, t);
+    s.request_engage();
+    assert!(s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
+}
+
+#[test]
+fn off_path_zero_is_off() {
+    let params = SafetyParams {
+        tracking: crate::safety::TrackingParams {
+            off_path: 0.0,
+            ..Default::default()
+        },
+        ..SafetyParams::default()
+    };
+    let (mut s, mut t) = engaged_on_a_line(params);
+    s.set_line(None, 0.0);
+    s.set_path_distance(Some(100.0));
+    for _ in 0..500 {
+        t += DT;
+        feed_good(&mut s, t);
+        assert!(s.step(t, Some(0.0), Some(0.0), Some(0.0)).engaged);
     }
 }
 

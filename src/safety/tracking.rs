@@ -1,6 +1,7 @@
-//! Tracking supervision: a fault instead of a weave (issue 15, point 5).
+//! Tracking supervision: a fault instead of a weave (issue 15, point 5) or a lost turn.
 //!
-//! While the supervisor is engaged on a work line it watches how the line is being tracked:
+//! While the supervisor is engaged it watches how the path is being tracked; the first three
+//! checks on a work line, the last on every other path:
 //!
 //! - `tracking_unstable`: a sustained oscillation — the cross-track error swinging from beyond
 //!   +`unstable_xte` to beyond −`unstable_xte` (or the wheel angle, about its own moving mean,
@@ -19,7 +20,15 @@
 //! - `off_line`: |XTE| beyond `off_line` for longer than `off_line_time`, once the line has been
 //!   acquired (|XTE| below `off_line` since the line started: a turn's exit error is not an
 //!   offset); or the line not acquired within `off_line_acquire` m driven on it (a vehicle
-//!   engaged near the limit, or out of a turn, that never converges).
+//!   engaged near the limit, or out of a turn, that never converges);
+//! - `off_path`: on every other path the tractor is steered along — turns, transits,
+//!   approaches, anything driven in reverse — the distance from the path (to its nearest
+//!   segment, not to a segment's extension) beyond `off_path` for longer than `off_line_time`.
+//!   Those paths are short and curved, and an error there is not an offset to hold on to: a
+//!   plant that cannot turn as tight as the plan, or loses the path at a cusp, would otherwise
+//!   be steered on after it, the work-line checks waiting for a line it never reaches. No
+//!   acquisition: a manoeuvre starts where the vehicle is (a line's end, a cusp, the approach's
+//!   start).
 //!
 //! And before engaging, the line itself: `line_unfollowable` when the line's sharpest curve
 //! needs more than the command limits allow at the current speed (the wheel angle limit, the
@@ -54,6 +63,9 @@ pub struct TrackingParams {
     pub unstable_window: f64,
     /// Time constant of the wheel angle's moving mean, s.
     pub wheel_mean_tau: f64,
+    /// Distance from a turn's, transit's, approach's or reversing path beyond this for longer
+    /// than `off_line_time` is `off_path`, m (0 = off).
+    pub off_path: f64,
 }
 
 /// The largest `unstable_swings` (the size of the swing history).
@@ -70,6 +82,7 @@ impl Default for TrackingParams {
             unstable_swings: 4,
             unstable_window: 40.0,
             wheel_mean_tau: 2.0,
+            off_path: 3.0,
         }
     }
 }
@@ -84,6 +97,7 @@ pub enum TrackingVerdict {
     Ok,
     Unstable,
     OffLine,
+    OffPath,
 }
 
 /// A swing whose peak is below this fraction of the previous swing's peak is a decaying
@@ -184,6 +198,8 @@ pub struct TrackingMonitor {
     /// Distance driven on the line while not acquired, m.
     unacquired: f64,
     off_since: Option<f64>,
+    /// Since when the vehicle has been beyond `off_path` of a manoeuvre's path.
+    off_path_since: Option<f64>,
 }
 
 impl Default for TrackingMonitor {
@@ -202,6 +218,7 @@ impl TrackingMonitor {
             acquired: false,
             unacquired: 0.0,
             off_since: None,
+            off_path_since: None,
         }
     }
 
@@ -282,6 +299,30 @@ impl TrackingMonitor {
             }
         }
         verdict
+    }
+}
+
+impl TrackingMonitor {
+    /// One engaged period at `t` on a path that is not a work line (a turn, a transit, an
+    /// approach, reversing): `distance` from the path, m (None: no path or no pose, which
+    /// restarts the timing).
+    pub fn update_manoeuvre(
+        &mut self,
+        p: &TrackingParams,
+        t: f64,
+        distance: Option<f64>,
+    ) -> TrackingVerdict {
+        let beyond = p.off_path > 0.0 && distance.is_some_and(|d| d.is_finite() && d > p.off_path);
+        if !beyond {
+            self.off_path_since = None;
+            return TrackingVerdict::Ok;
+        }
+        let since = *self.off_path_since.get_or_insert(t);
+        if t - since >= p.off_line_time {
+            TrackingVerdict::OffPath
+        } else {
+            TrackingVerdict::Ok
+        }
     }
 }
 

@@ -7,7 +7,9 @@
 //! 3. a disengage always follows within one period after any timeout (GNSS, wheel angle);
 //! 4. the counter and CRC of every emitted frame are right (through the controller node);
 //! 5. no engaged command once the GNSS heading has disagreed with the course over ground
-//!    (beyond the limit, above the minimum speed) for the configured time.
+//!    (beyond the limit, above the minimum speed) for the configured time;
+//! 6. no engaged command off a work line (a turn, a transit, reversing) once the vehicle has
+//!    been farther than `off_path` from the path for `off_line_time`.
 //!
 //! Inputs are random sequences of events and times, including garbage payloads on every known
 //! identifier, time jumps, NaN and infinite demands, and fast-packets out of order.
@@ -100,6 +102,7 @@ fn configurations() -> Vec<(&'static str, SafetyParams)> {
                     unstable_swings: 2,
                     unstable_window: 5.0,
                     wheel_mean_tau: 0.5,
+                    off_path: 0.5,
                 },
                 ..d.clone()
             },
@@ -163,6 +166,8 @@ enum Ev {
         line: Option<u64>,
         curvature: f64,
     },
+    /// The vehicle's distance from the path (None: no path or no pose).
+    PathDistance(Option<f64>),
     Step {
         demand: f64,
         xte: f64,
@@ -204,6 +209,8 @@ fn event() -> impl Strategy<Value = Ev> {
             .prop_map(|(course, off, sog)| Ev::Heading { heading: course + off, course, sog }),
         1 => (prop::option::weighted(0.8, 0u64..3), special_f64())
             .prop_map(|(line, curvature)| Ev::Line { line, curvature }),
+        2 => prop::option::weighted(0.9, prop_oneof![3 => 0.0f64..1.0, 3 => 0.0f64..8.0, 1 => special_f64()])
+            .prop_map(Ev::PathDistance),
         10 => (special_f64(), special_f64(), special_f64())
             .prop_map(|(demand, xte, heading_error)| Ev::Step { demand, xte, heading_error }),
         30 => (special_f64(), -0.6f64..0.6, prop_oneof![5 => 0.5f64..7.0, 1 => 0.0f64..0.5])
@@ -241,6 +248,11 @@ struct Oracle {
     heading: Option<(f64, f64)>,
     course: Option<(f64, f64, f64)>,
     mismatch_since: Option<f64>,
+    /// The work line set (None: any other path).
+    line: Option<u64>,
+    path_distance: Option<f64>,
+    /// Since when, engaged off a work line, the vehicle has been beyond `off_path`.
+    off_path_since: Option<f64>,
 }
 
 fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseError> {
@@ -311,7 +323,17 @@ fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseEr
                 }
             }
             Ev::Bus(up) => s.on_bus(*up),
-            Ev::Line { line, curvature } => s.set_line(*line, *curvature),
+            Ev::Line { line, curvature } => {
+                s.set_line(*line, *curvature);
+                if *line != o.line {
+                    o.off_path_since = None;
+                }
+                o.line = *line;
+            }
+            Ev::PathDistance(d) => {
+                s.set_path_distance(*d);
+                o.path_distance = d.filter(|d| d.is_finite());
+            }
             Ev::DirectionChange(active) => {
                 s.set_direction_change(o.t, *active);
                 if !active {
@@ -363,6 +385,15 @@ fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseEr
                 o.mismatch_since = match judged {
                     Some(true) => Some(o.mismatch_since.unwrap_or(o.t)),
                     _ => None,
+                };
+                // (6) the oracle's own timing of the path lost: steps engaged off a work line
+                // (an engage restarts it).
+                let far = o.line.is_none()
+                    && p.tracking.off_path > 0.0
+                    && o.path_distance.is_some_and(|d| d > p.tracking.off_path);
+                o.off_path_since = match o.off_path_since {
+                    _ if !(far && o.was_engaged) => None,
+                    since => Some(since.unwrap_or(o.t)),
                 };
                 let cmd = s.step(o.t, Some(demand), Some(xte), Some(heading_error));
                 let dt = o
@@ -426,6 +457,12 @@ fn run_supervisor_case(p: &SafetyParams, events: &[Ev]) -> Result<(), TestCaseEr
                         !o.mismatch_since.is_some_and(|since| o.t - since >= h.time),
                         "engaged with the heading {:?} s off the course",
                         o.mismatch_since.map(|since| o.t - since)
+                    );
+                    prop_assert!(
+                        !o.off_path_since
+                            .is_some_and(|since| o.t - since >= p.tracking.off_line_time),
+                        "engaged {:?} s farther than off_path from a manoeuvre's path",
+                        o.off_path_since.map(|since| o.t - since)
                     );
                     o.last_engaged_cmd = Some((o.t, cmd.wheel_angle));
                     ENGAGED_STEPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);

@@ -120,3 +120,45 @@ fn a_deliberately_unstable_gain_disengages() {
         10.0,
     );
 }
+
+/// The field demo (turns, transits and detours at r_min 6 m) on a tractor whose wheelbase is
+/// 5 m where the controller is told 3 m: at 35° it turns no tighter than 7.1 m, and the turns
+/// planned at 6 m are driven wide.
+fn wide_turning_field_job(set: &[&str]) -> DemoRun {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.toml");
+    let mut set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    set.push("sim.wheelbase_error_m=2.0".into());
+    let cfg = Config::load(std::path::Path::new(path), &set).expect("valid configuration");
+    drive(&cfg)
+}
+
+#[test]
+fn a_turn_the_tractor_cannot_make_is_given_back_off_path() {
+    use agsteer::plan::coverage::SegmentKind;
+    let r = wide_turning_field_job(&[]);
+    let first = r
+        .disengage_events
+        .first()
+        .cloned()
+        .unwrap_or_else(|| panic!("no disengagement: {:?}", r.report));
+    assert_eq!(first.1, "off_path", "{:?}", r.disengage_events);
+    assert!(!r.report.finished);
+    println!("OFF-PATH: off_path at {:.2} s", first.0);
+
+    // With the check off, the same tractor stays engaged through paths it is driven farther
+    // than off_path (3 m) from, and no other check stops it.
+    let r = wide_turning_field_job(&["safety.off_path_m=0"]);
+    let lost: Vec<_> = r
+        .report
+        .segments
+        .iter()
+        .filter(|s| matches!(s.kind, SegmentKind::Turn | SegmentKind::Transit) && s.xte_max_m > 3.0)
+        .collect();
+    println!("OFF-PATH off: {} segments beyond 3 m: {lost:?}", lost.len());
+    assert!(!lost.is_empty(), "{:?}", r.report.segments);
+    assert!(
+        r.disengage_events.iter().all(|(_, c)| c == "no_guidance"),
+        "{:?}",
+        r.disengage_events
+    );
+}

@@ -174,6 +174,7 @@ impl ControllerNode {
         self.supervisor.request_disengage();
         // No work line is supervised while calibrating (set again after it).
         self.supervisor.set_line(None, 0.0);
+        self.supervisor.set_path_distance(None);
         self.supervised_line = None;
         let session = Session::new(p);
         let nominal_s = session.nominal_duration();

@@ -188,3 +188,54 @@ fn resume_refuses_another_job() {
     .err();
     assert_eq!(err, Some(GuidanceError::DifferentJob));
 }
+
+#[test]
+fn distance_from_path_is_to_the_path_not_to_a_segment_extension() {
+    let cfg = Config::default();
+    let plan = JobPlan::from(segment_job());
+    let job = cfg.job_definition().with_plan(&plan);
+    let mut g = Guidance::new(plan, job, guidance_params(&cfg)).unwrap();
+    let up = std::f64::consts::FRAC_PI_2;
+    // To the end of the first line: the turn (a semicircle of radius 5 from (0, 30)) starts.
+    for y in 0..=30 {
+        g.update(&Pose::new(0.0, y as f64, up)).unwrap();
+    }
+    assert_eq!(g.phase(), Phase::Turn);
+    // 2 m short of the turn's start along its first chord (rolled past it before a cusp): on
+    // the chord's extension, 0 m; 1.5 m beside that, 1.5 m.
+    let d = |g: &Guidance, x: f64, y: f64| g.distance_from_path(&Pose::new(x, y, up)).unwrap();
+    let (a, b) = (g.global_path()[0].pos, g.global_path()[1].pos);
+    let u = (b - a) / (b - a).norm();
+    let back = a - u * 2.0;
+    let left = Vec2::new(-u.y, u.x);
+    assert!(d(&g, back.x, back.y) < 1e-9, "{}", d(&g, back.x, back.y));
+    let beside = back + left * 1.5;
+    assert!((d(&g, beside.x, beside.y) - 1.5).abs() < 1e-9);
+    // At the top of the arc, 2 m outside it: 2 m (to the chords, a little more).
+    g.update(&Pose::new(5.0, 35.0, 0.0)).unwrap();
+    assert!(
+        (d(&g, 5.0, 37.0) - 2.0).abs() < 0.05,
+        "{}",
+        d(&g, 5.0, 37.0)
+    );
+    // 50 m away along the chord there: the cross-track error to the chord's line is 0, the
+    // distance from the path is not.
+    let i = g.index_global();
+    let (a, b) = (g.global_path()[i].pos, g.global_path()[i + 1].pos);
+    let p = a + (b - a) / (b - a).norm() * 50.0;
+    let far = Pose::new(p.x, p.y, 0.0);
+    let (xte, _) = g.errors(&far).unwrap();
+    assert!(xte.abs() < 1e-9, "{xte}");
+    assert!(g.distance_from_path(&far).unwrap() > 40.0);
+    // Finished: no path.
+    for _ in 0..100 {
+        let path = g.global_path();
+        let p = path[path.len() - 1].pos;
+        g.update(&Pose::new(p.x, p.y, -up)).unwrap();
+        if g.is_finished() {
+            break;
+        }
+    }
+    assert!(g.is_finished());
+    assert_eq!(g.distance_from_path(&far), None);
+}
