@@ -51,6 +51,9 @@ pub struct NodeStatus {
     pub fix: FixQuality,
     pub xte_m: Option<f64>,
     pub heading_error_deg: Option<f64>,
+    /// Distance from the path being driven, to its nearest segment, m: what `off_path` watches
+    /// off work lines (`safety.off_path_m`).
+    pub path_distance_m: Option<f64>,
     pub line: u64,
     pub block: u64,
     pub lines_done: u64,
@@ -233,6 +236,7 @@ impl ControllerNode {
                 engage_refusal: FaultCode::None,
                 fix: FixQuality::None,
                 xte_m: None,
+                path_distance_m: None,
                 heading_error_deg: None,
                 line: 0,
                 block: 0,
@@ -742,6 +746,7 @@ impl ControllerNode {
             engage_refusal: refusal,
             xte_m: c.xte,
             heading_error_deg: c.heading_error.map(f64::to_degrees),
+            path_distance_m: self.supervisor.path_distance(),
             line: g.current_line(),
             block: g.index_block(),
             lines_done: g.lines_done(),

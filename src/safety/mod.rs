@@ -280,6 +280,11 @@ impl Supervisor {
         self.path_distance = distance.filter(|d| d.is_finite());
     }
 
+    /// The vehicle's distance from the path, as last set, m.
+    pub fn path_distance(&self) -> Option<f64> {
+        self.path_distance
+    }
+
     /// The path's curvature at the vehicle this period, 1/m (positive left): a swing of the
     /// cross-track error that follows a change of the path's bend is the path's, not a weave
     /// (see [`tracking`]).
