@@ -117,6 +117,8 @@ pub struct ControllerNode {
     guidance_failing: bool,
     /// The work line the supervisor watches (None: none).
     supervised_line: Option<u64>,
+    /// The segment of a segment job seen last (a gap is looked for when it changes).
+    supervised_segment: Option<usize>,
     last_request: Option<DirectionRequestDirection>,
     /// The wheel-angle sensor: gain and offset (rad), see [`BusParams::was_gain`].
     was_gain: f64,
@@ -212,6 +214,7 @@ impl ControllerNode {
             no_approach: false,
             guidance_failing: false,
             supervised_line: None,
+            supervised_segment: None,
             last_request: None,
             was_gain: if bus.was_gain.is_finite() && bus.was_gain > 0.0 {
                 bus.was_gain
@@ -496,6 +499,7 @@ impl ControllerNode {
         self.cusp = false;
         self.approach_refused = false;
         self.supervised_line = None;
+        self.supervised_segment = None;
         self.last_request = None;
         tracing::info!(job, "operator: job selected");
     }

@@ -534,6 +534,27 @@ impl Guidance {
             .reduce(f64::min)
     }
 
+    /// Where a segment job's current segment does not start where the previous one ended (a
+    /// gap the planner left: no clear transit between them, "drive there by hand"): the
+    /// distance across it, m. `None` where the segments join (within [`GAP_M`]), on the first
+    /// segment, while approaching and for AB jobs.
+    pub fn gap_before(&self) -> Option<f64> {
+        let JobPlan::Segments(job) = &self.plan else {
+            return None;
+        };
+        if self.approach_index.is_some() || self.phase == Phase::Finished {
+            return None;
+        }
+        let segments = job.segments();
+        let previous = segments
+            .get(self.index_rank.checked_sub(1)?)?
+            .points
+            .last()?;
+        let start = segments.get(self.index_rank)?.points.first()?;
+        let d = (start - previous).norm();
+        (d > GAP_M).then_some(d)
+    }
+
     /// The AB plan, when this is an AB job.
     pub fn plan(&self) -> Option<&AbPlan> {
         self.ab()
@@ -649,6 +670,10 @@ impl Guidance {
 
 mod approach;
 use approach::{point_at_distance, Rejoin};
+
+/// Segments of a job whose ends are farther apart than this do not join: a gap, m. (A plan's
+/// segments join exactly; a cusp starts where the segment before it ended.)
+pub const GAP_M: f64 = 0.5;
 
 #[cfg(test)]
 mod tests;

@@ -56,11 +56,16 @@ pub enum FaultCode {
     /// Farther than `safety.off_path_m` from a turn's, transit's, approach's or reversing
     /// path for `safety.off_line_time_s` ([`super::tracking`]).
     OffPath = 23,
+    /// The job's next segment does not start where the last one ended: the plan has a gap
+    /// there (the planner found no clear transit and said "drive there by hand"). The steering
+    /// is given back at the gap and held until the operator acknowledges; engaged again at the
+    /// segment, the engage gate (or an approach path) takes the tractor onto it.
+    PathGap = 24,
 }
 
 impl FaultCode {
     /// Every code, in bus order.
-    pub const ALL: [FaultCode; 24] = [
+    pub const ALL: [FaultCode; 25] = [
         FaultCode::None,
         FaultCode::GnssTimeout,
         FaultCode::FixQuality,
@@ -85,5 +90,6 @@ impl FaultCode {
         FaultCode::HeadingMismatch,
         FaultCode::NoApproachPath,
         FaultCode::OffPath,
+        FaultCode::PathGap,
     ];
 }

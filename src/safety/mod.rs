@@ -459,6 +459,15 @@ impl Supervisor {
         }
     }
 
+    /// The path being driven ends here and the next does not start here (a gap in the plan):
+    /// engaged, the steering is given back with `code` at the next step, held like a tracking
+    /// fault (until a line change or the operator acknowledges).
+    pub fn give_back(&mut self, code: FaultCode) {
+        if self.state == SafetyState::Engaged {
+            self.tracking_latch = Some(code);
+        }
+    }
+
     /// The operator acknowledged a held tracking fault (a disengage command while in it): the
     /// line may be engaged again.
     pub fn acknowledge(&mut self) {

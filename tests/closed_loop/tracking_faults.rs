@@ -162,3 +162,84 @@ fn a_turn_the_tractor_cannot_make_is_given_back_off_path() {
         r.disengage_events
     );
 }
+
+/// A segment job whose third segment starts 15 m from where the second ends (a gap the planner
+/// left: no clear transit there). Swaths north and south 12 m apart, a semicircle of 6 m
+/// between them.
+fn job_with_a_gap() -> agsteer::guidance::JobPlan {
+    use agsteer::geo::{v2, Direction, Vec2};
+    use agsteer::plan::coverage::SegmentKind;
+    use agsteer::plan::job::{JobSegment, SegmentJob};
+    let line = |x: f64, up: bool| -> Vec<Vec2> {
+        let pts: Vec<Vec2> = (0..=60).map(|i| v2(x, i as f64)).collect();
+        if up {
+            pts
+        } else {
+            pts.into_iter().rev().collect()
+        }
+    };
+    let arc: Vec<Vec2> = (0..=30)
+        .map(|i| {
+            let a = std::f64::consts::PI * (1.0 - i as f64 / 30.0);
+            v2(6.0 + 6.0 * a.cos(), 60.0 + 6.0 * a.sin())
+        })
+        .collect();
+    let seg = |kind, points| JobSegment {
+        kind,
+        direction: Direction::Forward,
+        cell: 0,
+        points,
+    };
+    agsteer::guidance::JobPlan::from(
+        SegmentJob::new(vec![
+            seg(SegmentKind::Work, line(0.0, true)),
+            seg(SegmentKind::Turn, arc),
+            seg(SegmentKind::Work, line(12.0, false)),
+            seg(SegmentKind::Work, line(27.0, true)),
+        ])
+        .expect("a valid job"),
+    )
+}
+
+#[test]
+fn a_gap_in_the_plan_is_not_steered_across() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/config/demo-field.toml");
+    let cfg = Config::load(std::path::Path::new(path), &[]).expect("valid configuration");
+    let mut started = Vec::new();
+    let r = run(
+        &cfg,
+        &DemoOptions {
+            job: Some(job_with_a_gap()),
+            ..Default::default()
+        },
+        &mut |_| {},
+        &mut |t, ev| {
+            if let agsteer::guidance::Event::LineStarted { rank, .. } = ev {
+                started.push((t, *rank));
+            }
+        },
+    )
+    .expect("the run");
+    // Given back as the segment after the gap starts, in the same control period or the next.
+    let first = r
+        .disengage_events
+        .first()
+        .cloned()
+        .unwrap_or_else(|| panic!("no disengagement: {:?}", r.report));
+    assert_eq!(first.1, "path_gap", "{:?}", r.disengage_events);
+    let (t_start, _) = *started
+        .iter()
+        .find(|(_, rank)| *rank == 3)
+        .unwrap_or_else(|| panic!("segment 3 never started: {started:?}"));
+    let dt = cfg.control.dt_s;
+    assert!(
+        first.0 >= t_start && first.0 - t_start <= 2.0 * dt + 1e-9,
+        "given back at {} s, segment 3 started at {t_start} s",
+        first.0
+    );
+    // Held: the simulated operator, who engages whenever the system is ready, is refused.
+    assert_eq!(r.disengage_events.len(), 1, "{:?}", r.disengage_events);
+    assert!(!r.report.finished);
+    // The swaths before the gap were driven (and the turn between them).
+    assert_eq!(r.report.lines_completed, 3, "{:?}", r.report);
+}

@@ -1,10 +1,13 @@
 //! What the node tells the supervisor about the path each period: which work line is driven
-//! (its tracking supervised: [`crate::safety::tracking`]) and, on every other path, how far the
-//! vehicle is from it (`off_path`).
+//! (its tracking supervised: [`crate::safety::tracking`]), on every other path how far the
+//! vehicle is from it (`off_path`), and a gap in the plan before the segment just started
+//! (`path_gap`: the steering given back there, not steered across ground the planner found no
+//! clear way over).
 
 use super::ControllerNode;
 use crate::estimate::VehicleEstimate;
 use crate::geo::Direction;
+use crate::safety::FaultCode;
 
 impl ControllerNode {
     /// Tells the supervisor which work line is driven (work lines driven forward; not turns,
@@ -30,6 +33,20 @@ impl ControllerNode {
                 0.0
             };
             self.supervisor.set_line(line, k);
+        }
+        // A gap in the plan before the segment just started: not steered across.
+        let g = self.ctrl.guidance();
+        let segment = (!g.is_approaching()).then(|| g.index_rank());
+        if segment != self.supervised_segment {
+            if let (Some(_), Some(gap)) = (self.supervised_segment, g.gap_before()) {
+                tracing::warn!(
+                    segment = g.index_rank(),
+                    gap_m = format_args!("{gap:.1}"),
+                    "the plan has a gap here: steering given back (drive to the segment's start)"
+                );
+                self.supervisor.give_back(FaultCode::PathGap);
+            }
+            self.supervised_segment = segment;
         }
     }
 }

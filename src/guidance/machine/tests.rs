@@ -239,3 +239,46 @@ fn distance_from_path_is_to_the_path_not_to_a_segment_extension() {
     assert!(g.is_finished());
     assert_eq!(g.distance_from_path(&far), None);
 }
+
+#[test]
+fn a_gap_between_segments_is_reported_where_the_segment_after_it_starts() {
+    let cfg = Config::default();
+    let mut segments = segment_job().segments().to_vec();
+    // The last swath moved 4 m east: 4 m from the turn's end to its start.
+    for p in &mut segments[2].points {
+        p.x += 4.0;
+    }
+    let plan = JobPlan::from(crate::plan::job::SegmentJob::new(segments).unwrap());
+    let job = cfg.job_definition().with_plan(&plan);
+    let mut g = Guidance::new(plan, job, guidance_params(&cfg)).unwrap();
+    let mut seen = Vec::new();
+    for _ in 0..100_000 {
+        if g.is_finished() {
+            break;
+        }
+        seen.push((g.index_rank(), g.gap_before()));
+        let path = g.global_path();
+        let i = (g.index_global() + 1).min(path.len() - 1);
+        let d = path[i].pos - path[i - 1].pos;
+        g.update(&Pose::new(path[i].pos.x, path[i].pos.y, d.y.atan2(d.x)))
+            .unwrap();
+    }
+    seen.dedup();
+    assert_eq!(seen.len(), 3, "{seen:?}");
+    assert_eq!(seen[0], (0, None));
+    assert_eq!(seen[1], (1, None), "the turn starts where the swath ends");
+    assert_eq!(seen[2].0, 2);
+    assert!((seen[2].1.expect("a gap") - 4.0).abs() < 1e-9, "{seen:?}");
+    // The job as planned joins everywhere: none.
+    let plan = JobPlan::from(segment_job());
+    let job = cfg.job_definition().with_plan(&plan);
+    let mut g = Guidance::new(plan, job, guidance_params(&cfg)).unwrap();
+    while !g.is_finished() {
+        assert_eq!(g.gap_before(), None, "segment {}", g.index_rank());
+        let path = g.global_path();
+        let i = (g.index_global() + 1).min(path.len() - 1);
+        let d = path[i].pos - path[i - 1].pos;
+        g.update(&Pose::new(path[i].pos.x, path[i].pos.y, d.y.atan2(d.x)))
+            .unwrap();
+    }
+}
