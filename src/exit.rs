@@ -29,7 +29,8 @@ pub enum Exit {
     /// `agsteer plan`: the plan breaks one of its guarantees (written for inspection, must not
     /// be driven).
     PlanViolation = 4,
-    /// `agsteer plan`: no swath fits the field.
+    /// `agsteer plan`: no swath fits the field; a command that sets up a field job (`demo`): a
+    /// field job with nothing to drive for that reason.
     NoSwath = 5,
     /// `agsteer demo`: the job did not finish (a fault stopped it, or time ran out);
     /// `agsteer accuracy`: a scenario of a tracker held to the limits did not finish.
@@ -77,7 +78,7 @@ impl Exit {
             Exit::Invalid => "usage or configuration error (the key, value and limit named)",
             Exit::NoPath => "maneuver: no path found",
             Exit::PlanViolation => "plan: the plan breaks a guarantee (written, not to be driven)",
-            Exit::NoSwath => "plan: no swath fits the field",
+            Exit::NoSwath => "plan, demo: no swath fits the field",
             Exit::NotFinished => "demo, accuracy: the job did not finish",
             Exit::AccuracyNotMet => {
                 "demo, accuracy: finished outside the documented accuracy ([acceptance])"

@@ -85,7 +85,7 @@ impl Default for SafetyConfig {
             off_line_m: 2.0,
             off_line_time_s: 0.5,
             off_line_acquire_m: 30.0,
-            off_path_m: 3.0,
+            off_path_m: 4.0,
             unstable_xte_m: 0.2,
             unstable_wheel_deg: 3.0,
             unstable_swings: 4,

@@ -56,6 +56,9 @@ pub enum FieldJobError {
         count: usize,
         first: Box<crate::plan::coverage::metrics::checks::Violation>,
     },
+    /// The plan has nothing to drive (no swath, no headland pass fits).
+    #[error("nothing to drive in {}: {reason}", path.display())]
+    Empty { path: PathBuf, reason: String },
     #[error("the coverage plan of {} cannot be driven as a segment job", path.display())]
     Job {
         path: PathBuf,
@@ -139,6 +142,12 @@ impl FieldJob {
             source,
         })?;
         let plan_time = start.elapsed();
+        if plan.segments.is_empty() {
+            return Err(FieldJobError::Empty {
+                path: path.to_path_buf(),
+                reason: crate::plan::coverage::narrow::no_swath_words(&loaded.field, params),
+            });
+        }
         // The independent checks (issue 17 point 2): the daemon, the demo and the simulator
         // never drive a plan that breaks a guarantee; `agsteer plan` writes it for inspection.
         let violations = crate::plan::coverage::metrics::checks::check_plan(

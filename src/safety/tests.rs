@@ -323,8 +323,8 @@ fn an_offset_on_a_work_line_is_off_line_and_the_operator_acknowledges_it() {
 
 #[test]
 fn the_work_line_checks_do_not_watch_other_paths() {
-    // A weave and an offset of 2.5 m (beyond off_line, within off_path) in a turn: its own
-    // design, not a fault.
+    // A weave and an offset of 2.5 m (beyond off_line, within off_path) in a turn: not a
+    // fault.
     let (mut s, mut t) = engaged_on_a_line(SafetyParams::default());
     s.set_line(None, 0.0);
     let start = t;
@@ -353,7 +353,7 @@ fn a_turn_lost_is_off_path_held_until_a_line_or_the_operator() {
     while t < start + 10.0 {
         t += DT;
         feed_good(&mut s, t);
-        // 1 m off for 2 s, then drifting away at 1 m/s: beyond 3 m from 4 s.
+        // 1 m off for 2 s, then drifting away at 1 m/s: beyond 4 m from 5 s.
         let d = if t - start < 2.0 {
             1.0
         } else {
@@ -361,7 +361,7 @@ fn a_turn_lost_is_off_path_held_until_a_line_or_the_operator() {
         };
         s.set_path_distance(Some(d));
         // An unknown distance (no pose) for one period restarts the timing.
-        if (t - start - 4.2).abs() < 0.5 * DT {
+        if (t - start - 5.2).abs() < 0.5 * DT {
             s.set_path_distance(None);
         }
         let c = s.step(t, Some(0.0), Some(0.0), Some(0.0));
@@ -372,7 +372,7 @@ fn a_turn_lost_is_off_path_held_until_a_line_or_the_operator() {
         }
     }
     let at = fault_at.expect("a lost turn must disengage");
-    assert!((at - 4.72).abs() <= 2.0 * DT + 1e-9, "{at}");
+    assert!((at - 5.72).abs() <= 2.0 * DT + 1e-9, "{at}");
     // Held: back near the path, an engage is refused.
     s.set_path_distance(Some(0.1));
     t += DT;

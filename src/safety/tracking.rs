@@ -82,7 +82,7 @@ impl Default for TrackingParams {
             unstable_swings: 4,
             unstable_window: 40.0,
             wheel_mean_tau: 2.0,
-            off_path: 3.0,
+            off_path: 4.0,
         }
     }
 }

@@ -176,6 +176,21 @@ fn planning_commands_exit_with_their_own_statuses() {
     let field = field.display().to_string();
     let out = dir.path().join("plan").display().to_string();
     agsteer(&["plan", "--field", &field, "--out", &out]).is(Exit::NoSwath, &["no swath fits"]);
+    // The same field as a field job: nothing to drive, the same status and reason (not "a
+    // segment job needs at least one segment").
+    let field_path = format!("job.field_path={field}");
+    let demo_out = dir.path().join("demo").display().to_string();
+    let r = agsteer(&[
+        "demo",
+        "--config",
+        "config/demo-field.toml",
+        "--set",
+        &field_path,
+        "--out",
+        &demo_out,
+    ]);
+    r.is(Exit::NoSwath, &["nothing to drive in", "no swath fits"]);
+    assert!(!r.stderr.contains("segment job"), "{}", r.stderr);
 }
 
 #[test]

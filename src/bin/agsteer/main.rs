@@ -468,7 +468,8 @@ fn main() -> ExitCode {
 
 /// The status of a failed command: [`Exit::Invalid`] when an invalid configuration (or
 /// `--set`) caused it, [`Exit::PlanViolation`] when a field job's plan breaks a guarantee
-/// (refused, not driven), [`Exit::Error`] otherwise (a file that cannot be read included).
+/// (refused, not driven), [`Exit::NoSwath`] when it has nothing to drive, [`Exit::Error`]
+/// otherwise (a file that cannot be read included).
 fn exit_for_error(e: &anyhow::Error) -> Exit {
     use agsteer::config::ConfigError;
     use agsteer::job::field::FieldJobError;
@@ -479,6 +480,14 @@ fn exit_for_error(e: &anyhow::Error) -> Exit {
         )
     }) {
         return Exit::PlanViolation;
+    }
+    if e.chain().any(|c| {
+        matches!(
+            c.downcast_ref::<FieldJobError>(),
+            Some(FieldJobError::Empty { .. })
+        )
+    }) {
+        return Exit::NoSwath;
     }
     let invalid = e.chain().any(|c| {
         matches!(

@@ -345,18 +345,7 @@ fn refusal(
         ),
         None => String::new(),
     };
-    let reason = match agsteer::plan::coverage::narrow::no_swath_reason(field, params) {
-        Some(why) => why.to_string(),
-        None => {
-            let area = (field.boundary.clone(), field.obstacles.clone());
-            let width = agsteer::plan::coverage::geometry::inscribed_width(&area);
-            format!(
-                "no swath fits the field ({width:.1} m wide at its widest, implement {:.1} m, turn diameter {:.1} m)",
-                params.line_width,
-                2.0 * params.r_min
-            )
-        }
-    };
+    let reason = agsteer::plan::coverage::narrow::no_swath_words(field, params);
     Some(format!("{reason}{short}"))
 }
 

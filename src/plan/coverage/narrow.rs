@@ -83,6 +83,23 @@ pub fn no_swath_reason(field: &Field, p: &CoverageParams) -> Option<headland::No
     Some(why)
 }
 
+/// Why no swath fits `field` at `p`, in words for the operator: [`no_swath_reason`], or else
+/// the field's width at its widest against the implement and the turn diameter.
+pub fn no_swath_words(field: &Field, p: &CoverageParams) -> String {
+    match no_swath_reason(field, p) {
+        Some(why) => why.to_string(),
+        None => {
+            let area = (field.boundary.clone(), field.obstacles.clone());
+            let width = super::geometry::inscribed_width(&area);
+            format!(
+                "no swath fits the field ({width:.1} m wide at its widest, implement {:.1} m, turn diameter {:.1} m)",
+                p.line_width,
+                2.0 * p.r_min
+            )
+        }
+    }
+}
+
 /// The largest implement width at which [`super::plan_field`] plans swaths, trying `start` and
 /// then 0.5 m narrower each time, at most `tries` plans; `None` when none of them has a swath.
 pub fn largest_planned_width(
