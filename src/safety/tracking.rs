@@ -23,7 +23,9 @@
 //!   engaged near the limit, or out of a turn, that never converges);
 //! - `off_path`: on every other path the tractor is steered along — turns, transits,
 //!   approaches, anything driven in reverse — the distance from the path (to its nearest
-//!   segment, not to a segment's extension) beyond `off_path` for longer than `off_line_time`.
+//!   segment, not to a segment's extension; beyond the path's ends, to the end segment's
+//!   extension, where the tractor rolls on past a cusp) beyond `off_path` for longer than
+//!   `off_line_time`.
 //!   Those paths are short and curved, and an error there is not an offset to hold on to: a
 //!   plant that cannot turn as tight as the plan, or loses the path at a cusp, would otherwise
 //!   be steered on after it, the work-line checks waiting for a line it never reaches. No
@@ -300,9 +302,7 @@ impl TrackingMonitor {
         }
         verdict
     }
-}
 
-impl TrackingMonitor {
     /// One engaged period at `t` on a path that is not a work line (a turn, a transit, an
     /// approach, reversing): `distance` from the path, m (None: no path or no pose, which
     /// restarts the timing).

@@ -473,21 +473,10 @@ fn main() -> ExitCode {
 fn exit_for_error(e: &anyhow::Error) -> Exit {
     use agsteer::config::ConfigError;
     use agsteer::job::field::FieldJobError;
-    if e.chain().any(|c| {
-        matches!(
-            c.downcast_ref::<FieldJobError>(),
-            Some(FieldJobError::Violates { .. })
-        )
-    }) {
-        return Exit::PlanViolation;
-    }
-    if e.chain().any(|c| {
-        matches!(
-            c.downcast_ref::<FieldJobError>(),
-            Some(FieldJobError::Empty { .. })
-        )
-    }) {
-        return Exit::NoSwath;
+    match e.chain().find_map(|c| c.downcast_ref::<FieldJobError>()) {
+        Some(FieldJobError::Violates { .. }) => return Exit::PlanViolation,
+        Some(FieldJobError::Empty { .. }) => return Exit::NoSwath,
+        _ => {}
     }
     let invalid = e.chain().any(|c| {
         matches!(
