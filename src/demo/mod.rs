@@ -7,13 +7,14 @@
 pub mod accuracy;
 pub mod calibrate;
 pub mod envelope;
+mod score;
 pub mod svg;
 
 use crate::can::bus::{CanBus, MemBus};
 use crate::can::codec::{OperatorCommand, Packer};
 use crate::can::Frame;
 use crate::config::{Config, JobKind, TrackerChoice};
-use crate::geo::{left_normal, signed_offset, v2, Pose, Vec2};
+use crate::geo::{left_normal, v2, Pose, Vec2};
 use crate::guidance::progress::{Phase, Progress};
 use crate::guidance::{Event, JobPlan};
 use crate::job::JobError;
@@ -21,6 +22,10 @@ use crate::safety::SafetyState;
 use crate::sim::can_node::{Scenario, SimAddresses, SimNode};
 use crate::sim::Simulator;
 use serde::Serialize;
+
+pub use score::XteStats;
+pub(crate) use score::{cumulative_lengths, nearest_on_polyline};
+use score::{ScoredPath, SegmentScore};
 
 /// Work-line samples closer than this to the line start are excluded from the XTE figures, m.
 pub const ACQUISITION_SKIP_M: f64 = 10.0;
@@ -32,76 +37,6 @@ const TRACE_SPACING_M: f64 = 0.5;
 /// The simulator's parameters from the configuration ([`Config::sim_params`]).
 pub fn sim_params(cfg: &Config) -> crate::sim::SimParams {
     cfg.sim_params()
-}
-
-/// |XTE| statistics in constant memory: a histogram of 0.1 mm bins up to 2 m.
-#[derive(Debug, Clone)]
-pub struct XteStats {
-    bins: Vec<u32>,
-    overflow: u64,
-    count: u64,
-    sum_sq: f64,
-    max: f64,
-}
-
-const BIN_M: f64 = 1e-4;
-const BINS: usize = 20_000;
-
-impl Default for XteStats {
-    fn default() -> Self {
-        XteStats {
-            bins: vec![0; BINS],
-            overflow: 0,
-            count: 0,
-            sum_sq: 0.0,
-            max: 0.0,
-        }
-    }
-}
-
-impl XteStats {
-    pub fn add(&mut self, xte: f64) {
-        let a = xte.abs();
-        if !a.is_finite() {
-            return;
-        }
-        let i = (a / BIN_M) as usize;
-        match self.bins.get_mut(i) {
-            Some(b) => *b += 1,
-            None => self.overflow += 1,
-        }
-        self.count += 1;
-        self.sum_sq += a * a;
-        self.max = self.max.max(a);
-    }
-    pub fn count(&self) -> u64 {
-        self.count
-    }
-    pub fn rms(&self) -> f64 {
-        if self.count == 0 {
-            0.0
-        } else {
-            (self.sum_sq / self.count as f64).sqrt()
-        }
-    }
-    pub fn max(&self) -> f64 {
-        self.max
-    }
-    /// The `q` quantile (0..1), to the bin resolution (upper bin edge).
-    pub fn quantile(&self, q: f64) -> f64 {
-        if self.count == 0 {
-            return 0.0;
-        }
-        let target = (q * self.count as f64).ceil().max(1.0) as u64;
-        let mut seen = 0u64;
-        for (i, &b) in self.bins.iter().enumerate() {
-            seen += b as u64;
-            if seen >= target {
-                return ((i + 1) as f64 * BIN_M).min(self.max);
-            }
-        }
-        self.max
-    }
 }
 
 /// The demo report (`report.json`).
@@ -129,6 +64,11 @@ pub struct Report {
     pub tracker: String,
     /// Fraction of control periods steered by agsteer (engaged).
     pub engaged_fraction: f64,
+    /// The run ended here: the steering was given back with a held tracking fault (`off_line`,
+    /// `tracking_unstable`, `off_path`, `path_gap`) that only a line change or the operator
+    /// clears, and a driver takes over (`None` when the run went on to its end).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub given_back: Option<GivenBack>,
     /// Frames on the in-memory bus (both directions).
     pub frames: u64,
     /// Why agsteer stopped steering, by fault, counted per disengagement.
@@ -153,6 +93,17 @@ pub struct Report {
     pub plan: Option<crate::field::output::PlanSummary>,
 }
 
+/// Where a run ended with the steering given back ([`Report::given_back`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct GivenBack {
+    /// The held fault's configuration name.
+    pub fault: String,
+    /// Simulated time, s.
+    pub t_s: f64,
+    /// True distance of the rear axle from the path then, m (`null` with no path).
+    pub path_distance_m: Option<f64>,
+}
+
 /// Tracking on one segment of a segment job, from the simulator's true pose over the whole
 /// segment (no acquisition skip).
 #[derive(Debug, Clone, Serialize)]
@@ -163,14 +114,6 @@ pub struct SegmentReport {
     pub length_m: f64,
     pub xte_rms_m: f64,
     pub xte_max_m: f64,
-}
-
-/// Running |XTE| of one segment.
-#[derive(Debug, Clone, Copy, Default)]
-struct SegmentScore {
-    count: u64,
-    sum_sq: f64,
-    max: f64,
 }
 
 /// What to record and where to start.
@@ -204,6 +147,10 @@ pub struct DemoOptions {
     pub record_work: bool,
     /// The field approach paths must stay in (local ENU, as the job).
     pub field: Option<crate::plan::coverage::Field>,
+    /// Drive on after the steering was given back with a held tracking fault (the simulated
+    /// driver holds the wheel and waits for the next line). By default the run ends there, as
+    /// a driver takes over: the report then names the fault ([`Report::given_back`]).
+    pub drive_on_after_held_fault: bool,
 }
 
 /// One work pass as driven (recorded with [`DemoOptions::record_work`]).
@@ -248,101 +195,6 @@ pub struct Trace {
     pub outlines: Vec<Vec<Vec2>>,
 }
 
-/// The cumulative lengths of the polyline `points` into `out` (cleared first), m: 0 at the
-/// first point.
-pub(crate) fn cumulative_lengths(points: &[Vec2], out: &mut Vec<f64>) {
-    out.clear();
-    let mut s = 0.0;
-    out.push(0.0);
-    for w in points.windows(2) {
-        s += (w[1] - w[0]).norm();
-        out.push(s);
-    }
-}
-
-/// The nearest point to `p` on the segments `segments` (indices of their first points) of the
-/// polyline `points` with cumulative lengths `cumulative`: (distance along m, signed offset m,
-/// positive left). With `extend_ends`, beyond the polyline's ends the distance along keeps
-/// counting along its end segments (negative before the start). `None` for fewer than two
-/// points.
-pub(crate) fn nearest_on_polyline(
-    points: &[Vec2],
-    cumulative: &[f64],
-    p: &Vec2,
-    segments: std::ops::RangeInclusive<usize>,
-    extend_ends: bool,
-) -> Option<(f64, f64)> {
-    let n = points.len();
-    if n < 2 {
-        return None;
-    }
-    let mut best: Option<(f64, f64, f64)> = None;
-    for i in segments {
-        let a = points[i];
-        let d = points[i + 1] - a;
-        let len = d.norm();
-        if len <= 0.0 {
-            continue;
-        }
-        let dir = d / len;
-        let t = (p - a).dot(&dir);
-        let tc = t.clamp(0.0, len);
-        let dist = (p - (a + dir * tc)).norm();
-        if best.is_none_or(|b| dist < b.0) {
-            let along_seg = if extend_ends && ((i == 0 && t < 0.0) || (i == n - 2 && t > len)) {
-                t
-            } else {
-                tc
-            };
-            best = Some((dist, cumulative[i] + along_seg, signed_offset(p, &a, &dir)));
-        }
-    }
-    best.map(|(_, along, offset)| (along, offset))
-}
-
-/// The work path being scored against the true pose, with its cumulative lengths.
-#[derive(Debug, Default)]
-struct ScoredPath {
-    /// (block, rank) of the guidance path this is.
-    key: Option<(u64, usize)>,
-    points: Vec<Vec2>,
-    cumulative: Vec<f64>,
-}
-
-impl ScoredPath {
-    /// Whether this is the guidance's current path: the same (block, rank) and the same first
-    /// point. The first point alone is not enough: a field plan's transit starts exactly where
-    /// the closed headland pass before it started and ended.
-    fn is_current(&self, g: &crate::guidance::Guidance) -> bool {
-        self.key == Some((g.index_block(), g.index_rank()))
-            && self.points.first().copied() == g.global_path().first().map(|p| p.pos)
-    }
-
-    fn set(&mut self, g: &crate::guidance::Guidance) {
-        self.key = Some((g.index_block(), g.index_rank()));
-        let path = g.global_path();
-        self.points.clear();
-        self.points.extend(path.iter().map(|p| p.pos));
-        cumulative_lengths(&self.points, &mut self.cumulative);
-    }
-
-    fn length(&self) -> f64 {
-        self.cumulative.last().copied().unwrap_or(0.0)
-    }
-
-    /// Distance along the path and signed cross-track error (positive left) of `p`, from the
-    /// nearest path segment within a few points of `hint`.
-    fn locate(&self, p: &Vec2, hint: usize) -> Option<(f64, f64)> {
-        let n = self.points.len();
-        if n < 2 {
-            return None;
-        }
-        let lo = hint.saturating_sub(4).min(n - 2);
-        let hi = (hint + 4).min(n - 2);
-        nearest_on_polyline(&self.points, &self.cumulative, p, lo..=hi, true)
-    }
-}
-
 /// A finished run.
 #[derive(Debug, Clone)]
 pub struct DemoRun {
@@ -356,6 +208,14 @@ pub struct DemoRun {
     pub disengage_events: Vec<(f64, String)>,
     /// The work passes driven, when [`DemoOptions::record_work`].
     pub work: Vec<WorkPass>,
+}
+
+/// A fault's configuration name (`off_line`), as the status and the reports spell it.
+fn fault_name(fault: crate::safety::FaultCode) -> String {
+    serde_json::to_value(fault)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_else(|| format!("{fault:?}"))
 }
 
 /// The configuration name of a tracker (`track.kind`).
@@ -515,6 +375,7 @@ pub fn run(
     let mut t = 0.0;
     let mut k: u64 = 0;
     let mut stopped = false;
+    let mut given_back = None;
 
     while t <= max_time {
         t = k as f64 * dt;
@@ -559,24 +420,31 @@ pub fn run(
                 engagements += 1;
             }
         } else if was_engaged {
-            let name = serde_json::to_value(cmd.fault)
-                .ok()
-                .and_then(|v| v.as_str().map(str::to_string))
-                .unwrap_or_else(|| format!("{:?}", cmd.fault));
+            let name = fault_name(cmd.fault);
             *disengagements.entry(name.clone()).or_insert(0) += 1;
             tracing::info!(t_s = format_args!("{t:.2}"), fault = %name, "disengaged");
             disengage_events.push((t, name));
+            // A held tracking fault: the driver takes over, the run ends here (once this
+            // period's events are handed on).
+            if let Some(held) = node
+                .supervisor()
+                .tracking_fault()
+                .filter(|_| !opts.drive_on_after_held_fault)
+            {
+                let truth = sim.sim().true_state();
+                given_back = Some(GivenBack {
+                    fault: fault_name(held),
+                    t_s: t,
+                    path_distance_m: node.controller().guidance().distance_from_path(&truth.pose),
+                });
+            }
         }
         was_engaged = cmd.engaged;
         let refusal = node.supervisor().last_refusal();
         if refusal != last_refusal {
             last_refusal = refusal;
             if refusal == crate::safety::FaultCode::LineUnfollowable {
-                let name = serde_json::to_value(refusal)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_string))
-                    .unwrap_or_else(|| format!("{refusal:?}"));
-                *refusals.entry(name).or_insert(0) += 1;
+                *refusals.entry(fault_name(refusal)).or_insert(0) += 1;
             }
         }
 
@@ -620,6 +488,9 @@ pub fn run(
                 stopped = true;
                 break;
             }
+        }
+        if given_back.is_some() {
+            break;
         }
         if node.controller().guidance().is_finished() {
             // A segment job ends with a stop request: let the vehicle come to rest (within
@@ -758,6 +629,7 @@ pub fn run(
         wall_time_s: wall.elapsed().as_secs_f64(),
         tracker: tracker_name(cfg.track.kind).to_string(),
         engaged_fraction: engaged_ticks as f64 / k.max(1) as f64,
+        given_back,
         frames,
         disengagements,
         refusals,

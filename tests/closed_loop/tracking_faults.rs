@@ -243,4 +243,24 @@ fn a_gap_in_the_plan_is_not_steered_across() {
     assert!(!r.report.finished);
     // The swaths before the gap were driven (and the turn between them).
     assert_eq!(r.report.lines_completed, 3, "{:?}", r.report);
+    // The run ends at the give-back, naming it: a driver takes over, and the report holds no
+    // figures of the tractor rolling on unsteered.
+    let given_back = r.report.given_back.as_ref().expect("the give-back named");
+    assert_eq!(given_back.fault, "path_gap");
+    assert!((given_back.t_s - first.0).abs() < 1e-9, "{given_back:?}");
+    assert!(r.report.sim_time_s <= first.0 + 1e-9, "{:?}", r.report);
+    // Asked to drive on, the simulated driver holds the wheel and the run goes on.
+    let on = run(
+        &cfg,
+        &DemoOptions {
+            job: Some(job_with_a_gap()),
+            drive_on_after_held_fault: true,
+            ..Default::default()
+        },
+        &mut |_| {},
+        &mut |_, _| {},
+    )
+    .expect("the run");
+    assert!(on.report.given_back.is_none(), "{:?}", on.report);
+    assert!(on.report.sim_time_s > first.0 + 10.0, "{:?}", on.report);
 }

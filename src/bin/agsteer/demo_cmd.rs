@@ -255,10 +255,19 @@ fn verdict(
                 .filter(|(k, _)| k.as_str() != "no_guidance")
                 .map(|(k, n)| format!("{k} {n}"))
                 .collect();
+            let given_back = r.given_back.as_ref().map_or(String::new(), |g| {
+                format!(
+                    "; the steering was given back ({}) at {:.1} s{} and the run ends there: a driver takes over",
+                    g.fault,
+                    g.t_s,
+                    g.path_distance_m
+                        .map_or(String::new(), |d| format!(", {d:.1} m from the path"))
+                )
+            });
             fail(
                 Exit::NotFinished,
                 format!(
-                    "the job did not finish: {}/{planned} lines in {:.0} s simulated (disengagements: {})",
+                    "the job did not finish: {}/{planned} lines in {:.0} s simulated (disengagements: {}){given_back}",
                     r.lines_completed,
                     r.sim_time_s,
                     if why.is_empty() { "none".to_string() } else { why.join(", ") }
