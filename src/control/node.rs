@@ -4,6 +4,7 @@
 
 mod calibration;
 mod commands;
+mod cusp;
 mod supervision;
 
 pub use calibration::CalibrationProgress;
@@ -28,6 +29,7 @@ use crate::safety::{
     CheckedInput, FaultCode, FixQuality, SafetyParams, SafetyState, SteeringCommand as Cmd,
     Supervisor,
 };
+use cusp::CuspParams;
 use serde::Serialize;
 
 /// A dual-antenna heading older than this is not used, s.
@@ -129,19 +131,6 @@ pub struct ControllerNode {
     calibration: calibration::CalibrationState,
 }
 
-/// How the node handles a change of driving direction (docs/METHODS.md, Manoeuvres at work: the
-/// daemon asks for it on the bus before each cusp, waits until the vehicle has stopped and turned,
-/// then steers on).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct CuspParams {
-    decel: f64,
-    stopped_speed: f64,
-    capture: f64,
-    /// Control period, s.
-    dt: f64,
-    min_speed: f64,
-}
-
 /// A control period this many dt after the previous one follows a pause of the loop's.
 const LATE_PERIOD: f64 = 1.5;
 
@@ -158,13 +147,6 @@ fn node_safety_params(safety: &SafetyParams, bus: &BusParams) -> SafetyParams {
         p.wheel_angle_timeout = bus.machine_info_timeout;
     }
     p
-}
-
-fn request_of(d: Direction) -> DirectionRequestDirection {
-    match d {
-        Direction::Forward => DirectionRequestDirection::Forward,
-        Direction::Reverse => DirectionRequestDirection::Reverse,
-    }
 }
 
 fn checked_input(link: CheckedLink) -> CheckedInput {
@@ -512,56 +494,6 @@ impl ControllerNode {
     /// The job driven: 0 the configured one, k the k-th recorded line.
     pub fn job_number(&self) -> u8 {
         self.operator.job
-    }
-
-    /// The direction to request this period, for segment jobs and approach paths (AB jobs
-    /// are driven forward and send none unless an approach path came first). Before a cusp: stop once within the stopping distance; when
-    /// stopped near the cusp, move on to the next segment and request its direction.
-    fn direction_request(&mut self, c: &super::ControlOutput) -> Option<DirectionRequestDirection> {
-        const STOP: DirectionRequestDirection = DirectionRequestDirection::Stop;
-        let p = self.cusps;
-        let g = self.ctrl.guidance();
-        // AB jobs send none, unless an approach path has made the node ask for a direction.
-        if !matches!(g.job_plan(), crate::guidance::JobPlan::Segments(_))
-            && !g.is_approaching()
-            && self.last_request.is_none()
-        {
-            return None;
-        }
-        if g.is_finished() {
-            self.cusp = false;
-            return Some(STOP);
-        }
-        let v = self.speed;
-        let stopped = v.abs() < p.stopped_speed;
-        let want = c.direction;
-        let moving = if v < 0.0 {
-            Direction::Reverse
-        } else {
-            Direction::Forward
-        };
-        // A cusp ahead, or the end of the job: stop there.
-        let next = g.next_direction();
-        if let Some(est) = c.estimate.filter(|_| next != Some(want)) {
-            let remaining = g.remaining(&est.pose.pos);
-            if remaining <= v * v / (2.0 * p.decel) + v.abs() * p.dt {
-                self.cusp = next.is_some();
-                if stopped && remaining <= p.capture {
-                    self.ctrl.guidance_mut().advance_segment();
-                    return Some(next.map(request_of).unwrap_or(STOP));
-                }
-                return Some(STOP);
-            }
-        }
-        if self.cusp && moving == want && v.abs() >= p.min_speed {
-            self.cusp = false;
-        }
-        if !stopped && moving != want {
-            // Still rolling the old way (e.g. past a cusp): stop first.
-            self.cusp = true;
-            return Some(STOP);
-        }
-        Some(request_of(want))
     }
 
     /// A period without an ISO 11783-5 address (claiming, lost, or Cannot Claim): nothing but

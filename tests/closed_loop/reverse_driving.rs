@@ -111,3 +111,64 @@ fn drives_a_job_with_two_cusps_closed_loop() {
         "max x {max_x}, then min {min_after}"
     );
 }
+
+/// Forward east along y = 0 for 40 m, then on east for `stub` m (a short piece of swath), then
+/// backing out along a quarter circle of radius 10 m that bends north (the tractor's rear
+/// going north-west).
+fn job_with_a_short_piece_before_the_cusp(stub: f64) -> SegmentJob {
+    let forward: Vec<Vec2> = (0..=80).map(|i| v2(i as f64 * 0.5, 0.0)).collect();
+    let piece = vec![v2(40.0, 0.0), v2(40.0 + stub, 0.0)];
+    let r = 10.0;
+    let back: Vec<Vec2> = (0..=30)
+        .map(|i| {
+            let a = std::f64::consts::FRAC_PI_2 * i as f64 / 30.0;
+            v2(40.0 + stub - r * a.sin(), r - r * a.cos())
+        })
+        .collect();
+    SegmentJob::new(vec![
+        seg(Direction::Forward, forward),
+        seg(Direction::Forward, piece),
+        seg(Direction::Reverse, back),
+    ])
+    .unwrap()
+}
+
+/// A cusp at the end of a piece shorter than the braking distance is braked for from the
+/// segment before it: at 10 km/h and the default 0.5 m/s² the tractor needs 7.7 m to stop,
+/// and a 0.5 m piece gave it none. It rolled on past the cusp steering for the backing-out
+/// curve and was 2.6 m off it on a real field's plan (`at_invekos_concave`, w 3 m r_min 8 m).
+#[test]
+fn a_cusp_after_a_piece_shorter_than_the_braking_distance_is_stopped_at() {
+    let mut cfg = Config::default();
+    cfg.control.speed_kmh = 10.0;
+    let stub = 0.5;
+    let run = run(
+        &cfg,
+        &DemoOptions {
+            job: Some(JobPlan::Segments(job_with_a_short_piece_before_the_cusp(
+                stub,
+            ))),
+            record_trace: true,
+            ..Default::default()
+        },
+        &mut |_| {},
+        &mut |_, _| {},
+    )
+    .unwrap();
+    let r = &run.report;
+    assert!(r.finished, "{r:?}");
+    // Stopped within the capture distance (1 m) of the cusp, not a braking distance past it.
+    let max_x = run
+        .trace
+        .points
+        .iter()
+        .map(|p| p.pos.x)
+        .fold(f64::MIN, f64::max);
+    assert!(max_x < 40.0 + stub + 1.0, "rolled on to x = {max_x:.2} m");
+    let back = r
+        .segments
+        .iter()
+        .find(|s| s.direction == Direction::Reverse)
+        .expect("the backing-out segment scored");
+    assert!(back.xte_max_m < 0.3, "backing out: {back:?}");
+}

@@ -282,3 +282,48 @@ fn a_gap_between_segments_is_reported_where_the_segment_after_it_starts() {
             .unwrap();
     }
 }
+
+#[test]
+fn the_segments_driven_the_same_way_count_up_to_the_next_cusp_or_the_end() {
+    use crate::geo::{v2, Direction};
+    use crate::plan::coverage::SegmentKind;
+    use crate::plan::job::{JobSegment, SegmentJob};
+    let cfg = Config::default();
+    let seg = |direction, x0: f64, x1: f64| JobSegment {
+        kind: SegmentKind::Work,
+        direction,
+        cell: 0,
+        points: vec![v2(x0, 0.0), v2(x1, 0.0)],
+    };
+    // Forward 20 m, forward 0.5 m and 1.5 m (short pieces), back 10 m, forward 10 m.
+    let job = SegmentJob::new(vec![
+        seg(Direction::Forward, 0.0, 20.0),
+        seg(Direction::Forward, 20.0, 20.5),
+        seg(Direction::Forward, 20.5, 22.0),
+        seg(Direction::Reverse, 22.0, 12.0),
+        seg(Direction::Forward, 12.0, 22.0),
+    ])
+    .unwrap();
+    let plan = JobPlan::from(job);
+    let definition = cfg.job_definition().with_plan(&plan);
+    let mut g = Guidance::new(plan, definition, guidance_params(&cfg)).unwrap();
+    let mut seen = Vec::new();
+    while seen.len() < 5 {
+        seen.push((g.index_rank(), g.same_way_after()));
+        g.advance_segment();
+    }
+    assert_eq!(g.index_rank(), 4);
+    let expected = [
+        (0, (2.0, true)),
+        (1, (1.5, true)),
+        (2, (0.0, true)),
+        (3, (0.0, true)),
+        (4, (0.0, false)),
+    ];
+    for ((rank, (length, cusp)), (want_rank, (want_length, want_cusp))) in seen.iter().zip(expected)
+    {
+        assert_eq!(*rank, want_rank);
+        assert!((length - want_length).abs() < 1e-9, "{seen:?}");
+        assert_eq!(*cusp, want_cusp, "{seen:?}");
+    }
+}
