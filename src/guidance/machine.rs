@@ -650,25 +650,23 @@ impl Guidance {
     /// the vehicle goes on before it must stop), and whether a change of direction (a cusp)
     /// follows them rather than the job's end. A segment shorter than the braking distance
     /// before a cusp (a short piece of swath before backing out) is braked for from the
-    /// segments before it. `(0, false)` on an approach path or an AB job.
-    pub fn same_way_after(&self) -> (f64, bool) {
+    /// segments before it. `None` on an approach path, an AB job or a finished job.
+    pub fn same_way_after(&self) -> Option<(f64, bool)> {
         let JobPlan::Segments(job) = &self.plan else {
-            return (0.0, false);
+            return None;
         };
         if self.approach_index.is_some() || self.phase == Phase::Finished {
-            return (0.0, false);
+            return None;
         }
         let segments = job.segments();
-        let Some(current) = segments.get(self.index_rank) else {
-            return (0.0, false);
-        };
+        let current = segments.get(self.index_rank)?;
         let after = &segments[self.index_rank + 1..];
         let same = after
             .iter()
             .take_while(|s| s.direction == current.direction)
             .count();
         let length = after[..same].iter().map(|s| s.length()).sum();
-        (length, same < after.len())
+        Some((length, same < after.len()))
     }
 
     /// At a cusp the vehicle stops within reach of the end of a segment: move on to the next

@@ -78,8 +78,10 @@ impl ControllerNode {
         // A cusp or the job's end beyond short segments driven the same way: brake for it
         // from here (the guidance moves on to those segments by itself).
         if let Some(est) = c.estimate.filter(|_| next == Some(want) && moving == want) {
-            let (after, cusp) = g.same_way_after();
-            if after <= braking && g.remaining(&est.pose.pos) + after <= braking {
+            let ahead = g.same_way_after().filter(|&(after, _)| after <= braking);
+            if let Some((_, cusp)) =
+                ahead.filter(|&(after, _)| g.remaining(&est.pose.pos) + after <= braking)
+            {
                 self.cusp = cusp;
                 return Some(STOP);
             }

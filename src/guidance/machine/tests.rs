@@ -320,10 +320,10 @@ fn the_segments_driven_the_same_way_count_up_to_the_next_cusp_or_the_end() {
         (3, (0.0, true)),
         (4, (0.0, false)),
     ];
-    for ((rank, (length, cusp)), (want_rank, (want_length, want_cusp))) in seen.iter().zip(expected)
-    {
+    for ((rank, after), (want_rank, (want_length, want_cusp))) in seen.iter().zip(expected) {
+        let (length, cusp) = after.expect("a segment job");
         assert_eq!(*rank, want_rank);
         assert!((length - want_length).abs() < 1e-9, "{seen:?}");
-        assert_eq!(*cusp, want_cusp, "{seen:?}");
+        assert_eq!(cusp, want_cusp, "{seen:?}");
     }
 }
