@@ -539,13 +539,7 @@ impl Guidance {
     /// distance across it, m. `None` where the segments join (within [`GAP_M`]), on the first
     /// segment, while approaching and for AB jobs.
     pub fn gap_before(&self) -> Option<f64> {
-        let JobPlan::Segments(job) = &self.plan else {
-            return None;
-        };
-        if self.approach_index.is_some() || self.phase == Phase::Finished {
-            return None;
-        }
-        let segments = job.segments();
+        let segments = self.segments_driven()?;
         let previous = segments
             .get(self.index_rank.checked_sub(1)?)?
             .points
@@ -645,28 +639,39 @@ impl Guidance {
         (rest - ahead).max(0.0)
     }
 
-    /// The segments after the current one that are driven the same way, up to the next change
-    /// of direction or the job's end: their length, m (how far beyond the current path's end
-    /// the vehicle goes on before it must stop), and whether a change of direction (a cusp)
-    /// follows them rather than the job's end. A segment shorter than the braking distance
-    /// before a cusp (a short piece of swath before backing out) is braked for from the
-    /// segments before it. `None` on an approach path, an AB job or a finished job.
-    pub fn same_way_after(&self) -> Option<(f64, bool)> {
+    /// Where the vehicle must stop next beyond the current path, if within `within` m of its
+    /// end: the segments after the current one driven the same way, up to the next change of
+    /// direction or the job's end, when they are no longer than `within` in all. Gives their
+    /// length, m, and whether a change of direction (a cusp) follows them rather than the
+    /// job's end. A segment shorter than the braking distance before a cusp (a short piece of
+    /// swath before backing out) is so braked for from the segments before it. Called every
+    /// control period: it reads at most `within` m of points. `None` when the stop is farther,
+    /// on an approach path, an AB job or a finished job.
+    pub fn stop_after_within(&self, within: f64) -> Option<(f64, bool)> {
+        let segments = self.segments_driven()?;
+        let direction = segments.get(self.index_rank)?.direction;
+        let mut length = 0.0;
+        for s in &segments[self.index_rank + 1..] {
+            if s.direction != direction {
+                return Some((length, true));
+            }
+            for w in s.points.windows(2) {
+                length += (w[1] - w[0]).norm();
+                if length > within {
+                    return None;
+                }
+            }
+        }
+        Some((length, false))
+    }
+
+    /// A segment job's segments while one of them is driven (not on an approach path, not
+    /// finished).
+    fn segments_driven(&self) -> Option<&[crate::plan::job::JobSegment]> {
         let JobPlan::Segments(job) = &self.plan else {
             return None;
         };
-        if self.approach_index.is_some() || self.phase == Phase::Finished {
-            return None;
-        }
-        let segments = job.segments();
-        let current = segments.get(self.index_rank)?;
-        let after = &segments[self.index_rank + 1..];
-        let same = after
-            .iter()
-            .take_while(|s| s.direction == current.direction)
-            .count();
-        let length = after[..same].iter().map(|s| s.length()).sum();
-        Some((length, same < after.len()))
+        (self.approach_index.is_none() && self.phase != Phase::Finished).then(|| job.segments())
     }
 
     /// At a cusp the vehicle stops within reach of the end of a segment: move on to the next

@@ -2,7 +2,8 @@
 //! job's end the node asks the tractor to stop (the direction-request frame), waits until it
 //! has stopped within reach of the cusp, moves the guidance on to the next segment and asks
 //! for its direction. The braking starts where the stopping distance reaches the cusp, also
-//! across segments driven the same way before it ([`crate::guidance::Guidance::same_way_after`]).
+//! across segments driven the same way before it
+//! ([`crate::guidance::Guidance::stop_after_within`]).
 
 use super::ControllerNode;
 use crate::can::codec::DirectionRequestDirection;
@@ -78,12 +79,11 @@ impl ControllerNode {
         // A cusp or the job's end beyond short segments driven the same way: brake for it
         // from here (the guidance moves on to those segments by itself).
         if let Some(est) = c.estimate.filter(|_| next == Some(want) && moving == want) {
-            let ahead = g.same_way_after().filter(|&(after, _)| after <= braking);
-            if let Some((_, cusp)) =
-                ahead.filter(|&(after, _)| g.remaining(&est.pose.pos) + after <= braking)
-            {
-                self.cusp = cusp;
-                return Some(STOP);
+            if let Some((after, cusp)) = g.stop_after_within(braking) {
+                if g.remaining(&est.pose.pos) + after <= braking {
+                    self.cusp = cusp;
+                    return Some(STOP);
+                }
             }
         }
         if self.cusp && moving == want && v.abs() >= p.min_speed {

@@ -309,7 +309,11 @@ fn the_segments_driven_the_same_way_count_up_to_the_next_cusp_or_the_end() {
     let mut g = Guidance::new(plan, definition, guidance_params(&cfg)).unwrap();
     let mut seen = Vec::new();
     while seen.len() < 5 {
-        seen.push((g.index_rank(), g.same_way_after()));
+        seen.push((g.index_rank(), g.stop_after_within(100.0)));
+        // Farther than asked: none.
+        if g.index_rank() < 2 {
+            assert_eq!(g.stop_after_within(0.4), None, "segment {}", g.index_rank());
+        }
         g.advance_segment();
     }
     assert_eq!(g.index_rank(), 4);
