@@ -263,4 +263,7 @@ fn a_gap_in_the_plan_is_not_steered_across() {
     .expect("the run");
     assert!(on.report.given_back.is_none(), "{:?}", on.report);
     assert!(on.report.sim_time_s > first.0 + 10.0, "{:?}", on.report);
+    // Held there too: the simulated operator, who engages whenever the system is ready, is
+    // refused for the rest of the run.
+    assert_eq!(on.disengage_events.len(), 1, "{:?}", on.disengage_events);
 }
