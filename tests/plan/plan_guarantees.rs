@@ -549,6 +549,45 @@ fn a_leftover_run_that_strands_the_vehicle_is_put_back() {
     assert!(plan.swaths > 0);
 }
 
+/// A plan with gaps starts with the chain of joined segments that works the most ground
+/// (`de_bb_holes_irregular`, three blocks joined by necks no transit crosses, at every width):
+/// the steering is given back at the first gap after that chain, not after the smallest block,
+/// a tenth of the work, as before session 39. The gaps are the planner's: as many as it warns
+/// of, and no chain works more ground than the first.
+#[test]
+fn a_plan_with_gaps_starts_with_the_chain_that_works_most() {
+    for w in [3.0, 12.0, 36.0] {
+        let (field, p, plan) = real_plan("de_bb_holes_irregular", w, 8.0);
+        assert!(check_plan(&field, &plan, p.line_width, p.r_min).is_empty());
+        let worked = |s: &agsteer::plan::coverage::PlanSegment| {
+            use agsteer::plan::coverage::SegmentKind::*;
+            matches!(s.kind, Work | Headland | Detour)
+        };
+        let mut chains = vec![0.0];
+        for (k, s) in plan.segments.iter().enumerate() {
+            assert_eq!(s.index, k);
+            if k > 0 && (s.points[0] - *plan.segments[k - 1].points.last().unwrap()).norm() > 1e-3 {
+                chains.push(0.0);
+            }
+            if worked(s) {
+                *chains.last_mut().unwrap() += s.length();
+            }
+        }
+        assert_eq!(
+            chains.len() - 1,
+            gap_warnings(&plan),
+            "w {w}: {:?}",
+            plan.warnings
+        );
+        assert!(chains.len() >= 2, "w {w}: the blocks are no longer apart");
+        let total: f64 = chains.iter().sum();
+        assert!(
+            chains[1..].iter().all(|&c| c <= chains[0]) && chains[0] >= 0.4 * total,
+            "w {w}: worked per chain {chains:?}"
+        );
+    }
+}
+
 /// How many warnings of `plan` name a place it goes on from without a transit.
 fn gap_warnings(plan: &FieldPlan) -> usize {
     plan.warnings

@@ -8,6 +8,7 @@
 mod apart;
 mod attempts;
 pub mod bypass;
+mod chains;
 mod clear_map;
 mod closed;
 pub mod decompose;
@@ -752,6 +753,8 @@ fn plan_once(
         }
     }
 
+    // Where the plan has gaps, the chain that works the most ground first (see `chains`).
+    let segments = chains::most_work_first(segments, |q| regions.of(q));
     Ok(FieldPlan {
         segments,
         working_area: working,
