@@ -13,6 +13,7 @@ use crate::geo::wgs84::LatLon;
 use crate::geo::Vec2;
 use crate::guidance::progress::JobDefinition;
 use crate::plan::coverage::metrics::{plan_metrics, PlanMetrics};
+use crate::plan::coverage::narrow::refusal;
 use crate::plan::coverage::{plan_field, CoverageParams, FieldPlan};
 use crate::plan::job::{JobPlan, SegmentJob};
 use crate::plan::types::PlanError;
@@ -56,7 +57,9 @@ pub enum FieldJobError {
         count: usize,
         first: Box<crate::plan::coverage::metrics::checks::Violation>,
     },
-    /// The plan has nothing to drive (no swath, no headland pass fits).
+    /// The plan has nothing to drive (no swath, no headland pass fits), or no swath and
+    /// headland passes that work too little of the field
+    /// ([`crate::plan::coverage::narrow::HEADLAND_ONLY_MIN_WORKED`]).
     #[error("nothing to drive in {}: {reason}", path.display())]
     Empty { path: PathBuf, reason: String },
     #[error("the coverage plan of {} cannot be driven as a segment job", path.display())]
@@ -142,10 +145,15 @@ impl FieldJob {
             source,
         })?;
         let plan_time = start.elapsed();
-        if plan.segments.is_empty() {
+        // No swath: refused as `agsteer plan` refuses it, when nothing is planned or the
+        // headland passes alone work less than `HEADLAND_ONLY_MIN_WORKED` of the field (their
+        // metrics are cheap: such fields are small).
+        let worked = (plan.swaths == 0 && !plan.segments.is_empty())
+            .then(|| plan_metrics(&loaded.field, &plan, params.line_width).covered_fraction);
+        if let Some(reason) = refusal(&loaded.field, params, &plan, worked) {
             return Err(FieldJobError::Empty {
                 path: path.to_path_buf(),
-                reason: crate::plan::coverage::narrow::no_swath_words(&loaded.field, params),
+                reason,
             });
         }
         // The independent checks (issue 17 point 2): the daemon, the demo and the simulator

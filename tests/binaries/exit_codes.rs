@@ -191,6 +191,42 @@ fn planning_commands_exit_with_their_own_statuses() {
     ]);
     r.is(Exit::NoSwath, &["nothing to drive in", "no swath fits"]);
     assert!(!r.stderr.contains("segment job"), "{}", r.stderr);
+    // A field 30 m by 41 m at w 12 m: no swath fits, and the one headland pass that does would
+    // work 81 % of it. `plan` refuses it, and so does the field job (before session 39 the
+    // demo drove the pass and exited 0).
+    let small = dir.path().join("small.geojson");
+    std::fs::write(
+        &small,
+        r#"{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[5.0,52.0],[5.0006,52.0],[5.0006,52.00027],[5.0,52.00027],[5.0,52.0]]]}}"#,
+    )
+    .unwrap();
+    let small = small.display().to_string();
+    let words = [
+        "no swath fits",
+        "headland passes alone would work",
+        "< 97 %",
+    ];
+    agsteer(&[
+        "plan",
+        "--config",
+        "config/demo-field.toml",
+        "--field",
+        &small,
+        "--out",
+        &out,
+    ])
+    .is(Exit::NoSwath, &words);
+    let field_path = format!("job.field_path={small}");
+    agsteer(&[
+        "demo",
+        "--config",
+        "config/demo-field.toml",
+        "--set",
+        &field_path,
+        "--out",
+        &demo_out,
+    ])
+    .is(Exit::NoSwath, &words);
 }
 
 #[test]

@@ -11,6 +11,7 @@ use agsteer::field::{
 };
 use agsteer::plan::coverage::metrics::checks::{check_plan, ViolationKind};
 use agsteer::plan::coverage::metrics::{area_and_pieces, plan_metrics};
+use agsteer::plan::coverage::narrow::{refusal, HEADLAND_ONLY_MIN_WORKED};
 use agsteer::plan::coverage::{CoverageParams, Field, FieldPlan};
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -310,43 +311,6 @@ where
         return Ok(agsteer::exit::Exit::PlanViolation.code());
     }
     Ok(0)
-}
-
-/// A plan without swaths worked by headland passes alone is accepted when they work at least
-/// this fraction of the field (issue 17's "every plan ≥ 97 %"); below it, and for a plan with
-/// no working pass at all, `agsteer plan` refuses with the reason and the numbers (exit 5).
-pub const HEADLAND_ONLY_MIN_WORKED: f64 = 0.97;
-
-/// Why `plan` is refused, if it is: no swath and no headland pass; or no swath, and the
-/// headland passes work less than [`HEADLAND_ONLY_MIN_WORKED`] of the field (`worked`, when
-/// the metrics are known). The reason names the field's width, the implement's, the turn
-/// diameter and the largest width that fits.
-fn refusal(
-    field: &Field,
-    params: &CoverageParams,
-    plan: &FieldPlan,
-    worked: Option<f64>,
-) -> Option<String> {
-    use agsteer::plan::coverage::SegmentKind;
-    if plan.swaths > 0 {
-        return None;
-    }
-    let passes = plan
-        .segments
-        .iter()
-        .any(|s| s.kind == SegmentKind::Headland);
-    let short = match worked {
-        None if passes => return None,
-        Some(f) if f >= HEADLAND_ONLY_MIN_WORKED => return None,
-        Some(f) => format!(
-            "; headland passes alone would work {:.1} % of it (< {:.0} %)",
-            100.0 * f,
-            100.0 * HEADLAND_ONLY_MIN_WORKED
-        ),
-        None => String::new(),
-    };
-    let reason = agsteer::plan::coverage::narrow::no_swath_words(field, params);
-    Some(format!("{reason}{short}"))
 }
 
 /// One plan of a sweep, by the independent metrics. Fractions 0–1, lengths m, areas m².

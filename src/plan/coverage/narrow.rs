@@ -100,6 +100,43 @@ pub fn no_swath_words(field: &Field, p: &CoverageParams) -> String {
     }
 }
 
+/// A plan without swaths worked by headland passes alone is accepted when they work at least
+/// this fraction of the field (issue 17's "every plan ≥ 97 %"); below it, and for a plan with
+/// no working pass at all, it is refused with the reason and the numbers: by `agsteer plan`
+/// (exit 5) and by the field job of the daemon, the demo and the simulator alike.
+pub const HEADLAND_ONLY_MIN_WORKED: f64 = 0.97;
+
+/// Why `plan` is refused, if it is: no swath and no headland pass; or no swath, and the
+/// headland passes work less than [`HEADLAND_ONLY_MIN_WORKED`] of the field (`worked`, when
+/// the metrics are known). The reason names the field's width, the implement's, the turn
+/// diameter and the largest width that fits.
+pub fn refusal(
+    field: &Field,
+    params: &CoverageParams,
+    plan: &FieldPlan,
+    worked: Option<f64>,
+) -> Option<String> {
+    if plan.swaths > 0 {
+        return None;
+    }
+    let passes = plan
+        .segments
+        .iter()
+        .any(|s| s.kind == SegmentKind::Headland);
+    let short = match worked {
+        None if passes => return None,
+        Some(f) if f >= HEADLAND_ONLY_MIN_WORKED => return None,
+        Some(f) => format!(
+            "; headland passes alone would work {:.1} % of it (< {:.0} %)",
+            100.0 * f,
+            100.0 * HEADLAND_ONLY_MIN_WORKED
+        ),
+        None => String::new(),
+    };
+    let reason = no_swath_words(field, params);
+    Some(format!("{reason}{short}"))
+}
+
 /// The largest implement width at which [`super::plan_field`] plans swaths, trying `start` and
 /// then 0.5 m narrower each time, at most `tries` plans; `None` when none of them has a swath.
 pub fn largest_planned_width(
