@@ -585,11 +585,14 @@ fn plan_once(
                         }
                         let far_end: Vec<Vec2> = near_end.iter().rev().copied().collect();
                         let ends = [near_end, far_end].into_iter();
-                        let (track, cut) =
-                            ring_start::first_reached(ends, &transit_gaps, &warnings, |t| {
-                                go_to(&mut segments, &mut at, t, 0)
-                            })
-                            .unwrap_or_default();
+                        let (track, cut) = ring_start::first_reached(
+                            ends,
+                            || None,
+                            &transit_gaps,
+                            &warnings,
+                            |t| go_to(&mut segments, &mut at, t, 0),
+                        )
+                        .unwrap_or_default();
                         let track = track[cut..].to_vec();
                         let n = track.len();
                         if n >= 2 {
@@ -611,11 +614,16 @@ fn plan_once(
                     let m = open.len();
                     let first = ring_start::first_start(open, at, &field.boundary, p, &clear);
                     let starts = std::iter::once(first).chain(ring_start::other_starts(m, first));
-                    let (start, cut) =
-                        ring_start::first_reached(starts, &transit_gaps, &warnings, |&s| {
-                            go_to(&mut segments, &mut at, &ring_start::track_from(open, s), 0)
-                        })
-                        .unwrap_or((first, 0));
+                    // With no way to it, the pass starts on a straight near the first start.
+                    let straight = || Some(ring_start::straight_start(open, first, p));
+                    let (start, cut) = ring_start::first_reached(
+                        starts,
+                        straight,
+                        &transit_gaps,
+                        &warnings,
+                        |&s| go_to(&mut segments, &mut at, &ring_start::track_from(open, s), 0),
+                    )
+                    .unwrap_or((first, 0));
                     let track = ring_start::track_from(open, start);
                     // A start pulled back (no way to it): the pass goes on past its start over the
                     // stretch cut, so the whole ring is still worked once.
