@@ -166,67 +166,57 @@ fn planning_commands_exit_with_their_own_statuses() {
     ]);
     assert!(r.stdout.contains("no path"), "{}", r.stdout);
     r.is(Exit::NoPath, &[]);
-    // A strip 3.3 m wide: no swath fits.
-    let field = dir.path().join("strip.geojson");
-    std::fs::write(
-        &field,
-        r#"{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[5.0,52.0],[5.0015,52.0],[5.0015,52.00003],[5.0,52.00003],[5.0,52.0]]]}}"#,
-    )
-    .unwrap();
-    let field = field.display().to_string();
+    // A field file of `dir` with the polygon `ring` (lon, lat), its path.
+    let field_file = |name: &str, ring: &str| {
+        let path = dir.path().join(name);
+        let text = format!(
+            r#"{{"type":"Feature","properties":{{}},"geometry":{{"type":"Polygon","coordinates":[{ring}]}}}}"#
+        );
+        std::fs::write(&path, text).unwrap();
+        path.display().to_string()
+    };
     let out = dir.path().join("plan").display().to_string();
+    let demo_out = dir.path().join("demo").display().to_string();
+    // The field demo on the field file at `field`.
+    let demo = |field: &str| {
+        let field_path = format!("job.field_path={field}");
+        agsteer(&[
+            "demo",
+            "--config",
+            "config/demo-field.toml",
+            "--set",
+            &field_path,
+            "--out",
+            &demo_out,
+        ])
+    };
+    // A strip 3.3 m wide: no swath fits.
+    let field = field_file(
+        "strip.geojson",
+        "[[5.0,52.0],[5.0015,52.0],[5.0015,52.00003],[5.0,52.00003],[5.0,52.0]]",
+    );
     agsteer(&["plan", "--field", &field, "--out", &out]).is(Exit::NoSwath, &["no swath fits"]);
     // The same field as a field job: nothing to drive, the same status and reason (not "a
     // segment job needs at least one segment").
-    let field_path = format!("job.field_path={field}");
-    let demo_out = dir.path().join("demo").display().to_string();
-    let r = agsteer(&[
-        "demo",
-        "--config",
-        "config/demo-field.toml",
-        "--set",
-        &field_path,
-        "--out",
-        &demo_out,
-    ]);
+    let r = demo(&field);
     r.is(Exit::NoSwath, &["nothing to drive in", "no swath fits"]);
     assert!(!r.stderr.contains("segment job"), "{}", r.stderr);
     // A field 30 m by 41 m at w 12 m: no swath fits, and the one headland pass that does would
     // work 81 % of it. `plan` refuses it, and so does the field job (before session 39 the
     // demo drove the pass and exited 0).
-    let small = dir.path().join("small.geojson");
-    std::fs::write(
-        &small,
-        r#"{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[5.0,52.0],[5.0006,52.0],[5.0006,52.00027],[5.0,52.00027],[5.0,52.0]]]}}"#,
-    )
-    .unwrap();
-    let small = small.display().to_string();
+    let small = field_file(
+        "small.geojson",
+        "[[5.0,52.0],[5.0006,52.0],[5.0006,52.00027],[5.0,52.00027],[5.0,52.0]]",
+    );
     let words = [
         "no swath fits",
         "headland passes alone would work",
         "< 97 %",
     ];
-    agsteer(&[
-        "plan",
-        "--config",
-        "config/demo-field.toml",
-        "--field",
-        &small,
-        "--out",
-        &out,
-    ])
-    .is(Exit::NoSwath, &words);
-    let field_path = format!("job.field_path={small}");
-    agsteer(&[
-        "demo",
-        "--config",
-        "config/demo-field.toml",
-        "--set",
-        &field_path,
-        "--out",
-        &demo_out,
-    ])
-    .is(Exit::NoSwath, &words);
+    let config = "config/demo-field.toml";
+    agsteer(&["plan", "--config", config, "--field", &small, "--out", &out])
+        .is(Exit::NoSwath, &words);
+    demo(&small).is(Exit::NoSwath, &words);
 }
 
 #[test]
