@@ -4,7 +4,7 @@
 //! turned, and steers the reverse segment about the rear axle; the simulator obeys the requests.
 
 use agsteer::config::Config;
-use agsteer::demo::{run, DemoOptions};
+use agsteer::demo::{run, DemoOptions, DemoRun};
 use agsteer::geo::{v2, Direction, Vec2};
 use agsteer::guidance::{Event, JobPlan};
 use agsteer::plan::coverage::SegmentKind;
@@ -19,11 +19,27 @@ fn seg(direction: Direction, points: Vec<Vec2>) -> JobSegment {
     }
 }
 
+/// Forward east along y = 0 from x = 0 to 40 m, points 0.5 m apart.
+fn forward_40_m() -> Vec<Vec2> {
+    (0..=80).map(|i| v2(i as f64 * 0.5, 0.0)).collect()
+}
+
+/// `job` driven closed-loop with `cfg`, its trace recorded, each guidance event given to
+/// `on_event`.
+fn drive(cfg: &Config, job: SegmentJob, on_event: &mut dyn FnMut(f64, &Event)) -> DemoRun {
+    let options = DemoOptions {
+        job: Some(JobPlan::Segments(job)),
+        record_trace: true,
+        ..Default::default()
+    };
+    run(cfg, &options, &mut |_| {}, on_event).unwrap()
+}
+
 /// Forward east along y = 0 for 40 m; reverse west along a gentle S (a cosine from y = 0 to
 /// y = 4 m over 40 m: curvature ≤ 0.025 /m); forward east along y = 4 for 40 m.
 fn job() -> SegmentJob {
     let n = 80;
-    let forward: Vec<Vec2> = (0..=n).map(|i| v2(i as f64 * 0.5, 0.0)).collect();
+    let forward = forward_40_m();
     let reverse: Vec<Vec2> = (0..=n)
         .map(|i| {
             let s = i as f64 / n as f64;
@@ -47,17 +63,7 @@ fn drives_a_job_with_two_cusps_closed_loop() {
     let mut cfg = Config::default();
     cfg.control.speed_kmh = 5.0;
     let mut events = Vec::new();
-    let run = run(
-        &cfg,
-        &DemoOptions {
-            job: Some(JobPlan::Segments(job())),
-            record_trace: true,
-            ..Default::default()
-        },
-        &mut |_| {},
-        &mut |t, e| events.push((t, e.clone())),
-    )
-    .unwrap();
+    let run = drive(&cfg, job(), &mut |t, e| events.push((t, e.clone())));
     let r = &run.report;
     assert!(r.finished, "{r:?}");
     assert_eq!(r.lines_completed, 3);
@@ -116,7 +122,7 @@ fn drives_a_job_with_two_cusps_closed_loop() {
 /// backing out along a quarter circle of radius 10 m that bends north (the tractor's rear
 /// going north-west).
 fn job_with_a_short_piece_before_the_cusp(stub: f64) -> SegmentJob {
-    let forward: Vec<Vec2> = (0..=80).map(|i| v2(i as f64 * 0.5, 0.0)).collect();
+    let forward = forward_40_m();
     let piece = vec![v2(40.0, 0.0), v2(40.0 + stub, 0.0)];
     let r = 10.0;
     let back: Vec<Vec2> = (0..=30)
@@ -142,19 +148,11 @@ fn a_cusp_after_a_piece_shorter_than_the_braking_distance_is_stopped_at() {
     let mut cfg = Config::default();
     cfg.control.speed_kmh = 10.0;
     let stub = 0.5;
-    let run = run(
+    let run = drive(
         &cfg,
-        &DemoOptions {
-            job: Some(JobPlan::Segments(job_with_a_short_piece_before_the_cusp(
-                stub,
-            ))),
-            record_trace: true,
-            ..Default::default()
-        },
-        &mut |_| {},
+        job_with_a_short_piece_before_the_cusp(stub),
         &mut |_, _| {},
-    )
-    .unwrap();
+    );
     let r = &run.report;
     assert!(r.finished, "{r:?}");
     // Stopped within the capture distance (1 m) of the cusp, not a braking distance past it.

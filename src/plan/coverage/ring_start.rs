@@ -7,6 +7,7 @@
 //! transit, twice). An open stretch of a cut pass is started at its end nearer the vehicle,
 //! else at the other.
 
+use super::metrics::three_point_curvature;
 use super::transit;
 use super::CoverageParams;
 use crate::geo::{vec_heading, Vec2};
@@ -80,13 +81,11 @@ pub(super) fn straight_start(open: &[Vec2], from: usize, p: &CoverageParams) -> 
     if m < 3 {
         return from.min(m.saturating_sub(1));
     }
-    // Point k bends when the turn there over the mean of its two pieces is too sharp.
+    // Point k bends when its three-point curvature (the guarantees' measure) is too sharp.
     let bends: Vec<bool> = (0..m)
         .map(|k| {
             let (a, b, c) = (open[(k + m - 1) % m], open[k], open[(k + 1) % m]);
-            let turn = crate::geo::wrap_angle(vec_heading(&(c - b)) - vec_heading(&(b - a)));
-            let piece = 0.5 * ((b - a).norm() + (c - b).norm());
-            turn.abs() > STRAIGHT_CURVATURE_R_MIN / p.r_min * piece.max(1e-9)
+            three_point_curvature(&a, &b, &c) > STRAIGHT_CURVATURE_R_MIN / p.r_min
         })
         .collect();
     // The points ahead of each start that must not bend: the stretch's length in pieces.
