@@ -2,7 +2,7 @@
 //! cover (docs/METHODS.md, Headland and working area): found once from the passes' areas, it
 //! joins the working area where an implement-wide disc fits, or is worked as cells of its own.
 
-use super::geometry::{in_area, offset, simplified, Area};
+use super::geometry::{in_area, offset_within, simplified, Area};
 use super::headland::{
     difference, pass_offset, ring_distance, union, Passes, SMOOTHING_RADIUS_FACTOR,
 };
@@ -13,6 +13,15 @@ use crate::geo::Vec2;
 /// ([`with_leftover`]): its offsets' fine arcs made the clipper cross every edge with every
 /// other (over a second on one parcel), for ground drawn to a few centimetres anyway.
 const LEFTOVER_SIMPLIFY_M: f64 = 0.05;
+
+/// The leftover ground's offsets keep their chords this close to their arcs, m: within the
+/// simplification, and within the slack, so the footprints still overlap where they meet.
+const LEFTOVER_CHORD_M: f64 = 0.02;
+
+/// [`offset_within`] to [`LEFTOVER_CHORD_M`].
+fn offset(areas: &[Area], distance: f64) -> Vec<Area> {
+    offset_within(areas, distance, LEFTOVER_CHORD_M)
+}
 
 /// How much wider than the implement each footprint is taken when the leftover ground is
 /// found, m ([`with_leftover`]).
