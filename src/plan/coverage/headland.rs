@@ -549,8 +549,7 @@ pub fn clear_stretches(
     r_min: f64,
     warnings: &std::cell::RefCell<Vec<String>>,
 ) -> Vec<Vec<Vec2>> {
-    use super::metrics::checks::{CURVATURE_SLACK, CURVATURE_SLACK_ABS};
-    let limit = (1.0 + CURVATURE_SLACK) / r_min + CURVATURE_SLACK_ABS;
+    let limit = super::metrics::checks::curvature_limit(r_min);
     let mut out = Vec::new();
     for track in tracks {
         // Closed: the last point repeats the first.

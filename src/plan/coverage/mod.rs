@@ -205,7 +205,8 @@ fn plan_once(
         obstacles: obstacle_passes,
         ..
     } = passes;
-    // Transits may follow the headland passes (field and obstacles) where they are clear.
+    // Transits may follow the headland passes (field and obstacles) where they are clear and
+    // turn no tighter than r_min (where the passes themselves are cut: `clear_stretches`).
     let rings = rings::Rings::new(
         &field_passes
             .iter()
@@ -213,6 +214,7 @@ fn plan_once(
             .cloned()
             .collect::<Vec<_>>(),
         &clear,
+        metrics::checks::curvature_limit(p.r_min),
     );
     // Pieces of the field that no transit with the implement clear joins (see `apart`).
     let gap = p.point_spacing.max(rings.max_gap());

@@ -40,7 +40,7 @@ struct Ring {
 const CHUNK: usize = 16;
 
 impl Ring {
-    fn new(track: &[Vec2], clear: &dyn Fn(&Vec2) -> bool) -> Option<Self> {
+    fn new(track: &[Vec2], clear: &dyn Fn(&Vec2) -> bool, max_curvature: f64) -> Option<Self> {
         let mut pts: Vec<Vec2> = track.to_vec();
         if pts.len() >= 2 && (pts[pts.len() - 1] - pts[0]).norm() < 1e-9 {
             pts.pop();
@@ -49,6 +49,14 @@ impl Ring {
             return None;
         }
         let n = pts.len();
+        // A point where the ring turns tighter than allowed is not followed, as one that is
+        // not clear: a transit along it would break the curvature guarantee there.
+        let ok = |i: usize| {
+            let (a, b) = (pts[(i + n - 1) % n], pts[(i + 1) % n]);
+            clear(&pts[i])
+                && crate::plan::coverage::metrics::three_point_curvature(&a, &pts[i], &b)
+                    <= max_curvature
+        };
         let mut cum = Vec::with_capacity(n + 1);
         let mut blocked = Vec::with_capacity(n + 1);
         let (mut len, mut b) = (0.0, 0u32);
@@ -56,7 +64,7 @@ impl Ring {
             cum.push(len);
             blocked.push(b);
             len += (pts[(i + 1) % n] - pts[i]).norm();
-            b += u32::from(!clear(&pts[i]));
+            b += u32::from(!ok(i));
         }
         cum.push(len);
         blocked.push(b);
@@ -178,10 +186,14 @@ pub struct Rings {
 }
 
 impl Rings {
-    /// The tracks (closed: first point repeated last, or not) with their clear points.
-    pub fn new(tracks: &[Vec<Vec2>], clear: &dyn Fn(&Vec2) -> bool) -> Self {
+    /// The tracks (closed: first point repeated last, or not) with their points that are
+    /// clear and turn no tighter than `max_curvature` (three-point curvature, 1/m).
+    pub fn new(tracks: &[Vec<Vec2>], clear: &dyn Fn(&Vec2) -> bool, max_curvature: f64) -> Self {
         Rings {
-            rings: tracks.iter().filter_map(|t| Ring::new(t, clear)).collect(),
+            rings: tracks
+                .iter()
+                .filter_map(|t| Ring::new(t, clear, max_curvature))
+                .collect(),
         }
     }
 
@@ -689,7 +701,7 @@ mod tests {
                 .any(|s| crate::geo::polygon::point_segment_distance(q, &s[0], &s[1]) <= 10.5)
                 && !(q.x > 45.0 && q.x < 55.0 && q.y > 2.0 && q.y < 8.0)
         };
-        let rings = Rings::new(&tracks, &clear);
+        let rings = Rings::new(&tracks, &clear, f64::INFINITY);
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let mut pose = || {
             let q = v2(rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0));
@@ -734,7 +746,7 @@ mod tests {
                 .windows(2)
                 .any(|s| crate::geo::polygon::point_segment_distance(q, &s[0], &s[1]) <= 10.5)
         };
-        let rings = Rings::new(&[track], &near_track);
+        let rings = Rings::new(&[track], &near_track, f64::INFINITY);
         let from = v2(10.0, 90.0);
         let to = v2(90.0, 90.0);
         let pts = rings
@@ -773,5 +785,43 @@ mod tests {
         )
         .unwrap();
         assert!(!ok && !direct.is_empty());
+    }
+
+    /// A ring's points that turn tighter than the limit are not followed: the U's track with
+    /// its square corners (three-point curvature 1.41 /m at 1 m spacing) gives, with the limit
+    /// of r_min 3 m, a way (if any) that turns no tighter than that anywhere; without the limit
+    /// the way round the bay follows the corners.
+    #[test]
+    fn a_transit_does_not_follow_a_ring_round_a_corner_tighter_than_r_min() {
+        let corners = u_corners();
+        let track = crate::geo::polygon::resample(&corners, 1.0);
+        let near_track = |q: &Vec2| {
+            corners
+                .windows(2)
+                .any(|s| crate::geo::polygon::point_segment_distance(q, &s[0], &s[1]) <= 10.5)
+        };
+        let limit = crate::plan::coverage::metrics::checks::curvature_limit(3.0);
+        let tightest = |pts: &[Vec2]| {
+            pts.windows(3)
+                .map(|w| crate::plan::coverage::metrics::three_point_curvature(&w[0], &w[1], &w[2]))
+                .fold(0.0, f64::max)
+        };
+        let way = |max_curvature: f64| {
+            Rings::new(std::slice::from_ref(&track), &near_track, max_curvature).transit_with(
+                v2(10.0, 90.0),
+                std::f64::consts::FRAC_PI_2,
+                v2(90.0, 90.0),
+                -std::f64::consts::FRAC_PI_2,
+                3.0,
+                0.5,
+                &near_track,
+                &mut Ends::default(),
+            )
+        };
+        let unlimited = way(f64::INFINITY).expect("a way round the bay");
+        assert!(tightest(&unlimited) > 1.0);
+        if let Some(pts) = way(limit) {
+            assert!(tightest(&pts) <= limit, "{} /m", tightest(&pts));
+        }
     }
 }

@@ -17,6 +17,12 @@ pub const CURVATURE_SLACK: f64 = 0.02;
 /// Absolute slack of the curvature limit, 1/m.
 pub const CURVATURE_SLACK_ABS: f64 = 1e-3;
 
+/// The largest three-point curvature the guarantees allow at `r_min`, 1/m: 1/r_min with
+/// [`CURVATURE_SLACK`] and [`CURVATURE_SLACK_ABS`].
+pub fn curvature_limit(r_min: f64) -> f64 {
+    (1.0 + CURVATURE_SLACK) / r_min + CURVATURE_SLACK_ABS
+}
+
 /// What a violation breaks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -115,7 +121,7 @@ impl Runs<'_> {
 pub fn check_plan(field: &Field, plan: &FieldPlan, line_width: f64, r_min: f64) -> Vec<Violation> {
     use SegmentKind::*;
     let half = 0.5 * line_width;
-    let limit = (1.0 + CURVATURE_SLACK) / r_min + CURVATURE_SLACK_ABS;
+    let limit = curvature_limit(r_min);
     let mut out = Vec::new();
     for s in &plan.segments {
         let seg = (s.index, s.kind);

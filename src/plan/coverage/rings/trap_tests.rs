@@ -128,7 +128,7 @@ fn trap_lengths_give_the_same_transits() {
         v2(6.0, 94.0),
         v2(6.0, 6.0),
     ];
-    let rings = Rings::new(&[resample(&track, 1.0)], &clear);
+    let rings = Rings::new(&[resample(&track, 1.0)], &clear, f64::INFINITY);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
     let (mut with, mut without) = (Ends::with_margin(&margin), Ends::default());
     let (mut found, mut none) = (0, 0);
