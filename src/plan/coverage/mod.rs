@@ -206,7 +206,10 @@ fn plan_once(
         ..
     } = passes;
     // Transits may follow the headland passes (field and obstacles) where they are clear and
-    // turn no tighter than r_min (where the passes themselves are cut: `clear_stretches`).
+    // turn no tighter than r_min (the passes themselves are cut where they turn tighter than
+    // the checks allow: `clear_stretches`). The rings' own limit leaves the checks' absolute
+    // slack to the joins, which bend a little more than the ring where a curve meets it (a
+    // ring at 0.0697 /m, a join at 0.06987 against 0.06985 at r_min 14.8 m).
     let rings = rings::Rings::new(
         &field_passes
             .iter()
@@ -214,7 +217,7 @@ fn plan_once(
             .cloned()
             .collect::<Vec<_>>(),
         &clear,
-        metrics::checks::curvature_limit(p.r_min),
+        metrics::checks::curvature_limit(p.r_min) - metrics::checks::CURVATURE_SLACK_ABS,
     );
     // Pieces of the field that no transit with the implement clear joins (see `apart`).
     let gap = p.point_spacing.max(rings.max_gap());
