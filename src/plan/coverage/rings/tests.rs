@@ -75,33 +75,34 @@ fn kept_ends_give_the_same_transits() {
     assert!(found > 10 && none > 2, "{found} found, {none} not");
 }
 
+/// The track round the U of [`u_corners`], points 1 m apart (its corners square).
+fn u_track() -> Vec<Vec2> {
+    crate::geo::polygon::resample(&u_corners(), 1.0)
+}
+
+/// Clear: within 10.5 m of [`u_track`] (a corridor), sharp corners allowed for the tests.
+fn near_u_track(q: &Vec2) -> bool {
+    u_corners()
+        .windows(2)
+        .any(|s| crate::geo::polygon::point_segment_distance(q, &s[0], &s[1]) <= 10.5)
+}
+
 /// A U-shaped field's ring: the way from one arm's tip to the other's goes round the bay,
 /// where a direct curve would cross it.
 #[test]
 fn a_transit_follows_the_ring_round_a_bay() {
-    // Track round a U (arms 20 m wide, bay 60 m wide and 80 m deep), 1 m apart.
-    let corners = u_corners();
-    let track = crate::geo::polygon::resample(&corners, 1.0);
-    // Clear: within 10.5 m of the track (a corridor), sharp corners allowed for the test.
-    let near_track = |q: &Vec2| {
-        corners
-            .windows(2)
-            .any(|s| crate::geo::polygon::point_segment_distance(q, &s[0], &s[1]) <= 10.5)
-    };
+    let (track, near_track) = (u_track(), near_u_track);
     let rings = Rings::new(&[track], &near_track, f64::INFINITY);
-    let from = v2(10.0, 90.0);
-    let to = v2(90.0, 90.0);
+    // From one arm's tip heading up it to the other's heading down, at r 3 m, points 0.5 m apart.
+    let (from, to) = (v2(10.0, 90.0), v2(90.0, 90.0));
+    let (h1, h2, r, step) = (
+        std::f64::consts::FRAC_PI_2,
+        -std::f64::consts::FRAC_PI_2,
+        3.0,
+        0.5,
+    );
     let pts = rings
-        .transit_with(
-            from,
-            std::f64::consts::FRAC_PI_2,
-            to,
-            -std::f64::consts::FRAC_PI_2,
-            3.0,
-            0.5,
-            &near_track,
-            &mut Ends::default(),
-        )
+        .transit_with(from, h1, to, h2, r, step, &near_track, &mut Ends::default())
         .expect("a way round the bay");
     assert!(pts.iter().all(near_track));
     assert!((pts[0] - from).norm() < 1e-9);
@@ -116,16 +117,7 @@ fn a_transit_follows_the_ring_round_a_bay() {
     assert!(!crossings.is_empty());
     assert!(crossings.iter().all(|&y| y < 30.5), "{crossings:?}");
     // A direct curve would cross the bay.
-    let (direct, ok) = transit(
-        from,
-        std::f64::consts::FRAC_PI_2,
-        to,
-        -std::f64::consts::FRAC_PI_2,
-        3.0,
-        0.5,
-        &near_track,
-    )
-    .unwrap();
+    let (direct, ok) = transit(from, h1, to, h2, r, step, &near_track).unwrap();
     assert!(!ok && !direct.is_empty());
 }
 
@@ -135,13 +127,7 @@ fn a_transit_follows_the_ring_round_a_bay() {
 /// the way round the bay follows the corners.
 #[test]
 fn a_transit_does_not_follow_a_ring_round_a_corner_tighter_than_r_min() {
-    let corners = u_corners();
-    let track = crate::geo::polygon::resample(&corners, 1.0);
-    let near_track = |q: &Vec2| {
-        corners
-            .windows(2)
-            .any(|s| crate::geo::polygon::point_segment_distance(q, &s[0], &s[1]) <= 10.5)
-    };
+    let (track, near_track) = (u_track(), near_u_track);
     let limit = crate::plan::coverage::metrics::checks::curvature_limit(3.0);
     let tightest = |pts: &[Vec2]| {
         pts.windows(3)
