@@ -558,10 +558,7 @@ pub fn clear_stretches(
             .iter()
             .enumerate()
             .map(|(i, q)| {
-                let curve_ok = m < 3 || {
-                    let (a, b) = (track[(i + m - 1) % m], track[(i + 1) % m]);
-                    super::metrics::three_point_curvature(&a, q, &b) <= limit
-                };
+                let curve_ok = m < 3 || super::metrics::ring_curvature(&track[..m], i) <= limit;
                 curve_ok && clear(q)
             })
             .collect();

@@ -485,6 +485,13 @@ pub fn three_point_curvature(a: &Vec2, b: &Vec2, c: &Vec2) -> f64 {
     (2.0 * cross(&(b - a), &(c - b)) / denom).abs()
 }
 
+/// [`three_point_curvature`] at point `k` of the closed ring `open` (its points, the first not
+/// repeated), with its neighbours round the ring, 1/m.
+pub fn ring_curvature(open: &[Vec2], k: usize) -> f64 {
+    let m = open.len();
+    three_point_curvature(&open[(k + m - 1) % m], &open[k % m], &open[(k + 1) % m])
+}
+
 fn max_curvature(points: &[Vec2]) -> f64 {
     merged(points)
         .windows(3)

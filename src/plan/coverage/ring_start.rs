@@ -7,7 +7,7 @@
 //! transit, twice). An open stretch of a cut pass is started at its end nearer the vehicle,
 //! else at the other.
 
-use super::metrics::three_point_curvature;
+use super::metrics::ring_curvature;
 use super::transit;
 use super::CoverageParams;
 use crate::geo::{vec_heading, Vec2};
@@ -83,10 +83,7 @@ pub(super) fn straight_start(open: &[Vec2], from: usize, p: &CoverageParams) -> 
     }
     // Point k bends when its three-point curvature (the guarantees' measure) is too sharp.
     let bends: Vec<bool> = (0..m)
-        .map(|k| {
-            let (a, b, c) = (open[(k + m - 1) % m], open[k], open[(k + 1) % m]);
-            three_point_curvature(&a, &b, &c) > STRAIGHT_CURVATURE_R_MIN / p.r_min
-        })
+        .map(|k| ring_curvature(open, k) > STRAIGHT_CURVATURE_R_MIN / p.r_min)
         .collect();
     // The points ahead of each start that must not bend: the stretch's length in pieces.
     let ahead = STRAIGHT_AHEAD_R_MIN * p.r_min;

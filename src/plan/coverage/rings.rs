@@ -52,10 +52,8 @@ impl Ring {
         // A point where the ring turns tighter than allowed is not followed, as one that is
         // not clear: a transit along it would break the curvature guarantee there.
         let ok = |i: usize| {
-            let (a, b) = (pts[(i + n - 1) % n], pts[(i + 1) % n]);
             clear(&pts[i])
-                && crate::plan::coverage::metrics::three_point_curvature(&a, &pts[i], &b)
-                    <= max_curvature
+                && crate::plan::coverage::metrics::ring_curvature(&pts, i) <= max_curvature
         };
         let mut cum = Vec::with_capacity(n + 1);
         let mut blocked = Vec::with_capacity(n + 1);
